@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# README command 2: install, build (Release and ASan+UBSan), run the whole test suite (ctest + pytest).
+# UWB_SKIP_SANITIZE=1 skips the sanitizer build (for quick local iterations only; CI always runs it).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/setup.sh
+JOBS="${UWB_JOBS:-$(nproc)}"
+
+echo "[test] unit and regression tests (Release)"
+ctest --test-dir build --output-on-failure -j "$JOBS" -LE slow
+
+echo "[test] Python tests"
+PYTHONPATH="$PWD/build/python" /usr/bin/python3 -m pytest -q python/tests
+
+if [ "${UWB_SKIP_SANITIZE:-0}" != "1" ]; then
+  echo "[test] unit tests under AddressSanitizer + UndefinedBehaviorSanitizer"
+  if [ ! -f build-asan/CMakeCache.txt ]; then
+    cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DUWB_SANITIZE=ON \
+      -DUWB_BUILD_BENCHMARKS=OFF -DUWB_BUILD_PYTHON=OFF
+  fi
+  cmake --build build-asan -j "$JOBS"
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --test-dir build-asan --output-on-failure -j "$JOBS" -L unit -LE "slow|realdata"
+fi
+echo "[test] all passed"
