@@ -1,0 +1,29 @@
+/** @file TrajectoryCsv.h
+ *  @brief Estimated trajectories: the filter's output, written as CSV for users and plots.
+ *
+ *  Columns: t,x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz  (SI units; quaternion body→world).
+ */
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "uwb/core/Types.h"
+
+namespace uwb {
+
+/// One estimated state: body origin, attitude, velocity and position standard deviations.
+struct TrajectorySample {
+  double t_s = 0.0;
+  Vec3 w_p_b = Vec3::Zero();      ///< body origin in the world frame [m]
+  Quat w_q_b = Quat::Identity();  ///< body→world rotation
+  Vec3 sigma_p_m = Vec3::Zero();  ///< 1σ of the position per world axis [m]
+  Vec3 w_v_b = Vec3::Zero();      ///< velocity in the world frame [m/s]
+};
+
+using Trajectory = std::vector<TrajectorySample>;
+
+void writeTrajectoryCsv(const Trajectory& trajectory, const std::string& path);
+Trajectory readTrajectoryCsv(const std::string& path);
+
+}  // namespace uwb
