@@ -1,0 +1,52 @@
+/** @file EvaluationTable.h
+ *  @brief The paper's Fig. 5 table: airborne RMSE without/with bias correction per kernel and number of
+ *         inducing points, aggregated over repeats and test flights; written as Markdown, CSV and JSON.
+ */
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+namespace uwb {
+
+/// One localization of one test flight with one trained model (one repeat).
+struct EvaluationRun {
+  std::string kernel;
+  int inducing = 0;
+  int repeat = 0;
+  std::string flight;
+  double rmse_uncorrected_m = 0.0;  ///< airborne 3D RMSE without correction
+  double rmse_corrected_m = 0.0;    ///< airborne 3D RMSE with the GP correction
+  double bias_rmse_before_m = 0.0;  ///< TDoA bias RMSE on the test flight, raw
+  double bias_rmse_after_m = 0.0;   ///< TDoA bias RMSE after subtracting the GP mean (ground-truth features)
+  double train_seconds = 0.0;
+};
+
+/// One row of the table: a kernel and a number of inducing points.
+struct EvaluationRow {
+  std::string kernel;
+  int inducing = 0;
+  int n_repeats = 0;
+  int n_flights = 0;
+  double rmse_uncorrected_m = 0.0;  ///< mean over repeats and test flights
+  double rmse_corrected_m = 0.0;    ///< mean over repeats and test flights
+  double improvement_pct = 0.0;     ///< 100 (1 − corrected / uncorrected), from the means above
+  double improvement_pct_min = 0.0; ///< over repeats (each repeat: mean over flights)
+  double improvement_pct_max = 0.0;
+  double bias_rmse_before_m = 0.0;
+  double bias_rmse_after_m = 0.0;
+  double train_seconds = 0.0;       ///< mean per model
+};
+
+/// Groups runs by (kernel, inducing) in first-seen kernel order and ascending inducing count.
+std::vector<EvaluationRow> aggregateRuns(const std::vector<EvaluationRun>& runs);
+
+std::string toMarkdown(const std::vector<EvaluationRow>& rows);
+std::string toCsv(const std::vector<EvaluationRow>& rows);
+/// JSON array, one object per row (keys as in EvaluationRow; the results.json contract of `evaluate`).
+nlohmann::json toJson(const std::vector<EvaluationRow>& rows);
+std::string runsToCsv(const std::vector<EvaluationRun>& runs);
+
+}  // namespace uwb

@@ -1,0 +1,141 @@
+/** @file EvaluationTable.cpp
+ *  @brief Aggregation and formatting of the evaluation table (paper Fig. 5, section IV).
+ */
+#include "uwb/eval/EvaluationTable.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+
+namespace uwb {
+namespace {
+
+double improvementPct(double uncorrected, double corrected) {
+  return uncorrected > 0.0 ? 100.0 * (1.0 - corrected / uncorrected) : 0.0;
+}
+
+struct Sums {
+  double unc = 0, corr = 0, before = 0, after = 0, train = 0;
+  int n = 0;
+  void add(const EvaluationRun& r) {
+    unc += r.rmse_uncorrected_m;
+    corr += r.rmse_corrected_m;
+    before += r.bias_rmse_before_m;
+    after += r.bias_rmse_after_m;
+    train += r.train_seconds;
+    ++n;
+  }
+};
+
+}  // namespace
+
+std::vector<EvaluationRow> aggregateRuns(const std::vector<EvaluationRun>& runs) {
+  std::vector<std::string> kernel_order;
+  for (const auto& r : runs) {
+    if (std::find(kernel_order.begin(), kernel_order.end(), r.kernel) == kernel_order.end()) {
+      kernel_order.push_back(r.kernel);
+    }
+  }
+  std::vector<EvaluationRow> rows;
+  for (const auto& kernel : kernel_order) {
+    std::set<int> inducing_counts;
+    for (const auto& r : runs) {
+      if (r.kernel == kernel) inducing_counts.insert(r.inducing);
+    }
+    for (int m : inducing_counts) {
+      Sums all;
+      std::map<int, Sums> per_repeat;
+      std::set<std::string> flights;
+      for (const auto& r : runs) {
+        if (r.kernel != kernel || r.inducing != m) continue;
+        all.add(r);
+        per_repeat[r.repeat].add(r);
+        flights.insert(r.flight);
+      }
+      EvaluationRow row;
+      row.kernel = kernel;
+      row.inducing = m;
+      row.n_repeats = static_cast<int>(per_repeat.size());
+      row.n_flights = static_cast<int>(flights.size());
+      row.rmse_uncorrected_m = all.unc / all.n;
+      row.rmse_corrected_m = all.corr / all.n;
+      row.improvement_pct = improvementPct(row.rmse_uncorrected_m, row.rmse_corrected_m);
+      row.improvement_pct_min = std::numeric_limits<double>::infinity();
+      row.improvement_pct_max = -std::numeric_limits<double>::infinity();
+      for (const auto& [repeat, s] : per_repeat) {
+        const double imp = improvementPct(s.unc / s.n, s.corr / s.n);
+        row.improvement_pct_min = std::min(row.improvement_pct_min, imp);
+        row.improvement_pct_max = std::max(row.improvement_pct_max, imp);
+      }
+      row.bias_rmse_before_m = all.before / all.n;
+      row.bias_rmse_after_m = all.after / all.n;
+      row.train_seconds = all.train / all.n;
+      rows.push_back(row);
+    }
+  }
+  return rows;
+}
+
+std::string toMarkdown(const std::vector<EvaluationRow>& rows) {
+  std::string out =
+      "| kernel | M | RMSE uncorrected [m] | RMSE corrected [m] | improvement [%] | min–max over repeats [%] | "
+      "bias RMSE raw → GP [m] | train [s] |\n"
+      "|---|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const auto& r : rows) {
+    out += fmt::format("| {} | {} | {:.3f} | {:.3f} | {:+.1f} | {:+.1f} … {:+.1f} | {:.3f} → {:.3f} | {:.1f} |\n",
+                       r.kernel, r.inducing, r.rmse_uncorrected_m, r.rmse_corrected_m, r.improvement_pct,
+                       r.improvement_pct_min, r.improvement_pct_max, r.bias_rmse_before_m, r.bias_rmse_after_m,
+                       r.train_seconds);
+  }
+  return out;
+}
+
+std::string toCsv(const std::vector<EvaluationRow>& rows) {
+  std::string out =
+      "kernel,inducing,n_repeats,n_flights,rmse_uncorrected_m,rmse_corrected_m,improvement_pct,improvement_pct_min,"
+      "improvement_pct_max,bias_rmse_before_m,bias_rmse_after_m,train_seconds\n";
+  for (const auto& r : rows) {
+    out += fmt::format("{},{},{},{},{:.6f},{:.6f},{:.4f},{:.4f},{:.4f},{:.6f},{:.6f},{:.3f}\n", r.kernel, r.inducing,
+                       r.n_repeats, r.n_flights, r.rmse_uncorrected_m, r.rmse_corrected_m, r.improvement_pct,
+                       r.improvement_pct_min, r.improvement_pct_max, r.bias_rmse_before_m, r.bias_rmse_after_m,
+                       r.train_seconds);
+  }
+  return out;
+}
+
+nlohmann::json toJson(const std::vector<EvaluationRow>& rows) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& r : rows) {
+    out.push_back({{"kernel", r.kernel},
+                   {"inducing", r.inducing},
+                   {"n_repeats", r.n_repeats},
+                   {"n_flights", r.n_flights},
+                   {"rmse_uncorrected_m", r.rmse_uncorrected_m},
+                   {"rmse_corrected_m", r.rmse_corrected_m},
+                   {"improvement_pct", r.improvement_pct},
+                   {"improvement_pct_min", r.improvement_pct_min},
+                   {"improvement_pct_max", r.improvement_pct_max},
+                   {"bias_rmse_before_m", r.bias_rmse_before_m},
+                   {"bias_rmse_after_m", r.bias_rmse_after_m},
+                   {"train_seconds", r.train_seconds}});
+  }
+  return out;
+}
+
+std::string runsToCsv(const std::vector<EvaluationRun>& runs) {
+  std::string out =
+      "kernel,inducing,repeat,flight,rmse_uncorrected_m,rmse_corrected_m,bias_rmse_before_m,bias_rmse_after_m,"
+      "train_seconds\n";
+  for (const auto& r : runs) {
+    out += fmt::format("{},{},{},{},{:.6f},{:.6f},{:.6f},{:.6f},{:.3f}\n", r.kernel, r.inducing, r.repeat, r.flight,
+                       r.rmse_uncorrected_m, r.rmse_corrected_m, r.bias_rmse_before_m, r.bias_rmse_after_m,
+                       r.train_seconds);
+  }
+  return out;
+}
+
+}  // namespace uwb
