@@ -3,7 +3,7 @@
  *
  *  The filter knows nothing of GPs (STYLE §1): it takes a BiasPredictor, a plain callable
  *  feature → (mean, variance) of the TDoA bias. Features are computed from a pose: the ground truth when
- *  training (paper eq. 6), the filter's estimate at run time (paper III-B). docs/math.md eq. (10)–(12).
+ *  training (paper eq. 6), the filter's estimate at run time (paper III-B). docs/math.md (M10–M11).
  */
 #pragma once
 
