@@ -1,0 +1,129 @@
+/** @file TdoaCorrection.h
+ *  @brief The Kalman-filter correction step of paper Fig. 3 built from graph nodes: the TDoA node's message on
+ *         the tag position x_k, passed backward through x_k = x̃_k + C δx (addition of a constant, then the
+ *         multiplication node C), combined with the predicted state in an equality node
+ *         (docs/math/message-passing.md G15–G18).
+ *
+ *  Fast path (header-only template on the state dimension N, e.g. N = 15): no heap allocation, no n×n inverse.
+ *  The message on δx has rank one (W = aᵀ a / s), so the equality node is used in its Kalman-gain form
+ *  (Table 4; G10 with a scalar Y) and the covariance in Joseph form, written in O(N²) for a rank-one update:
+ *    u = V a ᵀ,  S = a u + s,  K = u / S,
+ *    m⁺ = m + K (y − a m),
+ *    V⁺ = (I − K a) V (I − K a)ᵀ + K s Kᵀ = V − K uᵀ − u Kᵀ + S K Kᵀ      (G18, exactly symmetric).
+ *
+ *  Recipe for the filter (UTIL convention tdoa = |p − a_B| − |p − a_A|, right attitude error q ⊗ exp(δθ)):
+ *  @code
+ *    const Vec3 p_tag = tagPosition(w_p_b, w_q_b, b_t_tag);                       // x̃_k
+ *    auto lin = linearizeTdoa(p_tag, anchor_b.m, anchor_a.m);                      // x_i = B, x_j = A
+ *    if (!lin) → degenerate;
+ *    TdoaNodeMessages msg = tdoaNodeForward(*lin, anchor_b, anchor_a, z_m - bias_m, var_m2);
+ *    Eigen::Matrix<double, 3, 15> C = 0;  C.block<3,3>(0, kPos) = I;
+ *    C.block<3,3>(0, kAttErr) = tagPositionJacobianAttitude(w_q_b, b_t_tag);      // −R [b_t]×
+ *    ScalarLinearMessage<15> on_state = tdoaMessageOnState<15>(msg, C, p_tag);     // gate on innovationOf(...)
+ *    std::optional<InnovationStats> st = equalityRankOneInPlace<15>(dx, P, on_state);  // dx, P updated
+ *  @endcode
+ *  With dx = 0 (error state), the innovation equals z − ẑ(x̃) exactly (G16).
+ */
+#pragma once
+
+#include <cmath>
+#include <optional>
+
+#include "uwb/graph/GaussianMessage.h"
+#include "uwb/graph/TdoaNode.h"
+
+namespace uwb {
+
+/// A rank-one Gaussian message on a state δx (dimension N), kept in factored form: the scalar pseudo-observation
+/// y = a δx + v, v ~ N(0, var). Its information view is ξ = aᵀ y / var, W = aᵀ a / var (G15).
+template <int N>
+struct ScalarLinearMessage {
+  Eigen::Matrix<double, 1, N> a;
+  double y = 0.0;    ///< pseudo-observation [m]
+  double var = 0.0;  ///< its variance Σ7 [m²]
+  /// The same message in information form (G15): ξ = aᵀ y / var, W = aᵀ a / var.
+  GaussianInformation<N> information() const { return {a.transpose() * (y / var), a.transpose() * a / var}; }
+};
+
+/// Innovation statistics of a scalar correction: r = y − a m, S = a V aᵀ + var, NIS = r² / S (G17).
+struct InnovationStats {
+  double innovation_m = 0.0;
+  double innovation_var_m2 = 0.0;
+  double nis = 0.0;
+};
+
+/// Posterior of a TDoA correction plus its innovation statistics.
+template <int N>
+struct TdoaCorrection {
+  GaussianMoments<N> posterior;
+  InnovationStats stats;
+};
+
+/// (G16) TDoA node message on x_k (paper µ7 on B12 x_k, equivalently ξ8/W8) passed backward through the addition
+/// of the linearization point x̃_k and the multiplication node C = ∂x_k/∂δx (3×N), i.e. x_k = x̃_k + C δx:
+///   a = B12 C,  y = m7 − B12 x̃_k,  var = Σ7.
+template <int N>
+ScalarLinearMessage<N> tdoaMessageOnState(const TdoaNodeMessages& msg, const Eigen::Matrix<double, 3, N>& C,
+                                          const Vec3& x_k_lin) {
+  ScalarLinearMessage<N> out;
+  out.a.noalias() = msg.B12 * C;
+  out.y = msg.mu7.m - msg.B12.dot(x_k_lin);
+  out.var = msg.mu7.V;
+  return out;
+}
+
+/// (G17) Innovation r = y − a m, its variance S = a V aᵀ + var, and NIS = r²/S, before applying the update
+/// (for gating). S > 0 unless the prior and the measurement are both exact along a.
+template <int N>
+InnovationStats innovationOf(const ScalarLinearMessage<N>& msg, const Eigen::Matrix<double, N, 1>& m,
+                             const Eigen::Matrix<double, N, N>& V) {
+  InnovationStats st;
+  st.innovation_m = msg.y - msg.a.dot(m.transpose());
+  st.innovation_var_m2 = (msg.a * V).dot(msg.a) + msg.var;
+  st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
+  return st;
+}
+
+/// (G18) Equality node combining the prior N(m, V) (moment form) with a rank-one message, Kalman-gain form
+/// (Table 4) and Joseph-form covariance, in place. Returns the innovation statistics, or nullopt (and leaves m, V
+/// untouched) when S ≤ 0 or anything is not finite.
+template <int N>
+std::optional<InnovationStats> equalityRankOneInPlace(Eigen::Matrix<double, N, 1>& m, Eigen::Matrix<double, N, N>& V,
+                                                      const ScalarLinearMessage<N>& msg) {
+  Eigen::Matrix<double, N, 1> u;
+  u.noalias() = V * msg.a.transpose();  // V aᵀ (V symmetric)
+  InnovationStats st;
+  st.innovation_m = msg.y - msg.a.dot(m.transpose());
+  st.innovation_var_m2 = msg.a.dot(u.transpose()) + msg.var;
+  if (!(st.innovation_var_m2 > 0.0) || !std::isfinite(st.innovation_var_m2) || !std::isfinite(st.innovation_m)) {
+    return std::nullopt;
+  }
+  st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
+  const Eigen::Matrix<double, N, 1> K = u / st.innovation_var_m2;
+  m.noalias() += K * st.innovation_m;
+  // Joseph form for a rank-one gain: (I − K a) V (I − K a)ᵀ + K var Kᵀ = V − K uᵀ − u Kᵀ + S K Kᵀ.
+  V.noalias() -= K * u.transpose();
+  V.noalias() -= u * K.transpose();
+  V.noalias() += (st.innovation_var_m2 * K) * K.transpose();
+  return st;
+}
+
+/// (G16–G18) The whole correction step of Fig. 3 for one TDoA, by value.
+template <int N>
+std::optional<TdoaCorrection<N>> correctTdoa(const GaussianMoments<N>& prior, const Eigen::Matrix<double, 3, N>& C,
+                                             const Vec3& x_k_lin, const TdoaNodeMessages& msg) {
+  TdoaCorrection<N> out{prior, {}};
+  const ScalarLinearMessage<N> on_state = tdoaMessageOnState<N>(msg, C, x_k_lin);
+  const std::optional<InnovationStats> st = equalityRankOneInPlace<N>(out.posterior.m, out.posterior.V, on_state);
+  if (!st) return std::nullopt;
+  out.stats = *st;
+  return out;
+}
+
+/// Reference (slow, dynamic-size) route through the generic node functions, in information form: ξ8/W8 →
+/// additionBackwardConstant(x̃_k) → multiplyBackward(C) → equality(moments, information). Used by tests to show
+/// that the fast path is the same message passing; nullopt if the equality node fails.
+std::optional<Moments> correctTdoaByMessages(const Moments& prior, const MatX& C, const Vec3& x_k_lin,
+                                             const TdoaNodeMessages& msg);
+
+}  // namespace uwb
