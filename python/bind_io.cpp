@@ -1,0 +1,417 @@
+/** @file bind_io.cpp
+ *  @brief Python bindings of uwb/io: flights (each stream as a dict of numpy arrays, SI units) and anchor surveys.
+ *
+ *  Stream dicts (one row per sample; time t in seconds on the drone's clock):
+ *    tdoa: t, id_a, id_b (int32), tdoa [m] (= |p_tag − a_idB| − |p_tag − a_idA|)
+ *    twr:  t, anchor_id (int32), range [m]
+ *    acc:  t, value (N, 3) [m/s², body frame]        gyro: t, value (N, 3) [rad/s, body frame]
+ *    tof:  t, value [m]      baro: t, value [m above sea level]      flow: t, delta_x, delta_y [counts]
+ *    pose: t, p (N, 3) [m, world], q (N, 4) body→world quaternion (x, y, z, w)
+ */
+#include <array>
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "uwb/io/AnchorSurvey.h"
+#include "uwb/io/Flight.h"
+#include "uwb/io/UtilCsv.h"
+
+namespace uwb::python {
+namespace {
+
+struct StreamName {
+  Stream stream;
+  const char* name;
+};
+constexpr std::array<StreamName, 8> kStreams{{{Stream::kTdoa, "tdoa"},
+                                              {Stream::kTwr, "twr"},
+                                              {Stream::kAcc, "acc"},
+                                              {Stream::kGyro, "gyro"},
+                                              {Stream::kTof, "tof"},
+                                              {Stream::kFlow, "flow"},
+                                              {Stream::kBaro, "baro"},
+                                              {Stream::kPose, "pose"}}};
+
+Stream streamFromName(const std::string& name) {
+  for (const auto& s : kStreams)
+    if (name == s.name) return s.stream;
+  throw std::invalid_argument("unknown stream '" + name + "' (expected tdoa, twr, acc, gyro, tof, flow, baro, pose)");
+}
+
+template <class Sample>
+py::array_t<double> times(const std::vector<Sample>& v) {
+  auto out = newArray(static_cast<Eigen::Index>(v.size()));
+  auto o = out.template mutable_unchecked<1>();
+  for (std::size_t i = 0; i < v.size(); ++i) o(i) = v[i].t_s;
+  return out;
+}
+
+// ---- C++ → numpy (one pass per stream) ----
+py::dict tdoaDict(const std::vector<TdoaMeasurement>& v) {
+  const auto n = static_cast<Eigen::Index>(v.size());
+  auto a = newIntArray(n), b = newIntArray(n);
+  auto z = newArray(n);
+  auto ma = a.mutable_unchecked<1>(), mb = b.mutable_unchecked<1>();
+  auto mz = z.mutable_unchecked<1>();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    ma(i) = v[i].id_a;
+    mb(i) = v[i].id_b;
+    mz(i) = v[i].tdoa_m;
+  }
+  py::dict d;
+  d["t"] = times(v), d["id_a"] = a, d["id_b"] = b, d["tdoa"] = z;
+  return d;
+}
+
+py::dict twrDict(const std::vector<TwrMeasurement>& v) {
+  const auto n = static_cast<Eigen::Index>(v.size());
+  auto id = newIntArray(n);
+  auto r = newArray(n);
+  auto mi = id.mutable_unchecked<1>();
+  auto mr = r.mutable_unchecked<1>();
+  for (Eigen::Index i = 0; i < n; ++i) mi(i) = v[i].anchor_id, mr(i) = v[i].range_m;
+  py::dict d;
+  d["t"] = times(v), d["anchor_id"] = id, d["range"] = r;
+  return d;
+}
+
+py::dict imuDict(const std::vector<ImuSample>& v) {
+  const auto n = static_cast<Eigen::Index>(v.size());
+  auto x = newArray(n, 3);
+  auto mx = x.mutable_unchecked<2>();
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) mx(i, k) = v[i].b_value[k];
+  py::dict d;
+  d["t"] = times(v), d["value"] = x;
+  return d;
+}
+
+py::dict scalarDict(const std::vector<ScalarSample>& v) {
+  const auto n = static_cast<Eigen::Index>(v.size());
+  auto x = newArray(n);
+  auto mx = x.mutable_unchecked<1>();
+  for (Eigen::Index i = 0; i < n; ++i) mx(i) = v[i].value;
+  py::dict d;
+  d["t"] = times(v), d["value"] = x;
+  return d;
+}
+
+py::dict flowDict(const std::vector<FlowSample>& v) {
+  const auto n = static_cast<Eigen::Index>(v.size());
+  auto x = newArray(n), y = newArray(n);
+  auto mx = x.mutable_unchecked<1>(), my = y.mutable_unchecked<1>();
+  for (Eigen::Index i = 0; i < n; ++i) mx(i) = v[i].delta_x, my(i) = v[i].delta_y;
+  py::dict d;
+  d["t"] = times(v), d["delta_x"] = x, d["delta_y"] = y;
+  return d;
+}
+
+py::dict poseDict(const std::vector<PoseSample>& v) {
+  const auto n = static_cast<Eigen::Index>(v.size());
+  auto p = newArray(n, 3), q = newArray(n, 4);
+  auto mp = p.mutable_unchecked<2>(), mq = q.mutable_unchecked<2>();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) mp(i, k) = v[i].w_p_b[k];
+    mq(i, 0) = v[i].w_q_b.x(), mq(i, 1) = v[i].w_q_b.y(), mq(i, 2) = v[i].w_q_b.z(), mq(i, 3) = v[i].w_q_b.w();
+  }
+  py::dict d;
+  d["t"] = times(v), d["p"] = p, d["q"] = q;
+  return d;
+}
+
+// ---- numpy → C++ ----
+Eigen::VectorXd column(const py::dict& d, const char* key, const char* what, Eigen::Index n = -1) {
+  const RowMat m = toMatrix(requireKey(d, key, what), 0, (std::string(what) + "['" + key + "']").c_str());
+  if (n >= 0 && m.rows() != n) {
+    throw std::invalid_argument(std::string(what) + "['" + key + "']: " + std::to_string(m.rows()) +
+                                " rows, expected " + std::to_string(n) + " (as 't')");
+  }
+  return m.col(0);
+}
+RowMat block(const py::dict& d, const char* key, const char* what, Eigen::Index cols, Eigen::Index n) {
+  const std::string name = std::string(what) + "['" + key + "']";
+  RowMat m = toMatrix(requireKey(d, key, what), cols, name.c_str(), /*allow_row=*/false);
+  if (m.rows() != n) {
+    throw std::invalid_argument(name + ": " + std::to_string(m.rows()) + " rows, expected " + std::to_string(n) +
+                                " (as 't')");
+  }
+  return m;
+}
+Eigen::VectorXi intColumn(const py::dict& d, const char* key, const char* what, Eigen::Index n) {
+  const std::string name = std::string(what) + "['" + key + "']";
+  Eigen::VectorXi v = toIntVector(requireKey(d, key, what), name.c_str());
+  if (v.size() != n) {
+    throw std::invalid_argument(name + ": " + std::to_string(v.size()) + " rows, expected " + std::to_string(n) +
+                                " (as 't')");
+  }
+  return v;
+}
+
+std::vector<TdoaMeasurement> tdoaFrom(const py::dict& d) {
+  const Eigen::VectorXd t = column(d, "t", "tdoa");
+  const auto n = t.size();
+  const Eigen::VectorXi a = intColumn(d, "id_a", "tdoa", n), b = intColumn(d, "id_b", "tdoa", n);
+  const Eigen::VectorXd z = column(d, "tdoa", "tdoa", n);
+  std::vector<TdoaMeasurement> v(static_cast<std::size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) v[i] = {t(i), a(i), b(i), z(i)};
+  return v;
+}
+std::vector<TwrMeasurement> twrFrom(const py::dict& d) {
+  const Eigen::VectorXd t = column(d, "t", "twr");
+  const auto n = t.size();
+  const Eigen::VectorXi id = intColumn(d, "anchor_id", "twr", n);
+  const Eigen::VectorXd r = column(d, "range", "twr", n);
+  std::vector<TwrMeasurement> v(static_cast<std::size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) v[i] = {t(i), id(i), r(i)};
+  return v;
+}
+std::vector<ImuSample> imuFrom(const py::dict& d, const char* what) {
+  const Eigen::VectorXd t = column(d, "t", what);
+  const RowMat x = block(d, "value", what, 3, t.size());
+  std::vector<ImuSample> v(static_cast<std::size_t>(t.size()));
+  for (Eigen::Index i = 0; i < t.size(); ++i) v[i] = {t(i), row3(x, i)};
+  return v;
+}
+std::vector<ScalarSample> scalarFrom(const py::dict& d, const char* what) {
+  const Eigen::VectorXd t = column(d, "t", what);
+  const Eigen::VectorXd x = column(d, "value", what, t.size());
+  std::vector<ScalarSample> v(static_cast<std::size_t>(t.size()));
+  for (Eigen::Index i = 0; i < t.size(); ++i) v[i] = {t(i), x(i)};
+  return v;
+}
+std::vector<FlowSample> flowFrom(const py::dict& d) {
+  const Eigen::VectorXd t = column(d, "t", "flow");
+  const Eigen::VectorXd x = column(d, "delta_x", "flow", t.size()), y = column(d, "delta_y", "flow", t.size());
+  std::vector<FlowSample> v(static_cast<std::size_t>(t.size()));
+  for (Eigen::Index i = 0; i < t.size(); ++i) v[i] = {t(i), x(i), y(i)};
+  return v;
+}
+std::vector<PoseSample> poseFrom(const py::dict& d) {
+  const Eigen::VectorXd t = column(d, "t", "pose");
+  const RowMat p = block(d, "p", "pose", 3, t.size());
+  RowMat q;
+  if (d.contains("q")) {
+    q = block(d, "q", "pose", 4, t.size());
+  } else {
+    q = RowMat::Zero(1, 4);
+    q(0, 3) = 1.0;
+  }
+  std::vector<PoseSample> v(static_cast<std::size_t>(t.size()));
+  for (Eigen::Index i = 0; i < t.size(); ++i) v[i] = {t(i), row3(p, i), rowQuat(q, i)};
+  return v;
+}
+
+py::dict allStreams(const Flight& f) {
+  py::dict d;
+  if (f.has(Stream::kTdoa)) d["tdoa"] = tdoaDict(f.tdoa);
+  if (f.has(Stream::kTwr)) d["twr"] = twrDict(f.twr);
+  if (f.has(Stream::kAcc)) d["acc"] = imuDict(f.acc);
+  if (f.has(Stream::kGyro)) d["gyro"] = imuDict(f.gyro);
+  if (f.has(Stream::kTof)) d["tof"] = scalarDict(f.tof);
+  if (f.has(Stream::kFlow)) d["flow"] = flowDict(f.flow);
+  if (f.has(Stream::kBaro)) d["baro"] = scalarDict(f.baro);
+  if (f.has(Stream::kPose)) d["pose"] = poseDict(f.pose);
+  return d;
+}
+
+void setStream(Flight& f, const std::string& name, const py::dict& d) {
+  switch (streamFromName(name)) {
+    case Stream::kTdoa: f.tdoa = tdoaFrom(d); break;
+    case Stream::kTwr: f.twr = twrFrom(d); break;
+    case Stream::kAcc: f.acc = imuFrom(d, "acc"); break;
+    case Stream::kGyro: f.gyro = imuFrom(d, "gyro"); break;
+    case Stream::kTof: f.tof = scalarFrom(d, "tof"); break;
+    case Stream::kFlow: f.flow = flowFrom(d); break;
+    case Stream::kBaro: f.baro = scalarFrom(d, "baro"); break;
+    case Stream::kPose:
+      f.pose = poseFrom(d);
+      f.pose_has_orientation = d.contains("q");
+      break;
+  }
+}
+
+AnchorSurvey surveyFromArrays(const py::handle& ids, const py::handle& positions, const py::object& quaternions,
+                              const std::string& source) {
+  const Eigen::VectorXi id = toIntVector(ids, "ids");
+  const RowMat p = toMatrix(positions, 3, "positions", /*allow_row=*/false);
+  if (p.rows() != id.size()) {
+    throw std::invalid_argument("positions: " + std::to_string(p.rows()) + " rows, expected " +
+                                std::to_string(id.size()) + " (as ids)");
+  }
+  RowMat q;
+  if (!quaternions.is_none()) {
+    q = toMatrix(quaternions, 4, "quaternions", /*allow_row=*/false);
+    if (q.rows() != id.size()) throw std::invalid_argument("quaternions: row count differs from ids");
+  }
+  AnchorSurvey s;
+  s.source = source;
+  for (Eigen::Index i = 0; i < id.size(); ++i) {
+    Anchor a;
+    a.id = id(i);
+    a.w_p = row3(p, i);
+    if (q.size()) a.w_q = rowQuat(q, i);
+    s.anchors.push_back(a);
+  }
+  std::sort(s.anchors.begin(), s.anchors.end(), [](const Anchor& x, const Anchor& y) { return x.id < y.id; });
+  for (std::size_t i = 1; i < s.anchors.size(); ++i)
+    if (s.anchors[i].id == s.anchors[i - 1].id)
+      throw std::invalid_argument("ids: duplicate anchor id " + std::to_string(s.anchors[i].id));
+  return s;
+}
+
+}  // namespace
+
+/// Positions of the anchors of each id in `ids` (N, 3); KeyError naming the id when absent.
+RowMat anchorPositions(const AnchorSurvey& survey, const Eigen::VectorXi& ids) {
+  RowMat out(ids.size(), 3);
+  for (Eigen::Index i = 0; i < ids.size(); ++i) out.row(i) = survey.position(ids(i)).transpose();
+  return out;
+}
+
+void bindIo(py::module_& m) {
+  py::class_<AnchorSurvey>(m, "AnchorSurvey",
+                           "Surveyed UWB anchors: ids, world positions [m] and orientations (x, y, z, w).")
+      .def(py::init([](const py::handle& ids, const py::handle& positions, const py::object& quaternions,
+                       const std::string& source) { return surveyFromArrays(ids, positions, quaternions, source); }),
+           py::arg("ids"), py::arg("positions"), py::arg("quaternions") = py::none(), py::arg("source") = "",
+           "Builds a survey from ids (N,), positions (N, 3) [m] and optional quaternions (N, 4) (x, y, z, w).")
+      .def_property_readonly("ids",
+                             [](const AnchorSurvey& s) {
+                               auto out = newIntArray(static_cast<Eigen::Index>(s.anchors.size()));
+                               auto o = out.mutable_unchecked<1>();
+                               for (std::size_t i = 0; i < s.anchors.size(); ++i) o(i) = s.anchors[i].id;
+                               return out;
+                             })
+      .def_property_readonly("positions",
+                             [](const AnchorSurvey& s) {
+                               RowMat p(static_cast<Eigen::Index>(s.anchors.size()), 3);
+                               for (std::size_t i = 0; i < s.anchors.size(); ++i) p.row(i) = s.anchors[i].w_p;
+                               return toNumpy(p);
+                             },
+                             "(N, 3) anchor positions in the world frame [m], in the order of ids")
+      .def_property_readonly("quaternions",
+                             [](const AnchorSurvey& s) {
+                               RowMat q(static_cast<Eigen::Index>(s.anchors.size()), 4);
+                               for (std::size_t i = 0; i < s.anchors.size(); ++i) {
+                                 const Quat& w_q = s.anchors[i].w_q;
+                                 q.row(i) << w_q.x(), w_q.y(), w_q.z(), w_q.w();
+                               }
+                               return toNumpy(q);
+                             },
+                             "(N, 4) anchor orientations (x, y, z, w)")
+      .def_readwrite("source", &AnchorSurvey::source)
+      .def("position", [](const AnchorSurvey& s, int id) { return toNumpy(s.position(id), true); }, py::arg("id"),
+           "World position [m] of one anchor; KeyError when the id is absent.")
+      .def("positions_of",
+           [](const AnchorSurvey& s, const py::handle& ids) {
+             return toNumpy(anchorPositions(s, toIntVector(ids, "ids")));
+           },
+           py::arg("ids"), "(N, 3) positions [m] of the anchors with the given ids (vectorized lookup).")
+      .def("__contains__", &AnchorSurvey::contains)
+      .def("__len__", [](const AnchorSurvey& s) { return s.anchors.size(); })
+      .def("__repr__", [](const AnchorSurvey& s) {
+        return "<AnchorSurvey " + std::to_string(s.anchors.size()) + " anchors from '" + s.source + "'>";
+      });
+
+  py::class_<Flight>(m, "Flight",
+                     "A flight: every sensor stream as a dict of numpy arrays in SI units (see docs/python.md).\n"
+                     "Reading a stream property converts the whole stream at once; assigning a dict replaces it.")
+      .def(py::init([](const py::kwargs& streams) {
+             Flight f;
+             for (const auto& [key, value] : streams) setStream(f, py::str(key), py::cast<py::dict>(value));
+             return f;
+           }),
+           "Flight(tdoa={...}, acc={...}, ...): builds a flight from stream dicts.")
+      .def_property("tdoa", [](const Flight& f) { return tdoaDict(f.tdoa); },
+                    [](Flight& f, const py::dict& d) { setStream(f, "tdoa", d); },
+                    "dict: t [s], id_a, id_b (int32), tdoa [m] = |p_tag − a_idB| − |p_tag − a_idA|")
+      .def_property("twr", [](const Flight& f) { return twrDict(f.twr); },
+                    [](Flight& f, const py::dict& d) { setStream(f, "twr", d); }, "dict: t [s], anchor_id, range [m]")
+      .def_property("acc", [](const Flight& f) { return imuDict(f.acc); },
+                    [](Flight& f, const py::dict& d) { setStream(f, "acc", d); },
+                    "dict: t [s], value (N, 3) specific force [m/s², body]")
+      .def_property("gyro", [](const Flight& f) { return imuDict(f.gyro); },
+                    [](Flight& f, const py::dict& d) { setStream(f, "gyro", d); },
+                    "dict: t [s], value (N, 3) angular rate [rad/s, body]")
+      .def_property("tof", [](const Flight& f) { return scalarDict(f.tof); },
+                    [](Flight& f, const py::dict& d) { setStream(f, "tof", d); }, "dict: t [s], value [m]")
+      .def_property("flow", [](const Flight& f) { return flowDict(f.flow); },
+                    [](Flight& f, const py::dict& d) { setStream(f, "flow", d); },
+                    "dict: t [s], delta_x, delta_y [counts]")
+      .def_property("baro", [](const Flight& f) { return scalarDict(f.baro); },
+                    [](Flight& f, const py::dict& d) { setStream(f, "baro", d); },
+                    "dict: t [s], value [m above sea level]")
+      .def_property("pose", [](const Flight& f) { return poseDict(f.pose); },
+                    [](Flight& f, const py::dict& d) { setStream(f, "pose", d); },
+                    "dict: t [s], p (N, 3) [m, world], q (N, 4) body→world (x, y, z, w)")
+      .def_readwrite("pose_has_orientation", &Flight::pose_has_orientation)
+      .def_readwrite("columns", &Flight::columns, "header columns of the source file (the writer reproduces them)")
+      .def_readwrite("source", &Flight::source)
+      .def("streams", &allStreams, "All non-empty streams: {name: stream dict}.")
+      .def_property_readonly("present",
+                             [](const Flight& f) {
+                               std::vector<std::string> names;
+                               for (const auto& s : kStreams)
+                                 if (f.has(s.stream)) names.emplace_back(s.name);
+                               return names;
+                             },
+                             "names of the non-empty streams")
+      .def("time_span", &Flight::timeSpan, "(first, last) sample time over all streams [s]")
+      .def("__repr__", [](const Flight& f) {
+        std::string r = "<Flight '" + f.source + "'";
+        for (const auto& s : kStreams) {
+          if (!f.has(s.stream)) continue;
+          std::size_t n = 0;
+          switch (s.stream) {
+            case Stream::kTdoa: n = f.tdoa.size(); break;
+            case Stream::kTwr: n = f.twr.size(); break;
+            case Stream::kAcc: n = f.acc.size(); break;
+            case Stream::kGyro: n = f.gyro.size(); break;
+            case Stream::kTof: n = f.tof.size(); break;
+            case Stream::kFlow: n = f.flow.size(); break;
+            case Stream::kBaro: n = f.baro.size(); break;
+            case Stream::kPose: n = f.pose.size(); break;
+          }
+          r += std::string(" ") + s.name + "=" + std::to_string(n);
+        }
+        const auto [t0, t1] = f.timeSpan();
+        return r + " t=[" + std::to_string(t0) + ", " + std::to_string(t1) + "] s>";
+      });
+
+  m.def(
+      "read_flight_csv",
+      [](const std::string& path, const std::vector<std::string>& required, const AnchorSurvey* survey,
+         bool with_report) -> py::object {
+        FlightReadOptions options;
+        for (const auto& name : required) options.required.push_back(streamFromName(name));
+        options.survey = survey;
+        ReadReport report;
+        Flight f;
+        {
+          py::gil_scoped_release release;
+          f = readFlightCsv(path, options, &report);
+        }
+        if (!with_report) return py::cast(std::move(f));
+        py::dict r;
+        r["n_rows"] = report.n_rows, r["n_bytes"] = report.n_bytes, r["notes"] = report.notes;
+        return py::make_tuple(std::move(f), r);
+      },
+      py::arg("path"), py::arg("required") = std::vector<std::string>{}, py::arg("survey") = nullptr,
+      py::arg("with_report") = false,
+      "Reads a UTIL flight CSV (SI units in memory). required: stream names that must be present; survey: every\n"
+      "anchor id must be surveyed. with_report=True returns (flight, {n_rows, n_bytes, notes}).\n"
+      "ValueError 'file:line:column (field): ...' on bad data, OSError when the file cannot be read.");
+  m.def(
+      "write_flight_csv",
+      [](const Flight& f, const std::string& path) {
+        py::gil_scoped_release release;
+        writeFlightCsv(f, path);
+      },
+      py::arg("flight"), py::arg("path"), "Writes a flight in the UTIL layout (read_flight_csv reads it back exactly).");
+  m.def("read_anchor_survey", &readAnchorSurvey, py::arg("path"), "Reads a UTIL anchor survey text file.");
+  m.def("write_anchor_survey", &writeAnchorSurvey, py::arg("survey"), py::arg("path"),
+        "Writes a survey that read_anchor_survey reads back exactly.");
+}
+
+}  // namespace uwb::python

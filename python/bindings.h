@@ -1,0 +1,133 @@
+/** @file bindings.h
+ *  @brief Shared helpers of the pybind11 module `uwbtdoa._uwbtdoa`: numpy <-> Eigen conversion of whole arrays
+ *  (no per-sample Python calls) with argument checks that raise ValueError, and the per-module bind functions.
+ *
+ *  Conventions at the Python boundary: arrays are float64 (int32 for anchor ids), one row per sample;
+ *  3-vectors are (N, 3); quaternions are (N, 4) in (x, y, z, w) order (the UTIL column order, as scipy).
+ */
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <Eigen/Core>
+#include <stdexcept>
+#include <string>
+
+#include "uwb/core/Types.h"
+
+namespace uwb::python {
+
+namespace py = pybind11;
+
+using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using DArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using IArray = py::array_t<int, py::array::c_style | py::array::forcecast>;
+
+/// Converts any array-like to float64 and checks its shape: (N, cols), or (cols,) which is read as one row
+/// (when allow_row is true). cols == 0 means a 1-D array (N,). Throws std::invalid_argument (→ ValueError).
+inline RowMat toMatrix(const py::handle& obj, py::ssize_t cols, const char* name, bool allow_row = true) {
+  DArray a;
+  try {
+    a = DArray::ensure(obj);
+  } catch (const py::error_already_set&) {
+    throw std::invalid_argument(std::string(name) + ": expected a numeric array");
+  }
+  if (!a) throw std::invalid_argument(std::string(name) + ": expected a numeric array");
+  if (cols == 0) {
+    if (a.ndim() == 0) {
+      RowMat m(1, 1);
+      m(0, 0) = *a.data();
+      return m;
+    }
+    if (a.ndim() != 1) {
+      throw std::invalid_argument(std::string(name) + ": expected a 1-D array, got " + std::to_string(a.ndim()) +
+                                  " dimensions");
+    }
+    return Eigen::Map<const RowMat>(a.data(), a.shape(0), 1);
+  }
+  if (a.ndim() == 1 && allow_row && a.shape(0) == cols) return Eigen::Map<const RowMat>(a.data(), 1, cols);
+  if (a.ndim() != 2 || a.shape(1) != cols) {
+    std::string shape = "(";
+    for (py::ssize_t d = 0; d < a.ndim(); ++d) shape += (d ? ", " : "") + std::to_string(a.shape(d));
+    shape += a.ndim() == 1 ? ",)" : ")";
+    throw std::invalid_argument(std::string(name) + ": expected shape (N, " + std::to_string(cols) + "), got " +
+                                shape);
+  }
+  return Eigen::Map<const RowMat>(a.data(), a.shape(0), cols);
+}
+
+/// 1-D int array.
+inline Eigen::VectorXi toIntVector(const py::handle& obj, const char* name) {
+  IArray a;
+  try {
+    a = IArray::ensure(obj);
+  } catch (const py::error_already_set&) {
+    throw std::invalid_argument(std::string(name) + ": expected an integer array");
+  }
+  if (!a) throw std::invalid_argument(std::string(name) + ": expected an integer array");
+  if (a.ndim() == 0) return Eigen::VectorXi::Constant(1, *a.data());
+  if (a.ndim() != 1) throw std::invalid_argument(std::string(name) + ": expected a 1-D integer array");
+  return Eigen::Map<const Eigen::VectorXi>(a.data(), a.shape(0));
+}
+
+/// Number of rows after broadcasting single rows; throws when lengths differ.
+inline Eigen::Index commonRows(std::initializer_list<std::pair<Eigen::Index, const char*>> sizes) {
+  Eigen::Index n = 1;
+  const char* who = nullptr;
+  for (const auto& [rows, name] : sizes) {
+    if (rows == 1) continue;
+    if (n != 1 && rows != n) {
+      throw std::invalid_argument(std::string("length mismatch: ") + who + " has " + std::to_string(n) + " rows, " +
+                                  name + " has " + std::to_string(rows));
+    }
+    n = rows;
+    who = name;
+  }
+  return n;
+}
+
+inline Vec3 row3(const RowMat& m, Eigen::Index i) {
+  const Eigen::Index r = m.rows() == 1 ? 0 : i;
+  return Vec3(m(r, 0), m(r, 1), m(r, 2));
+}
+/// Quaternion from an (x, y, z, w) row.
+inline Quat rowQuat(const RowMat& m, Eigen::Index i) {
+  const Eigen::Index r = m.rows() == 1 ? 0 : i;
+  return Quat(m(r, 3), m(r, 0), m(r, 1), m(r, 2));
+}
+
+inline py::array_t<double> newArray(Eigen::Index n) { return py::array_t<double>(static_cast<py::ssize_t>(n)); }
+inline py::array_t<double> newArray(Eigen::Index n, Eigen::Index cols) {
+  return py::array_t<double>({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(cols)});
+}
+inline py::array_t<int> newIntArray(Eigen::Index n) { return py::array_t<int>(static_cast<py::ssize_t>(n)); }
+
+/// Copies an Eigen matrix into a fresh numpy array (2-D; 1-D when as_vector).
+template <class Derived>
+py::array_t<double> toNumpy(const Eigen::MatrixBase<Derived>& m, bool as_vector = false) {
+  if (as_vector) {
+    py::array_t<double> out = newArray(m.size());
+    auto o = out.mutable_unchecked<1>();
+    for (Eigen::Index i = 0; i < m.size(); ++i) o(i) = m(i);
+    return out;
+  }
+  py::array_t<double> out = newArray(m.rows(), m.cols());
+  auto o = out.mutable_unchecked<2>();
+  for (Eigen::Index i = 0; i < m.rows(); ++i)
+    for (Eigen::Index j = 0; j < m.cols(); ++j) o(i, j) = m(i, j);
+  return out;
+}
+
+/// Fetches a required key of a dict of arrays; KeyError-like message as ValueError.
+inline py::object requireKey(const py::dict& d, const char* key, const char* what) {
+  if (!d.contains(key)) throw std::invalid_argument(std::string(what) + ": missing key '" + key + "'");
+  return d[key];
+}
+
+void bindCore(py::module_& m);
+void bindIo(py::module_& m);
+void bindModel(py::module_& m);
+
+}  // namespace uwb::python
