@@ -1,0 +1,537 @@
+/** @file Kernel.cpp
+ *  @brief Block evaluation of composite kernels and their gradients (docs/math/gp.md P1–P10; paper eq. 7–9).
+ */
+#include "uwb/gp/Kernel.h"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+namespace uwb::gp {
+
+namespace {
+
+constexpr double kSqrt5 = 2.23606797749978969640917366873128;
+
+/// The active columns of X, as an n×d matrix.
+MatX activeCols(const MatX& X, const std::vector<int>& dims) {
+  MatX out(X.rows(), static_cast<Eigen::Index>(dims.size()));
+  for (std::size_t d = 0; d < dims.size(); ++d) out.col(static_cast<Eigen::Index>(d)) = X.col(dims[d]);
+  return out;
+}
+
+/// Row norms of a n×3 matrix; throws when one is (numerically) zero: k_L is undefined at x = 0 (P4).
+VecX rowNorms(const MatX& A) {
+  VecX n = A.rowwise().norm();
+  if (n.size() > 0 && n.minCoeff() < 1e-12) {
+    throw std::invalid_argument("ledergerber kernel: input vector of zero norm (k_L is undefined at x = 0)");
+  }
+  return n;
+}
+
+}  // namespace
+
+std::string toString(PartType type) {
+  switch (type) {
+    case PartType::kRbf: return "rbf";
+    case PartType::kMatern52: return "matern52";
+    case PartType::kPeriodic: return "periodic";
+    case PartType::kLedergerber: return "ledergerber";
+  }
+  return "unknown";
+}
+
+PartType partTypeFromString(const std::string& name) {
+  if (name == "rbf" || name == "se" || name == "squared_exponential") return PartType::kRbf;
+  if (name == "matern52" || name == "matern") return PartType::kMatern52;
+  if (name == "periodic") return PartType::kPeriodic;
+  if (name == "ledergerber" || name == "kl" || name == "k_L") return PartType::kLedergerber;
+  throw std::invalid_argument("unknown kernel part type '" + name +
+                              "' (expected rbf, matern52, periodic or ledergerber)");
+}
+
+Kernel Kernel::sum(const std::vector<PartSpec>& parts) {
+  std::vector<std::vector<int>> terms;
+  for (int p = 0; p < static_cast<int>(parts.size()); ++p) terms.push_back({p});
+  return Kernel(parts, terms);
+}
+
+Kernel Kernel::product(const std::vector<PartSpec>& parts) {
+  std::vector<int> all;
+  for (int p = 0; p < static_cast<int>(parts.size()); ++p) all.push_back(p);
+  return Kernel(parts, {all});
+}
+
+Kernel::Kernel(const std::vector<PartSpec>& parts, const std::vector<std::vector<int>>& terms) { build(parts, terms); }
+
+void Kernel::build(const std::vector<PartSpec>& parts, const std::vector<std::vector<int>>& terms) {
+  if (parts.empty()) throw std::invalid_argument("kernel: no parts");
+  std::vector<bool> used(parts.size(), false);
+  for (const auto& t : terms) {
+    if (t.empty()) throw std::invalid_argument("kernel: empty product term");
+    for (int p : t) {
+      if (p < 0 || p >= static_cast<int>(parts.size())) throw std::invalid_argument("kernel: term index out of range");
+      if (used[p]) throw std::invalid_argument("kernel: a part appears in more than one term");
+      used[p] = true;
+    }
+  }
+  for (bool u : used)
+    if (!u) throw std::invalid_argument("kernel: a part is in no term");
+  parts_.clear();
+  names_.clear();
+  trainable_.clear();
+  std::vector<double> values;
+  input_dim_ = 0;
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const PartSpec& s = parts[p];
+    if (s.active_dims.empty()) throw std::invalid_argument("kernel part " + std::to_string(p) + ": no active dims");
+    for (int d : s.active_dims) {
+      if (d < 0) throw std::invalid_argument("kernel part: negative active dim");
+      input_dim_ = std::max(input_dim_, d + 1);
+    }
+    Part part{s.type, s.active_dims, static_cast<int>(values.size()), 0, 0};
+    const int nd = static_cast<int>(s.active_dims.size());
+    const std::string prefix = "p" + std::to_string(p) + "." + toString(s.type) + ".";
+    auto add = [&](const std::string& n, double v, bool train) {
+      if (!(v > 0.0) || !std::isfinite(v)) {
+        throw std::invalid_argument("kernel parameter " + prefix + n + " must be positive and finite, got " +
+                                    std::to_string(v));
+      }
+      values.push_back(v);
+      names_.push_back(prefix + n);
+      trainable_.push_back(train);
+    };
+    auto addList = [&](const std::string& n, const std::vector<double>& v, bool train) {
+      if (v.size() != 1 && static_cast<int>(v.size()) != nd) {
+        throw std::invalid_argument("kernel part " + prefix + n + ": expected 1 or " + std::to_string(nd) +
+                                    " values, got " + std::to_string(v.size()));
+      }
+      if (v.size() == 1) {
+        add(n, v[0], train);
+      } else {
+        for (std::size_t i = 0; i < v.size(); ++i) add(n + "[" + std::to_string(i) + "]", v[i], train);
+      }
+      return static_cast<int>(v.size());
+    };
+    if (s.type == PartType::kLedergerber) {
+      if (nd != 3) throw std::invalid_argument("ledergerber kernel part needs exactly 3 active dims");
+      add("t0", s.sigma2, true);
+      add("t1", s.t1, true);
+      add("t2", s.t2, true);
+    } else {
+      add("sigma2", s.sigma2, true);
+      part.n_l = addList("l", s.l, true);
+      if (s.type == PartType::kPeriodic) part.n_T = addList("T", s.T, s.train_period);
+    }
+    parts_.push_back(part);
+  }
+  terms_ = terms;
+  theta_ = Eigen::Map<const VecX>(values.data(), static_cast<Eigen::Index>(values.size()));
+}
+
+Kernel Kernel::preset(const std::string& name) {
+  if (name == "z1") {  // paper eq. (7): k_p(α_i) + k_p(α_j), T = 2π
+    PartSpec a{PartType::kPeriodic, {0}, 0.05, {1.0}, {2.0 * kPi}};
+    PartSpec b = a;
+    b.active_dims = {1};
+    return sum({a, b});
+  }
+  if (name == "z2") {  // paper eq. (8): Matérn-5/2(α_i) + Matérn-5/2(α_j)
+    PartSpec a{PartType::kMatern52, {0}, 0.05, {1.0}};
+    PartSpec b = a;
+    b.active_dims = {1};
+    return sum({a, b});
+  }
+  if (name == "tdoa") {  // paper eq. (9): k_L(x_ki) + k_L(x_kj)
+    PartSpec a{PartType::kLedergerber, {0, 1, 2}, 0.05};
+    a.t1 = 0.5;
+    a.t2 = 4.0;
+    PartSpec b = a;
+    b.active_dims = {3, 4, 5};
+    return sum({a, b});
+  }
+  throw std::invalid_argument("unknown kernel preset '" + name + "' (expected z1, z2 or tdoa)");
+}
+
+std::string Kernel::name() const {
+  std::ostringstream os;
+  os << '(';
+  for (std::size_t t = 0; t < terms_.size(); ++t) {
+    if (t) os << '+';
+    for (std::size_t i = 0; i < terms_[t].size(); ++i) {
+      if (i) os << '*';
+      const Part& p = parts_[terms_[t][i]];
+      os << toString(p.type) << '[';
+      for (std::size_t d = 0; d < p.active_dims.size(); ++d) os << (d ? "," : "") << p.active_dims[d];
+      os << ']';
+    }
+  }
+  os << ')';
+  return os.str();
+}
+
+void Kernel::setTheta(const VecX& theta) {
+  if (theta.size() != theta_.size()) throw std::invalid_argument("kernel: wrong number of parameters");
+  if (!(theta.array() > 0.0).all() || !theta.allFinite())
+    throw std::invalid_argument("kernel: parameters must be positive and finite");
+  theta_ = theta;
+}
+
+void Kernel::setTrainable(const std::string& name, bool trainable) {
+  for (std::size_t i = 0; i < names_.size(); ++i) {
+    if (names_[i] == name) {
+      trainable_[i] = trainable;
+      return;
+    }
+  }
+  throw std::invalid_argument("unknown kernel parameter '" + name + "'");
+}
+
+std::map<std::string, Parameter> Kernel::params() const {
+  std::map<std::string, Parameter> out;
+  for (std::size_t i = 0; i < names_.size(); ++i) out[names_[i]] = {theta_[static_cast<Eigen::Index>(i)], trainable_[i]};
+  return out;
+}
+
+void Kernel::setParam(const std::string& name, double value) {
+  for (std::size_t i = 0; i < names_.size(); ++i) {
+    if (names_[i] == name) {
+      if (!(value > 0.0) || !std::isfinite(value))
+        throw std::invalid_argument("kernel parameter " + name + " must be positive and finite");
+      theta_[static_cast<Eigen::Index>(i)] = value;
+      return;
+    }
+  }
+  throw std::invalid_argument("unknown kernel parameter '" + name + "'");
+}
+
+double Kernel::param(const std::string& name) const {
+  for (std::size_t i = 0; i < names_.size(); ++i)
+    if (names_[i] == name) return theta_[static_cast<Eigen::Index>(i)];
+  throw std::invalid_argument("unknown kernel parameter '" + name + "'");
+}
+
+PartSpec Kernel::partSpec(int pi) const {
+  const Part& p = parts_[pi];
+  PartSpec s;
+  s.type = p.type;
+  s.active_dims = p.active_dims;
+  s.sigma2 = theta_[p.offset];
+  if (p.type == PartType::kLedergerber) {
+    s.t1 = theta_[p.offset + 1];
+    s.t2 = theta_[p.offset + 2];
+    s.l.clear();
+    s.T.clear();
+    return s;
+  }
+  s.l.assign(theta_.data() + p.offset + 1, theta_.data() + p.offset + 1 + p.n_l);
+  if (p.type == PartType::kPeriodic) {
+    s.T.assign(theta_.data() + p.offset + 1 + p.n_l, theta_.data() + p.offset + 1 + p.n_l + p.n_T);
+    s.train_period = trainable_[p.offset + 1 + p.n_l];
+  } else {
+    s.T.clear();
+  }
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Evaluation
+// ---------------------------------------------------------------------------------------------------------------
+
+MatX Kernel::partCross(int pi, const MatX& X1, const MatX& X2) const {
+  const Part& p = parts_[pi];
+  const MatX A = activeCols(X1, p.active_dims);
+  const MatX B = activeCols(X2, p.active_dims);
+  const Eigen::Index n1 = A.rows(), n2 = B.rows(), nd = A.cols();
+  const double s2 = theta_[p.offset];
+  MatX K(n1, n2);
+  switch (p.type) {
+    case PartType::kRbf:
+    case PartType::kMatern52: {
+      // ρ² = Σ_d ((a_d − b_d)/l_d)²  (P2, P3)
+      MatX As = A, Bs = B;
+      for (Eigen::Index d = 0; d < nd; ++d) {
+        const double l = theta_[p.offset + 1 + (p.n_l == 1 ? 0 : d)];
+        As.col(d) /= l;
+        Bs.col(d) /= l;
+      }
+      K.setZero();
+      for (Eigen::Index j = 0; j < n2; ++j)
+        for (Eigen::Index d = 0; d < nd; ++d) K.col(j).array() += (As.col(d).array() - Bs(j, d)).square();
+      if (p.type == PartType::kRbf) {
+        K = s2 * (-0.5 * K.array()).exp();
+      } else {
+        const Eigen::ArrayXXd r = K.array().sqrt() * kSqrt5;  // √5 ρ
+        K = s2 * (1.0 + r + r.square() / 3.0) * (-r).exp();
+      }
+      break;
+    }
+    case PartType::kPeriodic: {
+      // Σ_d sin²(π Δ_d / T_d) / l_d²  (P1)
+      K.setZero();
+      for (Eigen::Index d = 0; d < nd; ++d) {
+        const double l = theta_[p.offset + 1 + (p.n_l == 1 ? 0 : d)];
+        const double T = theta_[p.offset + 1 + p.n_l + (p.n_T == 1 ? 0 : d)];
+        const double c = kPi / T, il2 = 1.0 / (l * l);
+        for (Eigen::Index j = 0; j < n2; ++j)
+          K.col(j).array() += il2 * (c * (A.col(d).array() - B(j, d))).sin().square();
+      }
+      K = s2 * (-2.0 * K.array()).exp();
+      break;
+    }
+    case PartType::kLedergerber: {
+      // θ0 exp(−(1 − γ)/θ1 − (n − n')²/θ2), γ = xᵀx'/(n n')  (P4)
+      const double t1 = theta_[p.offset + 1], t2 = theta_[p.offset + 2];
+      const VecX na = rowNorms(A), nb = rowNorms(B);
+      const MatX Ua = na.cwiseInverse().asDiagonal() * A;
+      const MatX Ub = nb.cwiseInverse().asDiagonal() * B;
+      K.noalias() = Ua * Ub.transpose();  // γ
+      for (Eigen::Index j = 0; j < n2; ++j)
+        K.col(j).array() = -(1.0 - K.col(j).array()) / t1 - (na.array() - nb[j]).square() / t2;
+      K = s2 * K.array().exp();
+      break;
+    }
+  }
+  return K;
+}
+
+MatX Kernel::cross(const MatX& X1, const MatX& X2, std::vector<MatX>* part_blocks) const {
+  if (X1.cols() < input_dim_ || X2.cols() < input_dim_)
+    throw std::invalid_argument("kernel: inputs have " + std::to_string(std::min(X1.cols(), X2.cols())) +
+                                " columns, the kernel reads " + std::to_string(input_dim_));
+  MatX K = MatX::Zero(X1.rows(), X2.rows());
+  if (part_blocks) part_blocks->assign(parts_.size(), MatX());
+  for (const auto& term : terms_) {
+    if (term.size() == 1 && !part_blocks) {
+      K += partCross(term[0], X1, X2);
+      continue;
+    }
+    MatX prod;
+    for (std::size_t i = 0; i < term.size(); ++i) {
+      MatX Kp = partCross(term[i], X1, X2);
+      if (i == 0)
+        prod = Kp;
+      else
+        prod.array() *= Kp.array();
+      if (part_blocks) (*part_blocks)[term[i]] = std::move(Kp);
+    }
+    K += prod;
+  }
+  return K;
+}
+
+double Kernel::operator()(const Eigen::Ref<const RowVecX>& x, const Eigen::Ref<const RowVecX>& xp) const {
+  return cross(MatX(x), MatX(xp))(0, 0);
+}
+
+double Kernel::diagValue() const {
+  double k = 0.0;
+  for (const auto& term : terms_) {
+    double prod = 1.0;
+    for (int p : term) prod *= theta_[parts_[p].offset];
+    k += prod;
+  }
+  return k;
+}
+
+VecX Kernel::diag(const MatX& X) const { return VecX::Constant(X.rows(), diagValue()); }
+
+void Kernel::accumulateDiagGradient(double sum_g, VecX& grad_theta) const {
+  for (const auto& term : terms_) {
+    for (int p : term) {
+      double others = 1.0;
+      for (int q : term)
+        if (q != p) others *= theta_[parts_[q].offset];
+      grad_theta[parts_[p].offset] += sum_g * others;  // ∂k(x,x)/∂σ²_p = Π_{q≠p} σ²_q
+    }
+  }
+}
+
+void Kernel::accumulateCrossGradient(const MatX& X1, const MatX& X2, const MatX& G,
+                                     const std::vector<MatX>& part_blocks, VecX& grad_theta, MatX* grad_X1) const {
+  if (static_cast<int>(part_blocks.size()) != numParts())
+    throw std::invalid_argument("kernel gradient: part_blocks missing (call cross(X1, X2, &blocks))");
+  for (const auto& term : terms_) {
+    for (int p : term) {
+      if (term.size() == 1) {
+        partGradient(p, X1, X2, G, part_blocks[p], grad_theta, grad_X1);
+      } else {
+        MatX H = G;  // P5: ∂(Π k_q)/∂θ_p = (Π_{q≠p} k_q) ∂k_p/∂θ_p
+        for (int q : term)
+          if (q != p) H.array() *= part_blocks[q].array();
+        partGradient(p, X1, X2, H, part_blocks[p], grad_theta, grad_X1);
+      }
+    }
+  }
+}
+
+void Kernel::partGradient(int pi, const MatX& X1, const MatX& X2, const MatX& H, const MatX& Kp, VecX& grad_theta,
+                          MatX* grad_X1) const {
+  const Part& p = parts_[pi];
+  const MatX A = activeCols(X1, p.active_dims);
+  const MatX B = activeCols(X2, p.active_dims);
+  const Eigen::Index n2 = B.rows(), nd = A.cols();
+  const double s2 = theta_[p.offset];
+  const MatX W = H.cwiseProduct(Kp);  // H ∘ k
+  const double sumW = W.sum();
+  grad_theta[p.offset] += sumW / s2;  // ∂k/∂σ² = k/σ²
+  switch (p.type) {
+    case PartType::kRbf:
+    case PartType::kMatern52: {
+      MatX Wg;  // weight multiplying Δ_d/l_d² in ∂k/∂x_d = −w Δ_d / l_d²  and  ∂k/∂l_d = w Δ_d² / l_d³
+      if (p.type == PartType::kRbf) {
+        Wg = W;  // P8: RBF: ∂k/∂l_d = k Δ_d²/l_d³, ∂k/∂x_d = −k Δ_d/l_d²
+      } else {
+        // P9: Matérn-5/2, g = (5/3) σ² (1 + √5ρ) e^{−√5ρ}
+        MatX R2 = MatX::Zero(A.rows(), n2);
+        for (Eigen::Index d = 0; d < nd; ++d) {
+          const double l = theta_[p.offset + 1 + (p.n_l == 1 ? 0 : d)];
+          for (Eigen::Index j = 0; j < n2; ++j) R2.col(j).array() += ((A.col(d).array() - B(j, d)) / l).square();
+        }
+        const Eigen::ArrayXXd r = R2.array().sqrt() * kSqrt5;
+        Wg = H.array() * ((5.0 / 3.0) * s2 * (1.0 + r) * (-r).exp());
+      }
+      for (Eigen::Index d = 0; d < nd; ++d) {
+        const Eigen::Index li = p.offset + 1 + (p.n_l == 1 ? 0 : d);
+        const double l = theta_[li];
+        double acc = 0.0;
+        Eigen::ArrayXd gx = Eigen::ArrayXd::Zero(A.rows());
+        for (Eigen::Index j = 0; j < n2; ++j) {
+          const Eigen::ArrayXd delta = A.col(d).array() - B(j, d);
+          const Eigen::ArrayXd wd = Wg.col(j).array() * delta;
+          gx += wd;
+          acc += (wd * delta).sum();
+        }
+        grad_theta[li] += acc / (l * l * l);
+        if (grad_X1) grad_X1->col(p.active_dims[d]) -= (gx / (l * l)).matrix();
+      }
+      break;
+    }
+    case PartType::kPeriodic: {
+      // P7: u = πΔ/T; ∂k/∂l = 4k sin²u / l³; ∂k/∂T = k (2/l²) sin 2u · πΔ/T²; ∂k/∂x = −k (2/l²) sin 2u · π/T
+      for (Eigen::Index d = 0; d < nd; ++d) {
+        const Eigen::Index li = p.offset + 1 + (p.n_l == 1 ? 0 : d);
+        const Eigen::Index ti = p.offset + 1 + p.n_l + (p.n_T == 1 ? 0 : d);
+        const double l = theta_[li], T = theta_[ti], c = kPi / T;
+        double acc_l = 0.0, acc_T = 0.0;
+        Eigen::ArrayXd gx = Eigen::ArrayXd::Zero(A.rows());
+        for (Eigen::Index j = 0; j < n2; ++j) {
+          const Eigen::ArrayXd delta = A.col(d).array() - B(j, d);
+          const Eigen::ArrayXd u = c * delta;
+          const Eigen::ArrayXd w = W.col(j).array();
+          acc_l += (w * u.sin().square()).sum();
+          const Eigen::ArrayXd ws2 = w * (2.0 * u).sin();
+          acc_T += (ws2 * delta).sum();
+          gx += ws2;
+        }
+        grad_theta[li] += 4.0 * acc_l / (l * l * l);
+        grad_theta[ti] += (2.0 / (l * l)) * c / T * acc_T;
+        if (grad_X1) grad_X1->col(p.active_dims[d]) -= ((2.0 / (l * l)) * c * gx).matrix();
+      }
+      break;
+    }
+    case PartType::kLedergerber: {
+      // P10: ∂k/∂θ1 = k(1−γ)/θ1², ∂k/∂θ2 = k(n−n')²/θ2², ∂k/∂x = k[(x'/(nn') − γx/n²)/θ1 − 2(n−n')/θ2 · x/n]
+      const double t1 = theta_[p.offset + 1], t2 = theta_[p.offset + 2];
+      const VecX na = rowNorms(A), nb = rowNorms(B);
+      const MatX Ua = na.cwiseInverse().asDiagonal() * A;
+      const MatX Ub = nb.cwiseInverse().asDiagonal() * B;
+      const MatX gamma = Ua * Ub.transpose();
+      MatX dn2(A.rows(), n2);  // (n − n')
+      for (Eigen::Index j = 0; j < n2; ++j) dn2.col(j) = na.array() - nb[j];
+      grad_theta[p.offset + 1] += (W.array() * (1.0 - gamma.array())).sum() / (t1 * t1);
+      grad_theta[p.offset + 2] += (W.array() * dn2.array().square()).sum() / (t2 * t2);
+      if (grad_X1) {
+        const MatX WUb = W * Ub;                                         // Σ_j w_ij x'_j/n'_j
+        const VecX wg = (W.array() * gamma.array()).rowwise().sum();   // Σ_j w_ij γ_ij
+        const VecX wdn = (W.array() * dn2.array()).rowwise().sum();    // Σ_j w_ij (n_i − n'_j)
+        for (Eigen::Index d = 0; d < 3; ++d) {
+          const VecX g = (WUb.col(d).array() / na.array() / t1 - wg.array() * A.col(d).array() / na.array().square() / t1 -
+                          2.0 * wdn.array() / t2 * A.col(d).array() / na.array())
+                             .matrix();
+          grad_X1->col(p.active_dims[d]) += g;
+        }
+      }
+      break;
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// JSON
+// ---------------------------------------------------------------------------------------------------------------
+
+nlohmann::json Kernel::toJson() const {
+  nlohmann::json parts = nlohmann::json::array();
+  for (int p = 0; p < numParts(); ++p) {
+    const PartSpec s = partSpec(p);
+    nlohmann::json jp;
+    jp["type"] = toString(s.type);
+    jp["active_dims"] = s.active_dims;
+    if (s.type == PartType::kLedergerber) {
+      jp["t0"] = s.sigma2;
+      jp["t1"] = s.t1;
+      jp["t2"] = s.t2;
+    } else {
+      jp["sigma2"] = s.sigma2;
+      jp["l"] = s.l;
+      if (s.type == PartType::kPeriodic) {
+        jp["T"] = s.T;
+        jp["train_period"] = s.train_period;
+      }
+    }
+    parts.push_back(jp);
+  }
+  nlohmann::json fixed = nlohmann::json::array();
+  for (std::size_t i = 0; i < names_.size(); ++i)
+    if (!trainable_[i]) fixed.push_back(names_[i]);
+  return {{"combination", "sum_of_products"}, {"terms", terms_}, {"parts", parts}, {"fixed", fixed},
+          {"name", name()}};
+}
+
+Kernel Kernel::fromJson(const nlohmann::json& j) {
+  try {
+    std::vector<PartSpec> specs;
+    for (const auto& jp : j.at("parts")) {
+      PartSpec s;
+      s.type = partTypeFromString(jp.at("type").get<std::string>());
+      s.active_dims = jp.at("active_dims").get<std::vector<int>>();
+      // Either our own layout or the fixture layout (parameters in a "paper" block; FIXTURES.md §2).
+      const nlohmann::json& src = jp.contains("paper") ? jp.at("paper") : jp;
+      if (s.type == PartType::kLedergerber) {
+        s.sigma2 = src.at("t0").get<double>();
+        s.t1 = src.at("t1").get<double>();
+        s.t2 = src.at("t2").get<double>();
+      } else {
+        s.sigma2 = src.at("sigma2").get<double>();
+        s.l = src.at("l").get<std::vector<double>>();
+        if (s.type == PartType::kPeriodic) {
+          s.T = src.at("T").get<std::vector<double>>();
+          s.train_period = jp.value("train_period", false);
+        }
+      }
+      specs.push_back(s);
+    }
+    std::vector<std::vector<int>> terms;
+    const std::string comb = j.value("combination", std::string("sum"));
+    if (comb == "sum") {
+      for (int p = 0; p < static_cast<int>(specs.size()); ++p) terms.push_back({p});
+    } else if (comb == "product") {
+      terms.emplace_back();
+      for (int p = 0; p < static_cast<int>(specs.size()); ++p) terms[0].push_back(p);
+    } else if (comb == "sum_of_products") {
+      terms = j.at("terms").get<std::vector<std::vector<int>>>();
+    } else {
+      throw std::invalid_argument("unknown combination '" + comb + "'");
+    }
+    Kernel k(specs, terms);
+    if (j.contains("fixed"))
+      for (const auto& n : j.at("fixed")) k.setTrainable(n.get<std::string>(), false);
+    return k;
+  } catch (const nlohmann::json::exception& e) {
+    throw std::invalid_argument(std::string("kernel JSON: ") + e.what());
+  }
+}
+
+}  // namespace uwb::gp

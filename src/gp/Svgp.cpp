@@ -1,0 +1,334 @@
+/** @file Svgp.cpp
+ *  @brief Whitened SVGP: ELBO, analytic gradients (reverse mode by hand), predictions (docs/math/gp.md P11–P20).
+ */
+#include "uwb/gp/Svgp.h"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+namespace uwb::gp {
+
+namespace {
+
+constexpr double kLog2Pi = 1.83787706640934548356065947281123;
+
+MatX choleskyOrThrow(const MatX& K, const char* what) {
+  Eigen::LLT<MatX> llt(K);
+  if (llt.info() != Eigen::Success) {
+    throw std::runtime_error(std::string(what) + ": matrix is not positive definite (Cholesky failed)");
+  }
+  return llt.matrixL();
+}
+
+/// Φ(X): lower triangle with the diagonal halved (Murray 2016; P18).
+MatX phi(const MatX& X) {
+  MatX P = X.triangularView<Eigen::Lower>();
+  P.diagonal() *= 0.5;
+  return P;
+}
+
+template <class T>
+nlohmann::json matToJson(const T& M) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < M.rows(); ++i) {
+    std::vector<double> r(static_cast<std::size_t>(M.cols()));
+    for (Eigen::Index j = 0; j < M.cols(); ++j) r[static_cast<std::size_t>(j)] = M(i, j);
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+MatX matFromJson(const nlohmann::json& j, const char* what) {
+  if (!j.is_array() || j.empty()) throw std::invalid_argument(std::string(what) + ": expected a non-empty matrix");
+  const std::size_t rows = j.size(), cols = j[0].size();
+  MatX M(rows, cols);
+  for (std::size_t i = 0; i < rows; ++i) {
+    if (!j[i].is_array() || j[i].size() != cols)
+      throw std::invalid_argument(std::string(what) + ": ragged matrix (row " + std::to_string(i) + ")");
+    for (std::size_t k = 0; k < cols; ++k) M(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(k)) = j[i][k].get<double>();
+  }
+  return M;
+}
+
+VecX vecFromJson(const nlohmann::json& j) {
+  const auto v = j.get<std::vector<double>>();
+  return Eigen::Map<const VecX>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
+
+}  // namespace
+
+double relativeError(const MatX& a, const MatX& b) {
+  if (a.rows() != b.rows() || a.cols() != b.cols()) return std::numeric_limits<double>::infinity();
+  const double denom = b.cwiseAbs().maxCoeff();
+  const double num = (a - b).cwiseAbs().maxCoeff();
+  return denom > 0 ? num / denom : num;
+}
+
+Svgp::Svgp(Kernel kernel, MatX Z, double jitter) : kernel_(std::move(kernel)), jitter_(jitter) {
+  setInducing(Z);
+  m_ = VecX::Zero(Z_.rows());
+  L_ = MatX::Identity(Z_.rows(), Z_.rows());
+}
+
+void Svgp::setInducing(const MatX& Z) {
+  if (Z.rows() < 1) throw std::invalid_argument("SVGP: need at least one inducing point");
+  if (Z.cols() < kernel_.inputDim())
+    throw std::invalid_argument("SVGP: inducing points have " + std::to_string(Z.cols()) + " columns, kernel reads " +
+                                std::to_string(kernel_.inputDim()));
+  if (Z_.size() > 0 && Z.rows() != Z_.rows()) throw std::invalid_argument("SVGP: number of inducing points changed");
+  Z_ = Z;
+}
+
+void Svgp::setVariational(const VecX& m, const MatX& L) {
+  if (m.size() != Z_.rows() || L.rows() != Z_.rows() || L.cols() != Z_.rows())
+    throw std::invalid_argument("SVGP: variational parameters must be M=" + std::to_string(Z_.rows()) + " sized");
+  if ((L.diagonal().array() == 0.0).any()) throw std::invalid_argument("SVGP: L has a zero on its diagonal");
+  m_ = m;
+  L_ = L.triangularView<Eigen::Lower>();
+}
+
+void Svgp::setNoiseVariance(double s2) {
+  if (!(s2 > 0.0) || !std::isfinite(s2)) throw std::invalid_argument("SVGP: noise variance must be positive");
+  noise_ = s2;
+}
+
+void Svgp::setInputTransform(const VecX& shift, const VecX& scale) {
+  if (shift.size() != scale.size()) throw std::invalid_argument("SVGP: input shift and scale differ in size");
+  if (scale.size() > 0 && !(scale.array() > 0.0).all()) throw std::invalid_argument("SVGP: input scale must be > 0");
+  shift_ = shift;
+  scale_ = scale;
+}
+
+MatX Svgp::transformInputs(const MatX& X) const {
+  if (shift_.size() == 0) return X;
+  if (X.cols() != shift_.size()) throw std::invalid_argument("SVGP: input has the wrong number of columns");
+  return ((X.rowwise() - shift_.transpose()).array().rowwise() / scale_.transpose().array()).matrix();
+}
+
+std::map<std::string, Parameter> Svgp::params() const {
+  auto p = kernel_.params();
+  p["likelihood.noise"] = {noise_, true};
+  p["mean.constant"] = {c_, true};
+  return p;
+}
+
+void Svgp::setParam(const std::string& name, double value) {
+  if (name == "likelihood.noise")
+    setNoiseVariance(value);
+  else if (name == "mean.constant")
+    c_ = value;
+  else
+    kernel_.setParam(name, value);
+}
+
+double Svgp::kl() const {
+  // P14: KL = ½ [tr S + mᵀm − M − Σ log L_ii²]
+  const double M = static_cast<double>(m_.size());
+  return 0.5 * (L_.squaredNorm() + m_.squaredNorm() - M - L_.diagonal().array().square().log().sum());
+}
+
+ElboTerms Svgp::elbo(const MatX& X_raw, const VecX& y, double num_data, SvgpGradient* grad, ElboMode mode) const {
+  if (X_raw.rows() != y.size() || X_raw.rows() == 0) throw std::invalid_argument("SVGP elbo: X and y mismatch or empty");
+  if (!(num_data > 0)) throw std::invalid_argument("SVGP elbo: num_data must be positive");
+  const MatX X = transformInputs(X_raw);
+  const Eigen::Index M = Z_.rows(), B = X.rows();
+  const double s = noise_, Bd = static_cast<double>(B);
+  const bool need_grad = grad != nullptr;
+
+  // P11: Kzz = K(Z,Z) + εI = Lz Lzᵀ
+  std::vector<MatX> zz_blocks, zx_blocks;
+  MatX Kzz = kernel_.cross(Z_, Z_, need_grad ? &zz_blocks : nullptr);
+  Kzz.diagonal().array() += jitter_;
+  const MatX Lz = choleskyOrThrow(Kzz, "SVGP Kzz");
+  const auto LzT = Lz.triangularView<Eigen::Lower>();
+  const MatX Kzx = kernel_.cross(Z_, X, need_grad ? &zx_blocks : nullptr);
+  const double kdiag = kernel_.diagValue();
+  const MatX SmI = [&] {
+    MatX S = L_ * L_.transpose();
+    S.diagonal().array() -= 1.0;
+    return S;
+  }();
+
+  // P12–P13: mean_f = c + aᵀm, var_f = k + ε + aᵀ(S − I)a
+  VecX mean_f(B), var_f(B);
+  MatX A, C;      // kExact: A = Lz⁻¹Kzx, C = (S − I)A
+  VecX alpha;     // kFast: Lz⁻ᵀ m
+  MatX WK;        // kFast: W Kzx, W = Lz⁻ᵀ (S − I) Lz⁻¹
+  if (mode == ElboMode::kExact) {
+    A = LzT.solve(Kzx);
+    C.noalias() = SmI * A;
+    mean_f.noalias() = A.transpose() * m_;
+    var_f = (A.array() * C.array()).colwise().sum().transpose();
+  } else {
+    alpha = LzT.transpose().solve(m_);
+    const MatX T1 = LzT.transpose().solve(SmI);                // Lz⁻ᵀ (S − I)
+    MatX W = LzT.transpose().solve(T1.transpose()).transpose();  // Lz⁻ᵀ (S − I) Lz⁻¹
+    W = 0.5 * (W + W.transpose()).eval();
+    WK.noalias() = W * Kzx;
+    mean_f.noalias() = Kzx.transpose() * alpha;
+    var_f = (Kzx.array() * WK.array()).colwise().sum().transpose();
+  }
+  mean_f.array() += c_;
+  var_f.array() += kdiag + jitter_;
+
+  // P15: ELL_n and ELBO per datum
+  const VecX r = y - mean_f;
+  const double sum_sq = r.squaredNorm() + var_f.sum();
+  ElboTerms out;
+  out.exp_log_lik_sum = -0.5 * (Bd * (kLog2Pi + std::log(s)) + sum_sq / s);
+  out.exp_log_lik = out.exp_log_lik_sum / Bd;
+  out.kl = kl();
+  out.elbo = out.exp_log_lik - out.kl / num_data;
+  if (!need_grad) return out;
+
+  // ---- reverse pass (P16–P19; FIXTURES.md §5) ----
+  const double beta = 1.0 / (s * Bd);
+  SvgpGradient& g = *grad;
+  g.mean = beta * r.sum();
+  g.noise = (-0.5 * Bd / s + 0.5 * sum_sq / (s * s)) / Bd;
+
+  MatX AAt = MatX::Zero(M, M);
+  VecX Ar;
+  MatX Kbar_zx;
+  if (mode == ElboMode::kExact) {
+    AAt.selfadjointView<Eigen::Lower>().rankUpdate(A);
+    AAt = AAt.selfadjointView<Eigen::Lower>();
+    Ar.noalias() = A * r;
+    // Ā = β (m rᵀ − (S − I) A);  K̄zx = Lz⁻ᵀ Ā
+    MatX Abar = -beta * C;
+    Abar.noalias() += (beta * m_) * r.transpose();
+    Kbar_zx = LzT.transpose().solve(Abar);
+  } else {
+    MatX KKt = MatX::Zero(M, M);
+    KKt.selfadjointView<Eigen::Lower>().rankUpdate(Kzx);
+    KKt = KKt.selfadjointView<Eigen::Lower>();
+    AAt = LzT.solve(LzT.solve(KKt).transpose());  // Lz⁻¹ Kzx Kxz Lz⁻ᵀ
+    AAt = 0.5 * (AAt + AAt.transpose()).eval();
+    Ar = LzT.solve(Kzx * r);
+    // K̄zx = β (α rᵀ − W Kzx)
+    Kbar_zx = -beta * WK;
+    Kbar_zx.noalias() += (beta * alpha) * r.transpose();
+  }
+
+  // P16: variational parameters
+  g.m = beta * Ar - m_ / num_data;
+  MatX Linv_diag = MatX::Zero(M, M);
+  Linv_diag.diagonal() = L_.diagonal().cwiseInverse();
+  g.L = (-beta * (AAt * L_) - (L_ - Linv_diag) / num_data).triangularView<Eigen::Lower>();
+
+  // P17: ∂/∂Lz = tril(−K̄zx Aᵀ) = tril(−Lz⁻ᵀ Ā Aᵀ),  Ā Aᵀ = β (m (Ar)ᵀ − (S − I) A Aᵀ)
+  MatX AbarAt = -beta * (SmI * AAt);
+  AbarAt.noalias() += (beta * m_) * Ar.transpose();
+  const MatX Lzbar = (-LzT.transpose().solve(AbarAt)).triangularView<Eigen::Lower>();
+  // P18: Cholesky backward: K̄zz = ½ Lz⁻ᵀ (P + Pᵀ) Lz⁻¹, P = Φ(Lzᵀ L̄z)
+  const MatX P = phi(Lz.transpose() * Lzbar);
+  const MatX Ps = P + P.transpose();
+  MatX Kbar_zz = 0.5 * LzT.transpose().solve(LzT.transpose().solve(Ps).transpose());
+  Kbar_zz = 0.5 * (Kbar_zz + Kbar_zz.transpose()).eval();
+
+  // P19: kernel hyperparameters and inducing points
+  g.kernel = VecX::Zero(kernel_.numParams());
+  MatX gZ_zz = MatX::Zero(M, Z_.cols());
+  g.Z = MatX::Zero(M, Z_.cols());
+  kernel_.accumulateCrossGradient(Z_, Z_, Kbar_zz, zz_blocks, g.kernel, &gZ_zz);
+  kernel_.accumulateCrossGradient(Z_, X, Kbar_zx, zx_blocks, g.kernel, &g.Z);
+  g.Z += 2.0 * gZ_zz;
+  kernel_.accumulateDiagGradient(-0.5 * beta * Bd, g.kernel);  // k̄_n = −β/2 for every n
+  g.AAt = std::move(AAt);
+  g.Ar_centered = std::move(Ar);
+  return out;
+}
+
+SvgpPrediction Svgp::predict(const MatX& X) const { return predictor().predict(X); }
+
+SvgpPredictor Svgp::predictor() const { return SvgpPredictor(*this); }
+
+SvgpPredictor::SvgpPredictor(const Svgp& gp)
+    : kernel_(gp.kernel()),
+      Z_(gp.inducing()),
+      L_(gp.variationalCholesky()),
+      c_(gp.meanConstant()),
+      noise_(gp.noiseVariance()),
+      jitter_(gp.jitter()),
+      shift_(gp.inputShift()),
+      scale_(gp.inputScale()) {
+  MatX Kzz = kernel_.gram(Z_);
+  Kzz.diagonal().array() += jitter_;
+  Lz_ = choleskyOrThrow(Kzz, "SVGP Kzz");
+  alpha_ = Lz_.triangularView<Eigen::Lower>().transpose().solve(gp.variationalMean());
+  kdiag_ = kernel_.diagValue();
+}
+
+SvgpPrediction SvgpPredictor::predict(const MatX& X_raw) const {
+  MatX X = X_raw;
+  if (shift_.size() > 0) X = ((X.rowwise() - shift_.transpose()).array().rowwise() / scale_.transpose().array()).matrix();
+  const MatX Kzt = kernel_.cross(Z_, X);
+  const MatX A = Lz_.triangularView<Eigen::Lower>().solve(Kzt);  // P13: a = Lz⁻¹ k_Z(x)
+  const MatX LtA = L_.transpose().triangularView<Eigen::Upper>() * A;
+  SvgpPrediction p;
+  p.mean = (Kzt.transpose() * alpha_).array() + c_;  // c + aᵀm = c + k_Zᵀ Lz⁻ᵀ m
+  p.var_f = (LtA.colwise().squaredNorm() - A.colwise().squaredNorm()).transpose().array() + kdiag_ + jitter_;
+  p.var_y = p.var_f.array() + noise_;
+  return p;
+}
+
+void SvgpPredictor::predictOne(const Eigen::Ref<const RowVecX>& x_raw, double& mean, double& var_f) const {
+  RowVecX x = x_raw;
+  if (shift_.size() > 0) x = (x - shift_.transpose()).cwiseQuotient(scale_.transpose());
+  const VecX k = kernel_.cross(Z_, MatX(x)).col(0);
+  const VecX a = Lz_.triangularView<Eigen::Lower>().solve(k);
+  const VecX b = L_.transpose().triangularView<Eigen::Upper>() * a;
+  mean = c_ + k.dot(alpha_);
+  var_f = kdiag_ + jitter_ + b.squaredNorm() - a.squaredNorm();
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+
+nlohmann::json Svgp::toJson() const {
+  nlohmann::json j;
+  j["format"] = "uwbtdoa-svgp";
+  j["version"] = 1;
+  j["kernel"] = kernel_.toJson();
+  j["inducing_points"] = matToJson(Z_);
+  j["variational"] = {{"m", std::vector<double>(m_.data(), m_.data() + m_.size())}, {"L", matToJson(L_)}};
+  j["mean"] = {{"type", "constant"}, {"constant", c_}};
+  j["likelihood"] = {{"type", "gaussian"}, {"noise", noise_}};
+  j["jitter"] = jitter_;
+  j["input_transform"] = {{"shift", std::vector<double>(shift_.data(), shift_.data() + shift_.size())},
+                          {"scale", std::vector<double>(scale_.data(), scale_.data() + scale_.size())}};
+  return j;
+}
+
+Svgp Svgp::fromJson(const nlohmann::json& j) {
+  try {
+    if (!j.is_object()) throw std::invalid_argument("not a JSON object");
+    if (j.value("format", std::string()) != "uwbtdoa-svgp")
+      throw std::invalid_argument("\"format\" is not \"uwbtdoa-svgp\"");
+    const int version = j.at("version").get<int>();
+    if (version != 1) throw std::invalid_argument("unsupported SVGP model version " + std::to_string(version) + " (expected 1)");
+    Svgp gp(Kernel::fromJson(j.at("kernel")), matFromJson(j.at("inducing_points"), "inducing_points"),
+            j.at("jitter").get<double>());
+    const VecX m = vecFromJson(j.at("variational").at("m"));
+    const MatX L = matFromJson(j.at("variational").at("L"), "variational.L");
+    gp.setVariational(m, L);
+    gp.setMean(j.at("mean").at("constant").get<double>());
+    gp.setNoiseVariance(j.at("likelihood").at("noise").get<double>());
+    if (j.contains("input_transform")) {
+      gp.setInputTransform(vecFromJson(j.at("input_transform").at("shift")),
+                           vecFromJson(j.at("input_transform").at("scale")));
+      if (gp.shift_.size() != 0 && gp.shift_.size() != gp.Z_.cols())
+        throw std::invalid_argument("input_transform size does not match the inducing points");
+    }
+    if (!gp.Z_.allFinite() || !gp.m_.allFinite() || !gp.L_.allFinite())
+      throw std::invalid_argument("non-finite numbers in the model");
+    return gp;
+  } catch (const nlohmann::json::exception& e) {
+    throw std::invalid_argument(std::string("SVGP model JSON: ") + e.what());
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("SVGP model JSON: ") + e.what());
+  }
+}
+
+}  // namespace uwb::gp
