@@ -22,9 +22,9 @@ def _write_report_dir(out, rng):
     results = []
     for k, kernel in enumerate(KERNELS):
         for m in INDUCING:
-            imp = -5.0 - 4.0 * k - 8.0 * math.log10(m)
+            imp = 5.0 + 4.0 * k + 8.0 * math.log10(m)
             results.append({"kernel": kernel, "inducing": m, "rmse_uncorrected_m": 0.226,
-                            "rmse_corrected_m": 0.226 * (1 + imp / 100), "improvement_pct": imp,
+                            "rmse_corrected_m": 0.226 * (1 - imp / 100), "improvement_pct": imp,
                             "improvement_pct_min": imp - 1.5, "improvement_pct_max": imp + 1.0})
     (out / "results.json").write_text(json.dumps(results, indent=1))
 
@@ -95,8 +95,8 @@ def test_report_renders_every_figure_from_the_data_files(tmp_path):
 
 def test_report_without_optional_files_draws_fig5_only(tmp_path):
     (tmp_path / "results.json").write_text(json.dumps(
-        [{"kernel": "tdoa", "inducing": 30, "improvement_pct": -15.2, "improvement_pct_min": -16.0,
-          "improvement_pct_max": -14.0}]))
+        [{"kernel": "tdoa", "inducing": 30, "improvement_pct": 15.2, "improvement_pct_min": 14.0,
+          "improvement_pct_max": 16.0}]))
     written = plots.render_report(str(tmp_path))
     assert [os.path.basename(p) for p in written] == ["fig5_improvement.png"]
 

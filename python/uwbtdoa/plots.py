@@ -22,10 +22,10 @@ Data-file contract (written by ``uwbtdoa evaluate``; everything in SI units, ang
      "inducing": 30,                # number of inducing points M (integer)
      "rmse_uncorrected_m": 0.226,   # airborne RMSE without correction, mean over repeats and test flights
      "rmse_corrected_m": 0.192,     # airborne RMSE with correction, same averaging
-     "improvement_pct": -15.0,      # 100 * (rmse_corrected - rmse_uncorrected) / rmse_uncorrected,
-                                    #   mean over repeats and test flights; NEGATIVE = correction helps
-     "improvement_pct_min": -17.0,  # minimum over repeats (of the per-repeat mean over test flights)
-     "improvement_pct_max": -13.0}  # maximum over repeats
+     "improvement_pct": 15.0,       # 100 * (1 - rmse_corrected / rmse_uncorrected) from the means above;
+                                    #   POSITIVE = the correction reduces the error (paper: 15.25 %)
+     "improvement_pct_min": 13.0,   # minimum over repeats (of the per-repeat mean over test flights)
+     "improvement_pct_max": 17.0}   # maximum over repeats
     Only kernel, inducing, improvement_pct, improvement_pct_min and improvement_pct_max are needed by
     Fig. 5; other keys are ignored.
 
@@ -40,7 +40,7 @@ Data-file contract (written by ``uwbtdoa evaluate``; everything in SI units, ang
     t: time [s]; error_m: Euclidean position error |p_est - p_gt| [m].
     Rows are the samples that the RMSE is computed over (airborne only). Any number of configurations and
     repeats may be present (all rows of a configuration are pooled); decimate to <= ~50 Hz to keep the file
-    small. Fig. 6 is drawn for the configuration with the lowest improvement_pct in results.json that has
+    small. Fig. 6 is drawn for the configuration with the highest improvement_pct in results.json that has
     corrected rows (``fig6_error_distribution.png``) and, per kernel, for that kernel's best M
     (``fig6_error_distribution_<kernel>.png``).
 
@@ -119,11 +119,11 @@ def _rmse(x: np.ndarray) -> float:
 
 # --------------------------------------------------------------------------------------------- Fig. 5
 def fig5_improvement(results: Sequence[Mapping], path: str | None = None, title: str | None = None):
-    """Change of the airborne RMSE [%] against the number of inducing points, one line per kernel.
+    """Improvement of the airborne RMSE [%] against the number of inducing points, one line per kernel.
 
     ``results``: list of dicts with keys kernel, inducing, improvement_pct, improvement_pct_min,
     improvement_pct_max (the schema of results.json). The min/max spread over repeats is drawn as error bars
-    and a light band. Negative values mean the correction reduces the error.
+    and a light band. improvement_pct = 100 (1 − corrected/uncorrected): positive = the correction helps.
     """
     if not results:
         raise ValueError("fig5_improvement: no results")
@@ -144,8 +144,8 @@ def fig5_improvement(results: Sequence[Mapping], path: str | None = None, title:
         ax.fill_between(m, lo, hi, color=line[0].get_color(), alpha=0.15, linewidth=0)
     ax.axhline(0.0, color="0.4", linewidth=0.8, linestyle="--")
     ax.set_xlabel("number of inducing points M")
-    ax.set_ylabel("change of airborne RMSE with correction [%]\n(negative = better)")
-    ax.set_title(title or "Fig. 5: RMSE change vs. number of inducing points\n(mean over repeats and test flights; "
+    ax.set_ylabel("improvement of airborne RMSE [%]\n100·(1 − RMSE_corrected / RMSE_uncorrected)")
+    ax.set_title(title or "Fig. 5: RMSE improvement vs. number of inducing points\n(mean over repeats and test flights; "
                  "bars and band: min/max over repeats)", fontsize=10.5)
     all_m = sorted({int(r["inducing"]) for r in results})
     ax.set_xticks(all_m)
@@ -430,7 +430,7 @@ def render_report(out_dir: str, log=sys.stderr) -> list[str]:
         e = load_errors(errors_path)
         unc = e["error_m"][e["corrected"] == 0]
         configs = {(k, m) for k, m, c in zip(e["kernel"], e["inducing"], e["corrected"]) if c == 1}
-        ranked = sorted((float(r["improvement_pct"]), str(r["kernel"]), int(r["inducing"])) for r in results
+        ranked = sorted((-float(r["improvement_pct"]), str(r["kernel"]), int(r["inducing"])) for r in results
                         if (str(r["kernel"]), int(r["inducing"])) in configs)
         if not ranked:  # no results entry matches: take the configurations in file order
             ranked = [(0.0, k, m) for k, m in sorted(configs)]
