@@ -105,6 +105,10 @@ std::optional<InnovationStats> equalityRankOneInPlace(Eigen::Matrix<double, N, 1
   V.noalias() -= K * u.transpose();
   V.noalias() -= u * K.transpose();
   V.noalias() += (st.innovation_var_m2 * K) * K.transpose();
+  // Mirror the upper triangle so V stays exactly symmetric despite rounding (STYLE §6).
+  for (Eigen::Index j = 0; j < V.cols(); ++j) {
+    for (Eigen::Index i = j + 1; i < V.rows(); ++i) V(i, j) = V(j, i);
+  }
   return st;
 }
 
