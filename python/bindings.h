@@ -129,5 +129,6 @@ inline py::object requireKey(const py::dict& d, const char* key, const char* wha
 void bindCore(py::module_& m);
 void bindIo(py::module_& m);
 void bindModel(py::module_& m);
+void bindGp(py::module_& m);
 
 }  // namespace uwb::python

@@ -40,4 +40,5 @@ PYBIND11_MODULE(_uwbtdoa, m) {
   uwb::python::bindCore(m);
   uwb::python::bindIo(m);
   uwb::python::bindModel(m);
+  uwb::python::bindGp(m);
 }
