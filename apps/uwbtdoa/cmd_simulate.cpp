@@ -1,0 +1,255 @@
+/** @file cmd_simulate.cpp
+ *  @brief `uwbtdoa simulate`: writes a simulated Crazyflie flight (UTIL flight CSV) and its anchor survey.
+ *
+ *  uwbtdoa simulate [--trajectory zigzag|circle|circle-sine|figure8] [--duration S] [--seed N]
+ *                   [--anchors-preset paper|util-const1..4|util-pilot-0425|util-pilot-0426 | --anchors-file SURVEY]
+ *                   [--yaw-rate R] [--config params.json] --out FLIGHT.csv --survey-out SURVEY.txt [--json]
+ *  docs/math/simulation.md describes the model and every parameter the config file can set.
+ */
+#include <chrono>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+#include <variant>
+
+#include <fmt/format.h>
+
+#include "Command.h"
+#include "uwb/core/Error.h"
+#include "uwb/io/UtilCsv.h"
+#include "uwb/sim/FlightSimulator.h"
+#include "uwb/sim/ResidualStats.h"
+
+namespace {
+
+using uwb::sim::SimParams;
+using uwb::sim::TrajectoryParams;
+using Field = std::variant<double*, int*, bool*>;
+
+void applyObject(const nlohmann::json& j, const std::string& section, const std::map<std::string, Field>& fields) {
+  if (!j.is_object()) throw std::invalid_argument("config: '" + section + "' must be an object");
+  for (const auto& [key, value] : j.items()) {
+    const auto it = fields.find(key);
+    if (it == fields.end()) {
+      std::string known;
+      for (const auto& [name, _] : fields) known += (known.empty() ? "" : ", ") + name;
+      throw std::invalid_argument("config: unknown key '" + section + "." + key + "' (known: " + known + ")");
+    }
+    const std::string where = "config: '" + section + "." + key + "'";
+    if (auto* d = std::get_if<double*>(&it->second)) {
+      if (!value.is_number()) throw std::invalid_argument(where + " must be a number");
+      **d = value.get<double>();
+    } else if (auto* i = std::get_if<int*>(&it->second)) {
+      if (!value.is_number_integer()) throw std::invalid_argument(where + " must be an integer");
+      **i = value.get<int>();
+    } else if (auto* b = std::get_if<bool*>(&it->second)) {
+      if (!value.is_boolean()) throw std::invalid_argument(where + " must be true or false");
+      **b = value.get<bool>();
+    }
+  }
+}
+
+/// Reads params.json: {"trajectory": {...}, "imu": {...}, "pose": {...}, "tdoa": {...}, "bias": {...},
+/// "b_t_tag": [x, y, z]}; keys are the C++ field names. Unknown keys are errors (typos must not pass silently).
+void applyConfig(const std::string& path, SimParams* sp, TrajectoryParams* tp) {
+  std::ifstream in(path);
+  if (!in) throw uwb::FileError("cannot open config file " + path);
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw uwb::InputError(uwb::SourceLocation{path, 0, 0, ""}, std::string("invalid JSON: ") + e.what());
+  }
+  if (!j.is_object()) throw uwb::InputError(uwb::SourceLocation{path, 0, 0, ""}, "config must be a JSON object");
+  for (const auto& [key, value] : j.items()) {
+    if (key == "trajectory") {
+      applyObject(value, key,
+                  {{"ground_before_s", &tp->ground_before_s}, {"ground_after_s", &tp->ground_after_s},
+                   {"takeoff_s", &tp->takeoff_s}, {"landing_s", &tp->landing_s},
+                   {"speed_ramp_s", &tp->speed_ramp_s}, {"ground_z_m", &tp->ground_z_m},
+                   {"radius_m", &tp->radius_m}, {"height_m", &tp->height_m}, {"omega_rps", &tp->omega_rps},
+                   {"sine_amplitude_m", &tp->sine_amplitude_m}, {"sine_omega_ratio", &tp->sine_omega_ratio},
+                   {"figure8_half_length_m", &tp->figure8_half_length_m},
+                   {"figure8_half_width_m", &tp->figure8_half_width_m}, {"figure8_omega_rps", &tp->figure8_omega_rps},
+                   {"zigzag_half_x_m", &tp->zigzag_half_x_m}, {"zigzag_half_y_m", &tp->zigzag_half_y_m},
+                   {"zigzag_z_min_m", &tp->zigzag_z_min_m}, {"zigzag_z_max_m", &tp->zigzag_z_max_m},
+                   {"zigzag_speed_mps", &tp->zigzag_speed_mps}, {"zigzag_sweep_ratio", &tp->zigzag_sweep_ratio},
+                   {"yaw0_rad", &tp->yaw0_rad}, {"yaw_rate_rps", &tp->yaw_rate_rps},
+                   {"center_x_m", &tp->w_center_xy.x()}, {"center_y_m", &tp->w_center_xy.y()}});
+    } else if (key == "imu") {
+      auto& p = sp->imu;
+      applyObject(value, key,
+                  {{"rate_hz", &p.rate_hz}, {"acc_noise_std_mps2", &p.acc_noise_std_mps2},
+                   {"acc_bias_std_mps2", &p.acc_bias_std_mps2}, {"acc_bias_rw_mps2_sqrt_s", &p.acc_bias_rw_mps2_sqrt_s},
+                   {"gyro_noise_std_rps", &p.gyro_noise_std_rps}, {"gyro_bias_std_rps", &p.gyro_bias_std_rps},
+                   {"gyro_bias_rw_rps_sqrt_s", &p.gyro_bias_rw_rps_sqrt_s}});
+    } else if (key == "pose") {
+      auto& p = sp->pose;
+      applyObject(value, key,
+                  {{"rate_hz", &p.rate_hz}, {"position_quantum_m", &p.position_quantum_m},
+                   {"quat_quantum", &p.quat_quantum}});
+    } else if (key == "tdoa") {
+      auto& p = sp->tdoa;
+      applyObject(value, key, {{"rate_hz", &p.rate_hz}, {"jitter_fraction", &p.jitter_fraction}});
+    } else if (key == "bias") {
+      auto& p = sp->bias;
+      applyObject(value, key,
+                  {{"enabled", &p.enabled}, {"antenna_rms_m", &p.antenna_rms_m}, {"antenna_degree", &p.antenna_degree},
+                   {"anchor_pattern_rms_m", &p.anchor_pattern_rms_m}, {"anchor_offset_std_m", &p.anchor_offset_std_m},
+                   {"nlos_bias_m", &p.nlos_bias_m}, {"nlos_elevation_rad", &p.nlos_elevation_rad},
+                   {"nlos_width_rad", &p.nlos_width_rad}, {"nlos_azimuth_gain", &p.nlos_azimuth_gain},
+                   {"nlos_azimuth_rad", &p.nlos_azimuth_rad}, {"multipath_std_m", &p.multipath_std_m},
+                   {"multipath_length_m", &p.multipath_length_m}, {"multipath_features", &p.multipath_features},
+                   {"noise_std_m", &p.noise_std_m}, {"outlier_probability", &p.outlier_probability},
+                   {"outlier_scale_m", &p.outlier_scale_m}, {"outlier_dof", &p.outlier_dof},
+                   {"outlier_max_m", &p.outlier_max_m}, {"ground_effect", &p.ground_effect},
+                   {"ground_low_anchor_z_m", &p.ground_low_anchor_z_m}, {"ground_low_min_m", &p.ground_low_min_m},
+                   {"ground_low_max_m", &p.ground_low_max_m}, {"ground_high_abs_m", &p.ground_high_abs_m},
+                   {"ground_noise_std_m", &p.ground_noise_std_m},
+                   {"ground_blend_height_m", &p.ground_blend_height_m}});
+    } else if (key == "b_t_tag") {
+      if (!value.is_array() || value.size() != 3) throw std::invalid_argument("config: 'b_t_tag' must be [x, y, z]");
+      for (int i = 0; i < 3; ++i) sp->b_t_tag[i] = value.at(static_cast<std::size_t>(i)).get<double>();
+    } else {
+      throw std::invalid_argument("config: unknown section '" + key +
+                                  "' (known: trajectory, imu, pose, tdoa, bias, b_t_tag)");
+    }
+  }
+}
+
+struct Options {
+  std::string trajectory = "circle";
+  double duration_s = 60.0;
+  std::uint64_t seed = 1;
+  std::string anchors_preset = "paper";
+  std::string anchors_file;
+  double yaw_rate_rps = 0.5;
+  std::string config;
+  std::string out = "sim-flight.csv";
+  std::string survey_out = "sim-survey.txt";
+  bool json = false;
+};
+
+double rate(std::size_t n, double span_s) { return span_s > 0.0 && n > 1 ? static_cast<double>(n - 1) / span_s : 0.0; }
+
+template <class S>
+double spanOf(const S& stream) {
+  return stream.size() > 1 ? stream.back().t_s - stream.front().t_s : 0.0;
+}
+
+void run(const Options& o, CLI::App& sub) {
+  const auto t_start = std::chrono::steady_clock::now();
+  SimParams params;
+  uwb::sim::Scenario scenario;
+  scenario.survey = !o.anchors_file.empty() ? uwb::readAnchorSurvey(o.anchors_file)
+                                            : uwb::sim::anchorPreset(o.anchors_preset, uwb::app::defaultDataDir());
+  scenario.trajectory.shape = uwb::sim::parseTrajectoryShape(o.trajectory);
+  scenario.trajectory.duration_s = o.duration_s;
+  uwb::sim::fitTrajectoryToAnchors(scenario.survey, &scenario.trajectory);
+  scenario.trajectory.yaw_rate_rps = o.yaw_rate_rps;
+  if (!o.config.empty()) applyConfig(o.config, &params, &scenario.trajectory);
+  if (sub.count("--yaw-rate") > 0) scenario.trajectory.yaw_rate_rps = o.yaw_rate_rps;  // the flag wins
+  scenario.trajectory.yaw_mode = scenario.trajectory.yaw_rate_rps == 0.0 ? uwb::sim::YawMode::kConstant
+                                                                          : uwb::sim::YawMode::kConstantRate;
+
+  const uwb::sim::SimResult result = uwb::sim::simulateFlight(scenario, params, o.seed);
+  const auto t_sim = std::chrono::steady_clock::now();
+  uwb::writeFlightCsv(result.flight, o.out);
+  uwb::writeAnchorSurvey(result.survey, o.survey_out);
+  const auto t_end = std::chrono::steady_clock::now();
+
+  const uwb::Flight& f = result.flight;
+  const auto air = uwb::sim::residualStats(f, result.survey, uwb::sim::Phase::kAirborne);
+  const auto ground = uwb::sim::residualStats(f, result.survey, uwb::sim::Phase::kGround);
+  std::size_t n_airborne_pose = 0;
+  for (const auto& p : f.pose) n_airborne_pose += p.w_p_b.z() >= 0.3 ? 1 : 0;
+  std::size_t n_outliers = 0;
+  for (const auto& t : result.tdoa_truth) n_outliers += t.error.outlier_m != 0.0 ? 1 : 0;
+  const double ground_fraction =
+      f.pose.empty() ? 0.0 : 1.0 - static_cast<double>(n_airborne_pose) / static_cast<double>(f.pose.size());
+  const double sim_s = std::chrono::duration<double>(t_sim - t_start).count();
+  const double total_s = std::chrono::duration<double>(t_end - t_start).count();
+
+  if (o.json) {
+    nlohmann::json j;
+    j["flight"] = o.out;
+    j["survey"] = o.survey_out;
+    j["trajectory"] = o.trajectory;
+    j["seed"] = o.seed;
+    j["duration_s"] = o.duration_s;
+    j["anchors"] = result.survey.anchors.size();
+    j["anchors_source"] = result.survey.source;
+    j["yaw_rate_rps"] = scenario.trajectory.yaw_rate_rps;
+    j["streams"] = {
+        {"tdoa", {{"count", f.tdoa.size()}, {"rate_hz", rate(f.tdoa.size(), spanOf(f.tdoa))}}},
+        {"acc", {{"count", f.acc.size()}, {"rate_hz", rate(f.acc.size(), spanOf(f.acc))}}},
+        {"gyro", {{"count", f.gyro.size()}, {"rate_hz", rate(f.gyro.size(), spanOf(f.gyro))}}},
+        {"pose", {{"count", f.pose.size()}, {"rate_hz", rate(f.pose.size(), spanOf(f.pose))}}}};
+    j["ground_fraction"] = ground_fraction;
+    j["outliers"] = n_outliers;
+    nlohmann::json pairs = nlohmann::json::array();
+    for (const auto& [pair, ps] : air.pairs) {
+      pairs.push_back({{"id_a", pair.first}, {"id_b", pair.second}, {"count", ps.count}, {"median_m", ps.median_m},
+                       {"std_m", ps.std_m}});
+    }
+    nlohmann::json ac = nlohmann::json::object();
+    for (const auto& [lag, value] : air.autocorrelation) ac[fmt::format("{:g}s", lag)] = value;
+    j["residual_airborne"] = {{"count", air.count},         {"median_m", air.median_m},
+                              {"mean_abs_dev_m", air.mean_abs_dev_m}, {"std_m", air.std_m},
+                              {"outlier_fraction", air.outlier_fraction}, {"autocorrelation", ac},
+                              {"pairs", pairs}};
+    j["residual_ground"] = {{"count", ground.count}, {"median_m", ground.median_m},
+                            {"mean_abs_dev_m", ground.mean_abs_dev_m}};
+    j["time_simulate_s"] = sim_s;
+    j["time_total_s"] = total_s;
+    std::cout << j.dump() << '\n';
+    return;
+  }
+  std::cout << fmt::format("simulated {} flight, {:.1f} s, seed {}, {} anchors ({}), yaw rate {:g} rad/s\n",
+                           o.trajectory, o.duration_s, o.seed, result.survey.anchors.size(), result.survey.source,
+                           scenario.trajectory.yaw_rate_rps);
+  std::cout << fmt::format("  tdoa {:>7} ({:.0f} Hz)   acc/gyro {:>7} ({:.0f} Hz)   pose {:>7} ({:.0f} Hz)\n",
+                           f.tdoa.size(), rate(f.tdoa.size(), spanOf(f.tdoa)), f.acc.size(),
+                           rate(f.acc.size(), spanOf(f.acc)), f.pose.size(), rate(f.pose.size(), spanOf(f.pose)));
+  std::cout << fmt::format("  on the ground (z < 0.3 m): {:.0f} % of pose samples; outliers: {}\n",
+                           100.0 * ground_fraction, n_outliers);
+  std::cout << fmt::format("  airborne TDoA residual: median {:+.3f} m, mean abs dev {:.3f} m, std {:.3f} m\n",
+                           air.median_m, air.mean_abs_dev_m, air.std_m);
+  std::string pair_text;
+  for (const auto& [pair, ps] : air.pairs) pair_text += fmt::format(" {}-{}:{:+.3f}", pair.first, pair.second, ps.median_m);
+  std::cout << "  per-pair medians [m]:" << pair_text << '\n';
+  std::string ac_text;
+  for (const auto& [lag, value] : air.autocorrelation) ac_text += fmt::format(" {:g}s:{:.2f}", lag, value);
+  std::cout << "  autocorrelation:" << ac_text << '\n';
+  std::cout << fmt::format("  ground TDoA residual: mean abs dev {:.2f} m\n", ground.mean_abs_dev_m);
+  std::cout << fmt::format("wrote {} and {} ({:.2f} s, simulation {:.2f} s)\n", o.out, o.survey_out, total_s, sim_s);
+}
+
+void setup(CLI::App& sub) {
+  auto o = std::make_shared<Options>();
+  sub.add_option("--trajectory", o->trajectory, "zigzag | circle | circle-sine | figure8")
+      ->check(CLI::IsMember({"zigzag", "circle", "circle-sine", "figure8"}))
+      ->capture_default_str();
+  sub.add_option("--duration", o->duration_s, "Flight duration including ground phases [s]")->capture_default_str();
+  sub.add_option("--seed", o->seed, "Random seed (same seed, same flight)")->capture_default_str();
+  auto* preset = sub.add_option("--anchors-preset", o->anchors_preset,
+                                "paper | util-const1..4 | util-pilot-0425 | util-pilot-0426")
+                     ->capture_default_str();
+  auto* file = sub.add_option("--anchors-file", o->anchors_file, "Anchor survey in the UTIL format");
+  preset->excludes(file);
+  sub.add_option("--yaw-rate", o->yaw_rate_rps, "Yaw rate while flying [rad/s]; 0 = constant yaw")
+      ->capture_default_str();
+  sub.add_option("--config", o->config, "JSON file with parameter overrides (see docs/math/simulation.md)");
+  sub.add_option("--out", o->out, "Flight CSV to write (UTIL layout)")->capture_default_str();
+  sub.add_option("--survey-out", o->survey_out, "Anchor survey to write")->capture_default_str();
+  sub.add_flag("--json", o->json, "Print one JSON object instead of text");
+  sub.callback([o, &sub] { run(*o, sub); });
+}
+
+const bool kRegistered = uwb::app::registerCommand(
+    {"simulate", "Simulate a Crazyflie flight (IMU, Vicon pose, TDoA2) with a realistic TDoA bias", setup});
+
+}  // namespace

@@ -1,0 +1,147 @@
+/** @file FlightSimulator.cpp
+ *  @brief IMU, pose and TDoA2 streams of one simulated flight: docs/math/simulation.md (S9)–(S20).
+ */
+#include "uwb/sim/FlightSimulator.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+#include "uwb/model/TdoaModel.h"
+#include "uwb/sim/Kinematics.h"
+
+namespace uwb::sim {
+
+namespace {
+
+double quantize(double v, double q) { return q > 0.0 ? std::round(v / q) * q : v; }
+
+/// Independent random streams derived from one seed, so that e.g. disabling outliers leaves the IMU noise alone.
+struct Streams {
+  std::mt19937_64 bias_field;
+  std::mt19937_64 imu;
+  std::mt19937_64 schedule;
+  std::mt19937_64 tdoa_error;
+};
+
+Streams makeStreams(std::uint64_t seed) {
+  std::seed_seq seq{static_cast<std::uint32_t>(seed & 0xffffffffu), static_cast<std::uint32_t>(seed >> 32),
+                    0x75776274u /* "uwbt" */};
+  std::array<std::uint32_t, 8> w{};
+  seq.generate(w.begin(), w.end());
+  const auto word = [&](std::size_t i) { return (static_cast<std::uint64_t>(w[2 * i]) << 32) | w[2 * i + 1]; };
+  return Streams{std::mt19937_64(word(0)), std::mt19937_64(word(1)), std::mt19937_64(word(2)),
+                 std::mt19937_64(word(3))};
+}
+
+}  // namespace
+
+const std::vector<std::string>& utilFlightColumns() {
+  static const std::vector<std::string> kColumns = {
+      "t_tdoa", "idA",    "idB",    "tdoa_meas", "t_acc",  "acc_x",  "acc_y",  "acc_z",   "t_gyro",
+      "gyro_x", "gyro_y", "gyro_z", "t_tof",     "tof",    "t_flow", "deltaX", "deltaY",  "t_baro",
+      "baro",   "t_pose", "pose_x", "pose_y",    "pose_z", "pose_qx", "pose_qy", "pose_qz", "pose_qw"};
+  return kColumns;
+}
+
+SimResult simulateFlight(const Scenario& scenario, const SimParams& params, std::uint64_t seed) {
+  params.validate();
+  const Trajectory trajectory(scenario.trajectory);  // validates the trajectory params
+  AnchorSurvey survey = scenario.survey;
+  std::sort(survey.anchors.begin(), survey.anchors.end(), [](const Anchor& a, const Anchor& b) { return a.id < b.id; });
+  if (survey.anchors.size() < 2) throw std::invalid_argument("simulateFlight: the survey needs at least 2 anchors");
+
+  Streams rng = makeStreams(seed);
+  const BiasModel bias(params.bias, survey, rng.bias_field);
+  const double duration = trajectory.duration_s();
+  const double ground_z = scenario.trajectory.ground_z_m;
+
+  SimResult out;
+  out.survey = survey;
+  Flight& flight = out.flight;
+  flight.pose_has_orientation = true;
+  flight.source = "simulated " + toString(scenario.trajectory.shape) + " (seed " + std::to_string(seed) + ")";
+  if (params.write_full_util_header) flight.columns = utilFlightColumns();
+
+  // --- IMU (S10), (S11): truth + bias (turn-on + random walk) + white noise.
+  {
+    const ImuParams& ip = params.imu;
+    const double dt = 1.0 / ip.rate_hz;
+    const auto n = static_cast<std::size_t>(std::floor(duration * ip.rate_hz)) + 1;
+    std::normal_distribution<double> normal(0.0, 1.0);
+    const auto randn3 = [&] { return Vec3(normal(rng.imu), normal(rng.imu), normal(rng.imu)); };
+    Vec3 b_acc = ip.acc_bias_std_mps2 * randn3();
+    Vec3 b_gyro = ip.gyro_bias_std_rps * randn3();
+    const double acc_rw = ip.acc_bias_rw_mps2_sqrt_s * std::sqrt(dt);
+    const double gyro_rw = ip.gyro_bias_rw_rps_sqrt_s * std::sqrt(dt);
+    flight.acc.reserve(n);
+    flight.gyro.reserve(n);
+    out.imu_truth.reserve(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double t = static_cast<double>(k) * dt;
+      const KinematicState s = kinematicState(trajectory, t);
+      const Vec3 acc_noise = ip.acc_noise_std_mps2 * randn3();
+      const Vec3 gyro_noise = ip.gyro_noise_std_rps * randn3();
+      flight.acc.push_back({t, s.b_specific_force + b_acc + acc_noise});
+      flight.gyro.push_back({t, s.b_omega + b_gyro + gyro_noise});
+      out.imu_truth.push_back({s.b_specific_force, s.b_omega, b_acc, b_gyro});
+      b_acc += acc_rw * randn3();
+      b_gyro += gyro_rw * randn3();
+    }
+  }
+
+  // --- Ground-truth pose (Vicon-like), optionally quantized.
+  {
+    const PoseParams& pp = params.pose;
+    const auto n = static_cast<std::size_t>(std::floor(duration * pp.rate_hz)) + 1;
+    flight.pose.reserve(n);
+    out.pose_exact.reserve(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double t = static_cast<double>(k) / pp.rate_hz;
+      const KinematicState s = kinematicState(trajectory, t);
+      out.pose_exact.push_back({t, s.w_p, s.w_q_b});
+      PoseSample q{t, s.w_p, s.w_q_b};
+      for (int i = 0; i < 3; ++i) q.w_p_b[i] = quantize(q.w_p_b[i], pp.position_quantum_m);
+      if (pp.quat_quantum > 0.0) {
+        for (int i = 0; i < 4; ++i) q.w_q_b.coeffs()[i] = quantize(q.w_q_b.coeffs()[i], pp.quat_quantum);
+        q.w_q_b.normalize();
+      }
+      flight.pose.push_back(q);
+    }
+  }
+
+  // --- TDoA2 (S19), (S20): neighbour pairs in round robin at a jittered rate.
+  {
+    const TdoaScheduleParams& tp = params.tdoa;
+    const double dt = 1.0 / tp.rate_hz;
+    std::uniform_real_distribution<double> jitter(-tp.jitter_fraction, tp.jitter_fraction);
+    std::uniform_real_distribution<double> phase(0.0, 1.0);
+    const std::size_t n_anchors = survey.anchors.size();  // sorted by id above
+    const auto n_expected = static_cast<std::size_t>(duration * tp.rate_hz * 1.05) + 16;
+    flight.tdoa.reserve(n_expected);
+    out.tdoa_truth.reserve(n_expected);
+    std::size_t slot = static_cast<std::size_t>(phase(rng.schedule) * static_cast<double>(n_anchors)) % n_anchors;
+    double t = dt * phase(rng.schedule);
+    while (t <= duration) {
+      const Anchor& anchor_a = survey.anchors[slot];
+      const Anchor& anchor_b = survey.anchors[(slot + 1) % n_anchors];
+      const KinematicState s = kinematicState(trajectory, t);
+      const Vec3 w_p_tag = tagPosition(s.w_p, s.w_q_b, params.b_t_tag);
+      TdoaTruth truth;
+      truth.tdoa_true_m = range(w_p_tag, anchor_b.w_p) - range(w_p_tag, anchor_a.w_p);  // (S20)
+      truth.error = bias.sample(anchor_a.id, anchor_b.id, w_p_tag, s.w_q_b, s.w_p.z() - ground_z, rng.tdoa_error);
+      truth.on_ground = s.on_ground;
+      truth.airborne = s.w_p.z() >= 0.3;
+      flight.tdoa.push_back({t, anchor_a.id, anchor_b.id, truth.tdoa_true_m + truth.error.total()});
+      out.tdoa_truth.push_back(truth);
+      slot = (slot + 1) % n_anchors;
+      t += dt * (1.0 + jitter(rng.schedule));
+    }
+  }
+  return out;
+}
+
+}  // namespace uwb::sim
