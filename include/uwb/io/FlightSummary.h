@@ -1,0 +1,106 @@
+/** @file FlightSummary.h
+ *  @brief What a user wants to know first about a flight: streams, TDoA pairs, reader notes, pose glitches and the
+ *  TDoA residual against ground truth. Computed here; `uwbtdoa inspect` only formats it (docs/io.md, "inspect").
+ */
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "uwb/io/AnchorSurvey.h"
+#include "uwb/io/Flight.h"
+#include "uwb/io/PoseTrack.h"
+#include "uwb/io/UtilCsv.h"
+
+namespace uwb {
+
+/// Count, time span and mean rate of one stream.
+struct StreamSummary {
+  Stream stream = Stream::kTdoa;
+  std::string name;      ///< streamName(stream)
+  bool present = false;  ///< its columns were in the file (or it holds samples)
+  std::size_t count = 0;
+  double t_first_s = 0.0;
+  double t_last_s = 0.0;
+  double rate_hz = 0.0;  ///< (count − 1) / (t_last − t_first); 0 with fewer than 2 samples
+};
+
+/// Residuals farther than this from their median are gross errors for ResidualStats::mad_m [m].
+inline constexpr double kGrossResidual_m = 1.0;
+
+/// Statistics of a set of residuals r_k [m]. The median and `mad_m` reproduce util-pilot/MANIFEST.csv
+/// (resid_median_m, resid_mad_m; checked on all 17 flights to ≤ 0.001 m, docs/io.md "Residual statistics").
+struct ResidualStats {
+  std::size_t n = 0;
+  double median_m = 0.0;  ///< median of all r_k
+  /// Mean absolute deviation from the median over the residuals within kGrossResidual_m of it:
+  /// mean_{k: |r_k − median| < 1 m} |r_k − median|. The MANIFEST's "mad" (gross errors, e.g. the ground phase
+  /// or TDoA3 outliers, would otherwise dominate it).
+  double mad_m = 0.0;
+  std::size_t n_gross = 0;           ///< residuals excluded from mad_m (|r − median| ≥ kGrossResidual_m)
+  double mean_abs_dev_m = 0.0;       ///< mean_k |r_k − median| over all residuals
+  double median_abs_dev_m = 0.0;     ///< median_k |r_k − median| (the robust-statistics MAD, unscaled)
+  double mean_m = 0.0;
+  double rms_m = 0.0;
+};
+
+/// Statistics of `values` (empty → all zero, n = 0).
+ResidualStats residualStats(std::vector<double> values, double gross_residual_m = kGrossResidual_m);
+
+/// Residual statistics split by flight phase (airborne: ground-truth z > airborne_min_z_m).
+struct PhaseResiduals {
+  ResidualStats all;
+  ResidualStats airborne;
+  ResidualStats ground;
+};
+
+/// One ordered anchor pair (id_a, id_b) of the TDoA stream.
+struct PairSummary {
+  int id_a = 0;
+  int id_b = 0;
+  std::size_t count = 0;
+  bool neighbour = false;  ///< id_b follows id_a cyclically in the sorted anchor ids (UTIL TDoA2: (0,1)…(7,0))
+  PhaseResiduals residual;  ///< empty (n = 0) without ground truth or survey
+};
+
+struct FlightSummary {
+  std::string source;
+  double t_start_s = 0.0;
+  double t_end_s = 0.0;
+  double duration_s = 0.0;
+  std::vector<StreamSummary> streams;  ///< every stream, in UTIL column order (absent ones with present = false)
+  std::vector<PairSummary> pairs;      ///< sorted by (id_a, id_b)
+  std::size_t n_tdoa = 0;
+  double neighbour_pair_fraction = 0.0;  ///< share of TDoA measurements on neighbour pairs
+  std::vector<std::string> notes;        ///< reader notes (ReadReport) and summary remarks
+
+  // Ground truth (only when the flight has a pose stream).
+  bool has_ground_truth = false;
+  bool pose_has_orientation = false;
+  std::size_t n_pose_glitches_attitude = 0;
+  std::size_t n_pose_glitches_position = 0;
+  std::vector<PoseGlitch> pose_glitches;
+  double airborne_fraction_pose = 0.0;  ///< share of accepted pose samples with z > airborne_min_z_m
+
+  // Residuals (only with ground truth and a survey).
+  bool has_residuals = false;
+  TdoaResidualReport residual_report;
+  PhaseResiduals residual;            ///< all pairs
+  PhaseResiduals residual_neighbour;  ///< neighbour pairs only
+};
+
+struct FlightSummaryParams {
+  PoseTrackParams pose_track;
+  TdoaResidualParams residual;
+};
+
+/// Summarises a flight. `survey` (may be null) enables the residuals and the neighbour definition (without it,
+/// neighbours are taken over ids 0..max id seen); `read_report` (may be null) contributes its notes.
+FlightSummary summarizeFlight(const Flight& flight, const AnchorSurvey* survey, const ReadReport* read_report = nullptr,
+                              const FlightSummaryParams& params = {});
+
+/// True when id_b follows id_a cyclically in the sorted list `ids` (e.g. (0,1), …, (7,0) for ids 0–7).
+bool isNeighbourPair(int id_a, int id_b, const std::vector<int>& sorted_ids);
+
+}  // namespace uwb

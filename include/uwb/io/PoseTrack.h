@@ -1,0 +1,124 @@
+/** @file PoseTrack.h
+ *  @brief Ground-truth pose track of a flight (Vicon pose logged on board) and TDoA residuals against it.
+ *
+ *  - PoseTrack: the flight's pose samples minus detected glitches; interpolation at any time t (linear in position,
+ *    slerp in attitude), nullopt outside the track or across a gap longer than PoseTrackParams::max_gap_s.
+ *  - Glitches (util-pilot SOURCE.md, "Caveats"): Vicon occasionally reports a flipped attitude (roll ≈ ±170°) for
+ *    one or a few samples, and single-sample position spikes up to 0.23 m. They are detected, counted, reported
+ *    and excluded from interpolation (docs/io.md, "Ground truth").
+ *  - tdoaResiduals: r = tdoa_meas − h(p_gt), with h the TDoA model of model/TdoaModel.h (paper eq. 1–2,
+ *    docs/math/measurement.md M1–M2) and the tag lever arm b_t_tag. For position-only tracks (util-final-extract)
+ *    the lever arm is added in the world frame (identity attitude), as that data's SOURCE.md prescribes.
+ *
+ *  Used by: `uwbtdoa inspect` (io/FlightSummary.h), GP training-data extraction and evaluation.
+ */
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "uwb/core/Types.h"
+#include "uwb/io/AnchorSurvey.h"
+#include "uwb/io/Flight.h"
+
+namespace uwb {
+
+/// Glitch detection and interpolation settings. Defaults fit the UTIL pilot logs (200–300 Hz Vicon).
+struct PoseTrackParams {
+  /// Longest interval between two accepted samples that is interpolated across [s].
+  double max_gap_s = 0.05;
+  /// Attitude glitch: angle between a sample and the last accepted attitude above
+  /// max_attitude_jump_rad + max_angular_rate_radps · Δt.
+  double max_attitude_jump_rad = 0.35;
+  double max_angular_rate_radps = 10.0;
+  /// A run of rejected attitudes that lasts longer than this is accepted as real motion (re-anchoring) [s].
+  double max_glitch_run_s = 0.1;
+  /// Position spike: a sample farther than this from the chord of its two neighbours (linear interpolation at
+  /// its time) AND farther from that chord than the neighbours are from each other [m].
+  double max_position_jump_m = 0.02;
+
+  /// Throws std::invalid_argument naming the offending field.
+  void validate() const;
+};
+
+enum class PoseGlitchKind { kAttitude, kPosition };
+
+/// One rejected pose sample.
+struct PoseGlitch {
+  std::size_t index = 0;  ///< index into the input pose vector (Flight::pose)
+  double t_s = 0.0;
+  PoseGlitchKind kind = PoseGlitchKind::kAttitude;
+  double magnitude = 0.0;  ///< attitude: angle to the reference [rad]; position: distance to the chord [m]
+};
+
+/// Ground truth as a function of time. Immutable after construction; cheap to query (binary search).
+class PoseTrack {
+ public:
+  PoseTrack() = default;
+  /// Builds the track from samples sorted by time (as Flight::pose is). has_orientation = false: position only,
+  /// interpolated attitudes are identity and no attitude glitches are detected.
+  PoseTrack(const std::vector<PoseSample>& samples, bool has_orientation, const PoseTrackParams& params = {});
+  /// The flight's pose stream (uses flight.pose_has_orientation).
+  explicit PoseTrack(const Flight& flight, const PoseTrackParams& params = {});
+
+  /// Pose at time t_s: linear position, slerp attitude between the two accepted samples around t_s.
+  /// nullopt when the track is empty, t_s is outside [startTime, endTime], or the bracketing samples are more than
+  /// max_gap_s apart. The returned quaternion is unit norm.
+  std::optional<PoseSample> interpolate(double t_s) const;
+
+  bool empty() const { return samples_.empty(); }
+  bool hasOrientation() const { return has_orientation_; }
+  double startTime() const;  ///< first accepted sample [s]; 0 when empty
+  double endTime() const;    ///< last accepted sample [s]; 0 when empty
+  /// Accepted samples (quaternions normalised), sorted by time.
+  const std::vector<PoseSample>& samples() const { return samples_; }
+  /// Rejected samples, by input index.
+  const std::vector<PoseGlitch>& glitches() const { return glitches_; }
+  std::size_t countGlitches(PoseGlitchKind kind) const;
+  /// Number of input samples.
+  std::size_t inputSize() const { return n_input_; }
+  const PoseTrackParams& params() const { return params_; }
+
+ private:
+  PoseTrackParams params_;
+  bool has_orientation_ = false;
+  std::vector<PoseSample> samples_;
+  std::vector<PoseGlitch> glitches_;
+  std::size_t n_input_ = 0;
+};
+
+/// Settings of the residual computation.
+struct TdoaResidualParams {
+  Vec3 b_t_tag = kUtilTagOffset_b;  ///< tag (antenna) offset in the body frame [m]
+  double airborne_min_z_m = 0.3;    ///< airborne when the ground-truth body z is above this [m]
+};
+
+/// One TDoA measurement compared with the ground truth.
+struct TdoaResidual {
+  std::size_t index = 0;  ///< index into Flight::tdoa
+  double t_s = 0.0;
+  int id_a = 0;
+  int id_b = 0;
+  double measured_m = 0.0;   ///< tdoa_meas
+  double predicted_m = 0.0;  ///< |p_tag − a_B| − |p_tag − a_A| at the ground truth
+  double residual_m = 0.0;   ///< measured_m − predicted_m (the measurement bias + noise the GP learns)
+  Vec3 w_p_b = Vec3::Zero();      ///< interpolated ground-truth body position [m]
+  Quat w_q_b = Quat::Identity();  ///< interpolated ground-truth attitude (identity for position-only tracks)
+  bool airborne = false;          ///< w_p_b.z() > airborne_min_z_m
+};
+
+/// What tdoaResiduals could not compare (nothing is dropped silently).
+struct TdoaResidualReport {
+  std::size_t n_measurements = 0;     ///< flight.tdoa.size()
+  std::size_t n_residuals = 0;        ///< returned
+  std::size_t n_no_ground_truth = 0;  ///< outside the pose track or in a gap > max_gap_s
+  std::size_t n_unknown_anchor = 0;   ///< an anchor id missing from the survey
+};
+
+/// Residual of every TDoA measurement that has ground truth, in measurement order. See the file comment.
+std::vector<TdoaResidual> tdoaResiduals(const Flight& flight, const AnchorSurvey& survey, const PoseTrack& track,
+                                        const TdoaResidualParams& params = {}, TdoaResidualReport* report = nullptr);
+
+}  // namespace uwb

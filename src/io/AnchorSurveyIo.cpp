@@ -1,0 +1,145 @@
+/** @file AnchorSurveyIo.cpp
+ *  @brief UTIL anchor survey text: `an{i}_p,x,y,z` [m] lines and `an{i}_quat,qx,qy,qz,qw` lines (docs/io.md).
+ */
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cstring>
+#include <map>
+
+#include "CsvDetail.h"
+#include "uwb/io/UtilCsv.h"
+
+namespace uwb {
+
+AnchorSurvey readAnchorSurvey(const std::string& path) {
+  const std::string text = io_detail::readWholeFile(path, "anchor survey");
+  struct Entry {
+    Anchor anchor;
+    std::size_t p_line = 0;
+    std::size_t q_line = 0;
+  };
+  std::map<int, Entry> entries;
+  const auto fail = [&](std::size_t line, std::size_t column, const std::string& field, const std::string& msg) {
+    throw InputError(SourceLocation{path, line, column, field}, msg);
+  };
+
+  const char* p = text.data();
+  const char* const end = p + text.size();
+  if (text.size() >= 3 && std::memcmp(p, "\xEF\xBB\xBF", 3) == 0) p += 3;
+  std::size_t line = 0;
+  while (p < end) {
+    const char* b = p;
+    const void* nl = std::memchr(p, '\n', static_cast<std::size_t>(end - p));
+    const char* e = nl != nullptr ? static_cast<const char*>(nl) : end;
+    p = nl != nullptr ? e + 1 : end;
+    ++line;
+    if (e > b && e[-1] == '\r') --e;
+    io_detail::trim(b, e);
+    if (b == e || *b == '#') continue;  // blank lines and comments
+
+    std::vector<std::string_view> cells;
+    for (const char* c = b;;) {
+      const char* comma = static_cast<const char*>(std::memchr(c, ',', static_cast<std::size_t>(e - c)));
+      const char* ce = comma != nullptr ? comma : e;
+      const char* tb = c;
+      const char* te = ce;
+      io_detail::trim(tb, te);
+      cells.emplace_back(tb, static_cast<std::size_t>(te - tb));
+      if (comma == nullptr) break;
+      c = comma + 1;
+    }
+    const std::string_view label = cells[0];
+    // Label: an<id>_p or an<id>_quat
+    int id = 0;
+    bool is_quat = false;
+    {
+      const std::size_t us = label.rfind('_');
+      if (label.size() < 4 || label.substr(0, 2) != "an" || us == std::string_view::npos || us <= 2) {
+        fail(line, 1, "", fmt::format("malformed survey line: expected 'an<id>_p' or 'an<id>_quat', got '{}'", label));
+      }
+      const std::string_view id_text = label.substr(2, us - 2);
+      const auto [ptr, ec] = std::from_chars(id_text.data(), id_text.data() + id_text.size(), id);
+      if (ec != std::errc() || ptr != id_text.data() + id_text.size()) {
+        fail(line, 1, "", fmt::format("malformed anchor id in '{}'", label));
+      }
+      const std::string_view kind = label.substr(us + 1);
+      if (kind == "p") {
+        is_quat = false;
+      } else if (kind == "quat") {
+        is_quat = true;
+      } else {
+        fail(line, 1, "", fmt::format("malformed survey line: unknown kind '{}' in '{}' (expected _p or _quat)", kind,
+                                      label));
+      }
+    }
+    const std::size_t n_expected = is_quat ? 5 : 4;
+    if (cells.size() != n_expected) {
+      fail(line, std::min(cells.size(), n_expected) + 1, std::string(label),
+           fmt::format("'{}' needs {} numbers, found {}", label, n_expected - 1, cells.size() - 1));
+    }
+    double v[4];
+    for (std::size_t k = 1; k < n_expected; ++k) {
+      const auto st = io_detail::parseDouble(cells[k].data(), cells[k].data() + cells[k].size(), v[k - 1]);
+      if (st != io_detail::NumberStatus::kOk) {
+        fail(line, k + 1, std::string(label), fmt::format("{}: '{}'", io_detail::describe(st), cells[k]));
+      }
+    }
+    Entry& entry = entries[id];
+    entry.anchor.id = id;
+    if (!is_quat) {
+      if (entry.p_line != 0) {
+        fail(line, 1, std::string(label),
+             fmt::format("duplicate anchor id {}: position already given on line {}", id, entry.p_line));
+      }
+      entry.p_line = line;
+      entry.anchor.w_p = Vec3(v[0], v[1], v[2]);
+    } else {
+      if (entry.q_line != 0) {
+        fail(line, 1, std::string(label),
+             fmt::format("duplicate anchor id {}: orientation already given on line {}", id, entry.q_line));
+      }
+      entry.q_line = line;
+      entry.anchor.w_q = Quat(v[3], v[0], v[1], v[2]);
+    }
+  }
+  AnchorSurvey survey;
+  survey.source = path;
+  for (const auto& [id, entry] : entries) {
+    if (entry.p_line == 0) {
+      fail(entry.q_line, 1, fmt::format("an{}_quat", id),
+           fmt::format("missing position: anchor {} has an orientation but no 'an{}_p' line", id, id));
+    }
+    survey.anchors.push_back(entry.anchor);  // std::map: sorted by id
+  }
+  if (survey.anchors.empty()) fail(line == 0 ? 1 : line, 0, "", "survey holds no anchors");
+  return survey;
+}
+
+void writeAnchorSurvey(const AnchorSurvey& survey, const std::string& path) {
+  std::vector<Anchor> anchors = survey.anchors;
+  std::sort(anchors.begin(), anchors.end(), [](const Anchor& a, const Anchor& b) { return a.id < b.id; });
+  std::string out;
+  for (const Anchor& a : anchors) {
+    out += fmt::format("an{}_p,", a.id);
+    io_detail::appendDouble(out, a.w_p.x());
+    out.push_back(',');
+    io_detail::appendDouble(out, a.w_p.y());
+    out.push_back(',');
+    io_detail::appendDouble(out, a.w_p.z());
+    out.push_back('\n');
+  }
+  for (const Anchor& a : anchors) {
+    out += fmt::format("an{}_quat,", a.id);
+    const double q[4] = {a.w_q.x(), a.w_q.y(), a.w_q.z(), a.w_q.w()};
+    for (int k = 0; k < 4; ++k) {
+      if (k > 0) out.push_back(',');
+      io_detail::appendDouble(out, q[k]);
+    }
+    out.push_back('\n');
+  }
+  io_detail::writeWholeFile(path, out, "anchor survey");
+}
+
+}  // namespace uwb

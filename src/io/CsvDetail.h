@@ -1,0 +1,84 @@
+/** @file CsvDetail.h
+ *  @brief Internal helpers of the io module: whole-file reads, exact number parsing and shortest formatting.
+ *
+ *  Not a public header (lives in src/io): the readers parse with std::from_chars on one buffer, the writers
+ *  format with std::to_chars (shortest representation that parses back to the same double).
+ */
+#pragma once
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <string_view>
+
+#include "uwb/core/Error.h"
+
+namespace uwb::io_detail {
+
+/// Whole file as one string; FileError when it cannot be opened or read.
+std::string readWholeFile(const std::string& path, const char* what);
+/// Writes `text` to `path` (truncating); FileError on failure.
+void writeWholeFile(const std::string& path, std::string_view text, const char* what);
+
+inline bool isBlank(char c) { return c == ' ' || c == '\t'; }
+
+/// Trims spaces and tabs on both sides of [b, e).
+inline void trim(const char*& b, const char*& e) {
+  while (b < e && isBlank(*b)) ++b;
+  while (e > b && isBlank(e[-1])) --e;
+}
+
+enum class NumberStatus { kOk, kNotANumber, kOutOfRange, kNonFinite };
+
+/// Parses the whole of [b, e) (already trimmed) as a double. A leading '+' is accepted.
+inline NumberStatus parseDouble(const char* b, const char* e, double& out) {
+  if (b < e && *b == '+') ++b;
+  if (b == e) return NumberStatus::kNotANumber;
+  const auto [p, ec] = std::from_chars(b, e, out, std::chars_format::general);
+  if (ec == std::errc::result_out_of_range) return NumberStatus::kOutOfRange;
+  if (ec != std::errc() || p != e) return NumberStatus::kNotANumber;
+  if (!std::isfinite(out)) return NumberStatus::kNonFinite;
+  return NumberStatus::kOk;
+}
+
+inline const char* describe(NumberStatus s) {
+  switch (s) {
+    case NumberStatus::kOk: return "ok";
+    case NumberStatus::kNotANumber: return "not a number";
+    case NumberStatus::kOutOfRange: return "number out of range";
+    case NumberStatus::kNonFinite: return "NaN or Inf is not allowed";
+  }
+  return "?";
+}
+
+/// Appends the shortest decimal that parses back to exactly x.
+inline void appendDouble(std::string& out, double x) {
+  char buf[32];
+  const auto [p, ec] = std::to_chars(buf, buf + sizeof buf, x);
+  out.append(buf, p);
+}
+
+inline void appendInt(std::string& out, long long x) {
+  char buf[24];
+  const auto [p, ec] = std::to_chars(buf, buf + sizeof buf, x);
+  out.append(buf, p);
+}
+
+/// The double d (closest to x/scale) such that d * scale == x exactly, so that a value read as
+/// parse(text) * scale is written back as text that reproduces it bit for bit. Falls back to x/scale when no
+/// such d exists within a few ulps (x did not come from a file).
+inline double unscaleExactly(double x, double scale) {
+  const double y = x / scale;
+  if (y * scale == x) return y;
+  double up = y, down = y;
+  for (int k = 0; k < 8; ++k) {
+    up = std::nextafter(up, INFINITY);
+    if (up * scale == x) return up;
+    down = std::nextafter(down, -INFINITY);
+    if (down * scale == x) return down;
+  }
+  return y;
+}
+
+}  // namespace uwb::io_detail

@@ -1,0 +1,206 @@
+/** @file FlightSummary.cpp
+ *  @brief Flight overview for `uwbtdoa inspect` (docs/io.md, "inspect").
+ */
+#include "uwb/io/FlightSummary.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace uwb {
+
+namespace {
+
+double medianInPlace(std::vector<double>& v) {
+  const std::size_t n = v.size();
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(n / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  const double hi = *mid;
+  if (n % 2 == 1) return hi;
+  const double lo = *std::max_element(v.begin(), mid);
+  return 0.5 * (lo + hi);
+}
+
+template <class Samples>
+StreamSummary summarizeStream(Stream s, const Samples& samples, bool present) {
+  StreamSummary out;
+  out.stream = s;
+  out.name = streamName(s);
+  out.present = present || !samples.empty();
+  out.count = samples.size();
+  if (!samples.empty()) {
+    out.t_first_s = samples.front().t_s;
+    out.t_last_s = samples.back().t_s;
+    const double span = out.t_last_s - out.t_first_s;
+    if (samples.size() >= 2 && span > 0.0) out.rate_hz = static_cast<double>(samples.size() - 1) / span;
+  }
+  return out;
+}
+
+bool columnsMention(const Flight& f, Stream s) {
+  const std::string t = streamColumns(s).front();
+  return std::find(f.columns.begin(), f.columns.end(), t) != f.columns.end();
+}
+
+}  // namespace
+
+ResidualStats residualStats(std::vector<double> values, double gross_residual_m) {
+  ResidualStats st;
+  st.n = values.size();
+  if (values.empty()) return st;
+  double sum = 0.0;
+  double sum2 = 0.0;
+  for (double v : values) {
+    sum += v;
+    sum2 += v * v;
+  }
+  st.mean_m = sum / static_cast<double>(st.n);
+  st.rms_m = std::sqrt(sum2 / static_cast<double>(st.n));
+  st.median_m = medianInPlace(values);
+  double abs_sum = 0.0;
+  double kept_sum = 0.0;
+  std::size_t n_kept = 0;
+  for (double& v : values) {
+    v = std::abs(v - st.median_m);
+    abs_sum += v;
+    if (v < gross_residual_m) {
+      kept_sum += v;
+      ++n_kept;
+    }
+  }
+  st.mean_abs_dev_m = abs_sum / static_cast<double>(st.n);
+  st.n_gross = st.n - n_kept;
+  st.mad_m = n_kept > 0 ? kept_sum / static_cast<double>(n_kept) : 0.0;
+  st.median_abs_dev_m = medianInPlace(values);
+  return st;
+}
+
+bool isNeighbourPair(int id_a, int id_b, const std::vector<int>& sorted_ids) {
+  const auto it = std::lower_bound(sorted_ids.begin(), sorted_ids.end(), id_a);
+  if (it == sorted_ids.end() || *it != id_a || sorted_ids.size() < 2) return false;
+  const auto next = std::next(it) == sorted_ids.end() ? sorted_ids.begin() : std::next(it);
+  return *next == id_b;
+}
+
+FlightSummary summarizeFlight(const Flight& flight, const AnchorSurvey* survey, const ReadReport* read_report,
+                              const FlightSummaryParams& params) {
+  FlightSummary out;
+  out.source = flight.source;
+  const auto [t0, t1] = flight.timeSpan();
+  out.t_start_s = t0;
+  out.t_end_s = t1;
+  out.duration_s = t1 - t0;
+  for (Stream s : allStreams()) {
+    const bool present = columnsMention(flight, s);
+    switch (s) {
+      case Stream::kTdoa: out.streams.push_back(summarizeStream(s, flight.tdoa, present)); break;
+      case Stream::kTwr: out.streams.push_back(summarizeStream(s, flight.twr, present)); break;
+      case Stream::kAcc: out.streams.push_back(summarizeStream(s, flight.acc, present)); break;
+      case Stream::kGyro: out.streams.push_back(summarizeStream(s, flight.gyro, present)); break;
+      case Stream::kTof: out.streams.push_back(summarizeStream(s, flight.tof, present)); break;
+      case Stream::kFlow: out.streams.push_back(summarizeStream(s, flight.flow, present)); break;
+      case Stream::kBaro: out.streams.push_back(summarizeStream(s, flight.baro, present)); break;
+      case Stream::kPose: out.streams.push_back(summarizeStream(s, flight.pose, present)); break;
+    }
+  }
+  if (read_report != nullptr) out.notes = read_report->notes;
+
+  // Anchor ids for the neighbour definition: the survey's, else 0..max id seen.
+  std::vector<int> ids;
+  if (survey != nullptr) {
+    for (const Anchor& a : survey->anchors) ids.push_back(a.id);
+  } else {
+    int max_id = -1;
+    for (const TdoaMeasurement& m : flight.tdoa) max_id = std::max({max_id, m.id_a, m.id_b});
+    for (int i = 0; i <= max_id; ++i) ids.push_back(i);
+  }
+  std::sort(ids.begin(), ids.end());
+
+  std::map<std::pair<int, int>, std::size_t> pair_index;
+  std::size_t n_neighbour = 0;
+  for (const TdoaMeasurement& m : flight.tdoa) {
+    const auto key = std::make_pair(m.id_a, m.id_b);
+    auto [it, inserted] = pair_index.emplace(key, 0);
+    if (inserted) {
+      PairSummary p;
+      p.id_a = m.id_a;
+      p.id_b = m.id_b;
+      p.neighbour = isNeighbourPair(m.id_a, m.id_b, ids);
+      out.pairs.push_back(p);
+      it->second = out.pairs.size() - 1;
+    }
+    PairSummary& p = out.pairs[it->second];
+    ++p.count;
+    if (p.neighbour) ++n_neighbour;
+  }
+  out.n_tdoa = flight.tdoa.size();
+  out.neighbour_pair_fraction =
+      out.n_tdoa > 0 ? static_cast<double>(n_neighbour) / static_cast<double>(out.n_tdoa) : 0.0;
+
+  if (flight.hasGroundTruth()) {
+    out.has_ground_truth = true;
+    out.pose_has_orientation = flight.pose_has_orientation;
+    const PoseTrack track(flight, params.pose_track);
+    out.pose_glitches = track.glitches();
+    out.n_pose_glitches_attitude = track.countGlitches(PoseGlitchKind::kAttitude);
+    out.n_pose_glitches_position = track.countGlitches(PoseGlitchKind::kPosition);
+    if (!track.empty()) {
+      const auto n_air = std::count_if(track.samples().begin(), track.samples().end(), [&](const PoseSample& s) {
+        return s.w_p_b.z() > params.residual.airborne_min_z_m;
+      });
+      out.airborne_fraction_pose = static_cast<double>(n_air) / static_cast<double>(track.samples().size());
+    }
+    if (!track.glitches().empty()) {
+      out.notes.push_back(fmt::format("{} pose glitch sample(s) excluded from ground truth ({} attitude, {} position)",
+                                      track.glitches().size(), out.n_pose_glitches_attitude,
+                                      out.n_pose_glitches_position));
+    }
+    if (survey != nullptr && !flight.tdoa.empty()) {
+      const std::vector<TdoaResidual> residuals =
+          tdoaResiduals(flight, *survey, track, params.residual, &out.residual_report);
+      out.has_residuals = !residuals.empty();
+      // Collect per phase, overall / neighbour / per pair.
+      struct Buckets {
+        std::vector<double> all, air, ground;
+        void add(const TdoaResidual& r) {
+          all.push_back(r.residual_m);
+          (r.airborne ? air : ground).push_back(r.residual_m);
+        }
+        PhaseResiduals stats() const { return {residualStats(all), residualStats(air), residualStats(ground)}; }
+      };
+      Buckets overall;
+      Buckets neighbour;
+      std::vector<Buckets> per_pair(out.pairs.size());
+      for (const TdoaResidual& r : residuals) {
+        overall.add(r);
+        const std::size_t pi = pair_index.at({r.id_a, r.id_b});
+        per_pair[pi].add(r);
+        if (out.pairs[pi].neighbour) neighbour.add(r);
+      }
+      out.residual = overall.stats();
+      out.residual_neighbour = neighbour.stats();
+      for (std::size_t i = 0; i < out.pairs.size(); ++i) out.pairs[i].residual = per_pair[i].stats();
+      const TdoaResidualReport& rr = out.residual_report;
+      if (rr.n_no_ground_truth > 0) {
+        out.notes.push_back(fmt::format("{} TDoA measurement(s) without ground truth (outside the pose track or in a "
+                                        "gap > {} s)",
+                                        rr.n_no_ground_truth, params.pose_track.max_gap_s));
+      }
+      if (rr.n_unknown_anchor > 0) {
+        out.notes.push_back(fmt::format("{} TDoA measurement(s) name an anchor missing from the survey",
+                                        rr.n_unknown_anchor));
+      }
+    }
+  }
+  const std::size_t n_non_neighbour = out.n_tdoa - n_neighbour;
+  if (n_non_neighbour > 0 && out.neighbour_pair_fraction > 0.5) {
+    out.notes.push_back(fmt::format("{} TDoA measurement(s) on non-neighbour pairs", n_non_neighbour));
+  }
+  std::sort(out.pairs.begin(), out.pairs.end(),
+            [](const PairSummary& a, const PairSummary& b) { return std::tie(a.id_a, a.id_b) < std::tie(b.id_a, b.id_b); });
+  return out;
+}
+
+}  // namespace uwb

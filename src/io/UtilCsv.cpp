@@ -1,0 +1,626 @@
+/** @file UtilCsv.cpp
+ *  @brief UTIL flight-CSV reader and writer (Zhao et al., IJRR 2022, arXiv:2203.14471; docs/io.md).
+ *
+ *  Reader: the file is read into one buffer and parsed with std::from_chars; each stream keeps its own cursor,
+ *  ends at its first empty time cell and may not resume. Units are converted once here (g → m/s², deg/s → rad/s).
+ *  Writer: std::to_chars shortest representation; converted values are written as the decimal that converts back
+ *  to the same double (io_detail::unscaleExactly), so read(write(read(f))) == read(f) bit for bit.
+ */
+#include "uwb/io/UtilCsv.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+
+#include "CsvDetail.h"
+
+namespace uwb {
+
+namespace {
+
+using io_detail::NumberStatus;
+
+constexpr int kNumStreams = 8;
+constexpr int kMaxFields = 8;
+constexpr int kPoseQuatFirstField = 4;  ///< pose fields 0..3: t, x, y, z; 4..7: qx, qy, qz, qw
+
+struct ColumnDef {
+  const char* name;
+  Stream stream;
+  int field;
+};
+
+// UTIL column names. TWR first (the TWR variant starts with it), then the 27 TDoA-layout columns in file order.
+constexpr std::array<ColumnDef, 30> kColumns{{
+    {"t_twr", Stream::kTwr, 0},    {"anchor_id", Stream::kTwr, 1}, {"twr_range", Stream::kTwr, 2},
+    {"t_tdoa", Stream::kTdoa, 0},  {"idA", Stream::kTdoa, 1},      {"idB", Stream::kTdoa, 2},
+    {"tdoa_meas", Stream::kTdoa, 3},
+    {"t_acc", Stream::kAcc, 0},    {"acc_x", Stream::kAcc, 1},     {"acc_y", Stream::kAcc, 2},
+    {"acc_z", Stream::kAcc, 3},
+    {"t_gyro", Stream::kGyro, 0},  {"gyro_x", Stream::kGyro, 1},   {"gyro_y", Stream::kGyro, 2},
+    {"gyro_z", Stream::kGyro, 3},
+    {"t_tof", Stream::kTof, 0},    {"tof", Stream::kTof, 1},
+    {"t_flow", Stream::kFlow, 0},  {"deltaX", Stream::kFlow, 1},   {"deltaY", Stream::kFlow, 2},
+    {"t_baro", Stream::kBaro, 0},  {"baro", Stream::kBaro, 1},
+    {"t_pose", Stream::kPose, 0},  {"pose_x", Stream::kPose, 1},   {"pose_y", Stream::kPose, 2},
+    {"pose_z", Stream::kPose, 3},  {"pose_qx", Stream::kPose, 4},  {"pose_qy", Stream::kPose, 5},
+    {"pose_qz", Stream::kPose, 6}, {"pose_qw", Stream::kPose, 7},
+}};
+
+int streamIndex(Stream s) { return static_cast<int>(s); }
+
+int numFields(Stream s) {
+  switch (s) {
+    case Stream::kTdoa: return 4;
+    case Stream::kTwr: return 3;
+    case Stream::kAcc: return 4;
+    case Stream::kGyro: return 4;
+    case Stream::kTof: return 2;
+    case Stream::kFlow: return 3;
+    case Stream::kBaro: return 2;
+    case Stream::kPose: return 8;
+  }
+  return 0;
+}
+
+const ColumnDef* findColumn(std::string_view name) {
+  for (const ColumnDef& c : kColumns) {
+    if (name == c.name) return &c;
+  }
+  return nullptr;
+}
+
+const char* fieldName(Stream s, int field) {
+  for (const ColumnDef& c : kColumns) {
+    if (c.stream == s && c.field == field) return c.name;
+  }
+  return "?";
+}
+
+/// Where each stream's fields sit in the file: column index per field, -1 when absent.
+struct Layout {
+  std::array<std::array<int, kMaxFields>, kNumStreams> col;
+  std::array<bool, kNumStreams> present{};
+  bool pose_quat = false;
+
+  Layout() {
+    for (auto& c : col) c.fill(-1);
+  }
+  /// Number of fields the stream carries in this file (pose: 4 or 8).
+  int fieldsOf(Stream s) const {
+    if (s == Stream::kPose) return pose_quat ? 8 : 4;
+    return numFields(s);
+  }
+};
+
+/// Builds the layout from column names; `fail(column_index, message)` reports problems (does not return).
+template <class Fail>
+Layout makeLayout(const std::vector<std::string>& names, Fail&& fail) {
+  Layout layout;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const ColumnDef* def = findColumn(names[i]);
+    if (def == nullptr) {
+      fail(i, names[i], fmt::format("unknown column '{}' (expected UTIL names such as t_tdoa, idA, idB, tdoa_meas)",
+                                    names[i]));
+    }
+    int& slot = layout.col[streamIndex(def->stream)][def->field];
+    if (slot >= 0) fail(i, names[i], fmt::format("duplicated column '{}' (also column {})", names[i], slot + 1));
+    slot = static_cast<int>(i);
+  }
+  for (Stream s : allStreams()) {
+    const auto& c = layout.col[streamIndex(s)];
+    const int n_main = s == Stream::kPose ? kPoseQuatFirstField : numFields(s);
+    int n_have = 0;
+    for (int f = 0; f < n_main; ++f) n_have += c[f] >= 0 ? 1 : 0;
+    int n_quat = 0;
+    if (s == Stream::kPose) {
+      for (int f = kPoseQuatFirstField; f < 8; ++f) n_quat += c[f] >= 0 ? 1 : 0;
+    }
+    if (n_have == 0 && n_quat == 0) continue;
+    const auto first_present = [&]() {
+      for (int f = 0; f < kMaxFields; ++f) {
+        if (c[f] >= 0) return static_cast<std::size_t>(c[f]);
+      }
+      return std::size_t{0};
+    };
+    if (n_have != n_main) {
+      for (int f = 0; f < n_main; ++f) {
+        if (c[f] < 0) {
+          fail(first_present(), names[first_present()],
+               fmt::format("stream '{}' is incomplete: column '{}' is missing (a stream's columns must be all "
+                           "present or all absent)",
+                           streamName(s), fieldName(s, f)));
+        }
+      }
+    }
+    if (s == Stream::kPose && n_quat != 0 && n_quat != 4) {
+      for (int f = kPoseQuatFirstField; f < 8; ++f) {
+        if (c[f] < 0) {
+          fail(first_present(), names[first_present()],
+               fmt::format("pose quaternion is incomplete: column '{}' is missing", fieldName(s, f)));
+        }
+      }
+    }
+    layout.present[streamIndex(s)] = true;
+    if (s == Stream::kPose) layout.pose_quat = n_quat == 4;
+  }
+  return layout;
+}
+
+/// Per-stream parsing state.
+struct StreamCursor {
+  bool ended = false;
+  std::size_t end_line = 0;  ///< line of the first empty time cell
+  double last_t = -std::numeric_limits<double>::infinity();
+  std::size_t duplicates = 0;
+  std::size_t count = 0;
+};
+
+bool equalsQuatNorm(double qx, double qy, double qz, double qw, double& norm) {
+  norm = std::sqrt(qx * qx + qy * qy + qz * qz + qw * qw);
+  return std::abs(norm - 1.0) <= kMaxQuaternionNormError;
+}
+
+}  // namespace
+
+const char* streamName(Stream stream) {
+  switch (stream) {
+    case Stream::kTdoa: return "tdoa";
+    case Stream::kTwr: return "twr";
+    case Stream::kAcc: return "acc";
+    case Stream::kGyro: return "gyro";
+    case Stream::kTof: return "tof";
+    case Stream::kFlow: return "flow";
+    case Stream::kBaro: return "baro";
+    case Stream::kPose: return "pose";
+  }
+  return "?";
+}
+
+const std::vector<Stream>& allStreams() {
+  static const std::vector<Stream> kAll{Stream::kTwr,  Stream::kTdoa, Stream::kAcc,  Stream::kGyro,
+                                        Stream::kTof,  Stream::kFlow, Stream::kBaro, Stream::kPose};
+  return kAll;
+}
+
+std::vector<std::string> streamColumns(Stream stream) {
+  std::vector<std::string> out;
+  for (const ColumnDef& c : kColumns) {
+    if (c.stream == stream) out.emplace_back(c.name);
+  }
+  return out;
+}
+
+const std::vector<std::string>& utilTdoaColumns() {
+  static const std::vector<std::string> kCols = [] {
+    std::vector<std::string> out;
+    for (const ColumnDef& c : kColumns) {
+      if (c.stream != Stream::kTwr) out.emplace_back(c.name);
+    }
+    return out;
+  }();
+  return kCols;
+}
+
+// ------------------------------------------------------------------------------------------------ reader
+
+Flight readFlightCsv(const std::string& path, const FlightReadOptions& options, ReadReport* report) {
+  const std::string text = io_detail::readWholeFile(path, "flight file");
+  return parseFlightCsv(text, path, options, report);
+}
+
+Flight parseFlightCsv(std::string_view text, const std::string& source, const FlightReadOptions& options,
+                      ReadReport* report) {
+  Flight flight;
+  flight.source = source;
+  ReadReport local_report;
+  ReadReport& rep = report != nullptr ? *report : local_report;
+  rep = ReadReport{};
+  rep.n_bytes = text.size();
+
+  const char* p = text.data();
+  const char* const end = p + text.size();
+  if (text.size() >= 3 && std::memcmp(p, "\xEF\xBB\xBF", 3) == 0) p += 3;  // UTF-8 BOM
+
+  std::size_t line = 0;
+  const auto nextLine = [&](const char*& b, const char*& e) -> bool {
+    if (p >= end) return false;
+    b = p;
+    const void* nl = std::memchr(p, '\n', static_cast<std::size_t>(end - p));
+    e = nl != nullptr ? static_cast<const char*>(nl) : end;
+    p = nl != nullptr ? e + 1 : end;
+    if (e > b && e[-1] == '\r') --e;
+    ++line;
+    return true;
+  };
+  const auto failAt = [&](std::size_t at_line, std::size_t column, const std::string& field,
+                          const std::string& message) {
+    throw InputError(SourceLocation{source, at_line, column, field}, message);
+  };
+
+  // ---- header
+  const char* hb = nullptr;
+  const char* he = nullptr;
+  bool got_header = false;
+  while (nextLine(hb, he)) {
+    const char* tb = hb;
+    const char* te = he;
+    io_detail::trim(tb, te);
+    if (tb != te) {
+      got_header = true;
+      break;
+    }
+  }
+  if (!got_header) failAt(line == 0 ? 1 : line, 0, "", "empty file: missing header line");
+  const std::size_t header_line = line;
+  std::vector<std::string> names;
+  for (const char* b = hb;;) {
+    const char* comma = static_cast<const char*>(std::memchr(b, ',', static_cast<std::size_t>(he - b)));
+    const char* e = comma != nullptr ? comma : he;
+    const char* tb = b;
+    const char* te = e;
+    io_detail::trim(tb, te);
+    names.emplace_back(tb, te);
+    if (comma == nullptr) break;
+    b = comma + 1;
+  }
+  {
+    double dummy = 0.0;
+    const std::string& first = names.front();
+    if (io_detail::parseDouble(first.data(), first.data() + first.size(), dummy) == NumberStatus::kOk ||
+        first.empty()) {
+      failAt(header_line, 1, "", "missing header line: the first line holds data, expected column names");
+    }
+  }
+  const Layout layout = makeLayout(names, [&](std::size_t i, const std::string& name, const std::string& msg) {
+    failAt(header_line, i + 1, name, msg);
+  });
+  flight.columns = names;
+  flight.pose_has_orientation = layout.present[streamIndex(Stream::kPose)] && layout.pose_quat;
+  const std::size_t n_cols = names.size();
+
+  // Rough capacity from the file size: avoids reallocation in the common full-layout case.
+  const std::size_t approx_rows = text.size() / std::max<std::size_t>(1, n_cols * 8) + 16;
+  for (Stream s : allStreams()) {
+    if (!layout.present[streamIndex(s)]) continue;
+    switch (s) {
+      case Stream::kTdoa: flight.tdoa.reserve(approx_rows); break;
+      case Stream::kTwr: flight.twr.reserve(approx_rows); break;
+      case Stream::kAcc: flight.acc.reserve(approx_rows); break;
+      case Stream::kGyro: flight.gyro.reserve(approx_rows); break;
+      case Stream::kPose: flight.pose.reserve(approx_rows); break;
+      default: break;
+    }
+  }
+
+  // Present streams in the order of their time column in the file (error order follows the row).
+  std::vector<Stream> present;
+  for (Stream s : allStreams()) {
+    if (layout.present[streamIndex(s)]) present.push_back(s);
+  }
+  std::sort(present.begin(), present.end(), [&](Stream a, Stream b) {
+    return layout.col[streamIndex(a)][0] < layout.col[streamIndex(b)][0];
+  });
+
+  std::array<StreamCursor, kNumStreams> cursors{};
+  std::vector<const char*> cell_b(n_cols);
+  std::vector<const char*> cell_e(n_cols);
+  std::size_t blank_lines = 0;
+  std::size_t pending_blank = 0;  // blank lines not yet known to be trailing
+  std::size_t n_rows = 0;
+
+  const char* lb = nullptr;
+  const char* le = nullptr;
+  while (nextLine(lb, le)) {
+    // A line with nothing but blanks: tolerated (counted) unless at the very end of the file.
+    {
+      const char* tb = lb;
+      const char* te = le;
+      io_detail::trim(tb, te);
+      if (tb == te) {
+        ++pending_blank;
+        continue;
+      }
+    }
+    blank_lines += pending_blank;
+    pending_blank = 0;
+    ++n_rows;
+
+    // Split into cells.
+    std::size_t n = 0;
+    for (const char* b = lb;;) {
+      const char* comma = static_cast<const char*>(std::memchr(b, ',', static_cast<std::size_t>(le - b)));
+      const char* e = comma != nullptr ? comma : le;
+      if (n < n_cols) {
+        const char* tb = b;
+        const char* te = e;
+        io_detail::trim(tb, te);
+        cell_b[n] = tb;
+        cell_e[n] = te;
+      }
+      ++n;
+      if (comma == nullptr) break;
+      b = comma + 1;
+    }
+    if (n != n_cols) {
+      failAt(line, std::min(n, n_cols) + (n > n_cols ? 1 : 0), "",
+             fmt::format("row has {} fields, the header has {}", n, n_cols));
+    }
+
+    for (Stream s : present) {
+      const int si = streamIndex(s);
+      const auto& col = layout.col[si];
+      const int nf = layout.fieldsOf(s);
+      StreamCursor& cur = cursors[si];
+      const bool time_empty = cell_b[col[0]] == cell_e[col[0]];
+      if (time_empty) {
+        for (int f = 1; f < nf; ++f) {
+          const int c = col[f];
+          if (cell_b[c] != cell_e[c]) {
+            failAt(line, c + 1, names[c],
+                   fmt::format("partly filled row of stream '{}': '{}' is empty but '{}' is not", streamName(s),
+                               names[col[0]], names[c]));
+          }
+        }
+        if (!cur.ended) {
+          cur.ended = true;
+          cur.end_line = line;
+        }
+        continue;
+      }
+      if (cur.ended) {
+        failAt(line, col[0] + 1, names[col[0]],
+               fmt::format("stream '{}' continues after it ended (its time cell was empty on line {})", streamName(s),
+                           cur.end_line));
+      }
+      double v[kMaxFields];
+      for (int f = 0; f < nf; ++f) {
+        const int c = col[f];
+        if (cell_b[c] == cell_e[c]) {
+          failAt(line, c + 1, names[c],
+                 fmt::format("partly filled row of stream '{}': '{}' is empty", streamName(s), names[c]));
+        }
+        const NumberStatus st = io_detail::parseDouble(cell_b[c], cell_e[c], v[f]);
+        if (st != NumberStatus::kOk) {
+          failAt(line, c + 1, names[c],
+                 fmt::format("{}: '{}'", io_detail::describe(st), std::string_view(cell_b[c], cell_e[c] - cell_b[c])));
+        }
+      }
+      // Time order within the stream.
+      const double t = v[0];
+      if (t < cur.last_t) {
+        failAt(line, col[0] + 1, names[col[0]],
+               fmt::format("time goes backwards in stream '{}': {} after {}", streamName(s), t, cur.last_t));
+      }
+      if (t == cur.last_t) ++cur.duplicates;
+      cur.last_t = t;
+      ++cur.count;
+
+      const auto anchorId = [&](int f) -> int {
+        const double x = v[f];
+        const int c = col[f];
+        if (x != std::floor(x) || x < std::numeric_limits<int>::min() || x > std::numeric_limits<int>::max()) {
+          failAt(line, c + 1, names[c],
+                 fmt::format("anchor id must be an integer: '{}'", std::string_view(cell_b[c], cell_e[c] - cell_b[c])));
+        }
+        const int id = static_cast<int>(x);
+        if (options.survey != nullptr && !options.survey->contains(id)) {
+          failAt(line, c + 1, names[c],
+                 fmt::format("anchor id {} has no entry in the survey{}", id,
+                             options.survey->source.empty() ? std::string() : " " + options.survey->source));
+        }
+        return id;
+      };
+
+      switch (s) {
+        case Stream::kTdoa: flight.tdoa.push_back({t, anchorId(1), anchorId(2), v[3]}); break;
+        case Stream::kTwr: flight.twr.push_back({t, anchorId(1), v[2]}); break;
+        case Stream::kAcc:
+          flight.acc.push_back({t, Vec3(v[1] * kGravity_mps2, v[2] * kGravity_mps2, v[3] * kGravity_mps2)});
+          break;
+        case Stream::kGyro:
+          flight.gyro.push_back({t, Vec3(v[1] * kDegToRad, v[2] * kDegToRad, v[3] * kDegToRad)});
+          break;
+        case Stream::kTof: flight.tof.push_back({t, v[1]}); break;
+        case Stream::kFlow: flight.flow.push_back({t, v[1], v[2]}); break;
+        case Stream::kBaro: flight.baro.push_back({t, v[1]}); break;
+        case Stream::kPose: {
+          PoseSample ps;
+          ps.t_s = t;
+          ps.w_p_b = Vec3(v[1], v[2], v[3]);
+          if (layout.pose_quat) {
+            double norm = 0.0;
+            if (!equalsQuatNorm(v[4], v[5], v[6], v[7], norm)) {
+              const int c = col[kPoseQuatFirstField];
+              failAt(line, c + 1, names[c],
+                     fmt::format("pose quaternion is far from unit norm: |q| = {:.6g} (tolerance {})", norm,
+                                 kMaxQuaternionNormError));
+            }
+            ps.w_q_b = Quat(v[7], v[4], v[5], v[6]);  // Eigen order: w, x, y, z
+          }
+          flight.pose.push_back(ps);
+          break;
+        }
+      }
+    }
+  }
+  if (n_rows == 0 && blank_lines == 0 && pending_blank == 0) {
+    // Header only: allowed (empty streams), but "required" below may reject it.
+  }
+  rep.n_rows = n_rows;
+
+  // ---- notes: tolerated oddities, counted
+  if (blank_lines > 0) rep.notes.push_back(fmt::format("{} blank line(s) inside the data skipped", blank_lines));
+  for (Stream s : present) {
+    const StreamCursor& cur = cursors[streamIndex(s)];
+    if (cur.duplicates > 0) {
+      rep.notes.push_back(fmt::format("{} duplicate timestamp(s) in stream {}", cur.duplicates, streamName(s)));
+    }
+    if (cur.count == 0) rep.notes.push_back(fmt::format("stream {}: columns present but no samples", streamName(s)));
+  }
+  if (layout.present[streamIndex(Stream::kPose)] && !layout.pose_quat) {
+    rep.notes.push_back("pose carries position only (no quaternion columns)");
+  }
+
+  // ---- required streams
+  for (Stream s : options.required) {
+    const int si = streamIndex(s);
+    if (!layout.present[si]) {
+      failAt(header_line, 0, "",
+             fmt::format("required stream '{}' is missing: no '{}' column in the header", streamName(s),
+                         fieldName(s, 0)));
+    }
+    if (cursors[si].count == 0) {
+      const int c = layout.col[si][0];
+      failAt(header_line + 1, c + 1, names[c], fmt::format("required stream '{}' has no samples", streamName(s)));
+    }
+  }
+  return flight;
+}
+
+// ------------------------------------------------------------------------------------------------ writer
+
+namespace {
+
+std::vector<std::string> defaultColumns(const Flight& flight) {
+  std::vector<std::string> cols;
+  if (!flight.twr.empty()) {
+    for (auto& c : streamColumns(Stream::kTwr)) cols.push_back(c);
+  }
+  for (const auto& c : utilTdoaColumns()) {
+    if (!flight.pose_has_orientation && c.rfind("pose_q", 0) == 0) continue;
+    cols.push_back(c);
+  }
+  return cols;
+}
+
+std::size_t streamSize(const Flight& f, Stream s) {
+  switch (s) {
+    case Stream::kTdoa: return f.tdoa.size();
+    case Stream::kTwr: return f.twr.size();
+    case Stream::kAcc: return f.acc.size();
+    case Stream::kGyro: return f.gyro.size();
+    case Stream::kTof: return f.tof.size();
+    case Stream::kFlow: return f.flow.size();
+    case Stream::kBaro: return f.baro.size();
+    case Stream::kPose: return f.pose.size();
+  }
+  return 0;
+}
+
+}  // namespace
+
+std::string formatFlightCsv(const Flight& flight) {
+  const std::vector<std::string> names = flight.columns.empty() ? defaultColumns(flight) : flight.columns;
+  const Layout layout = makeLayout(names, [](std::size_t i, const std::string&, const std::string& msg) {
+    throw std::invalid_argument(fmt::format("writeFlightCsv: flight.columns[{}]: {}", i, msg));
+  });
+  std::size_t n_rows = 0;
+  for (Stream s : allStreams()) {
+    const std::size_t n = streamSize(flight, s);
+    if (n > 0 && !layout.present[streamIndex(s)]) {
+      throw std::invalid_argument(fmt::format(
+          "writeFlightCsv: stream '{}' holds {} samples but flight.columns has none of its columns", streamName(s), n));
+    }
+    n_rows = std::max(n_rows, n);
+  }
+  if (layout.present[streamIndex(Stream::kPose)] && layout.pose_quat != flight.pose_has_orientation &&
+      !flight.pose.empty()) {
+    throw std::invalid_argument(
+        "writeFlightCsv: flight.columns and flight.pose_has_orientation disagree about the pose quaternion");
+  }
+
+  // Column → (stream, field).
+  struct Slot {
+    Stream stream;
+    int field;
+  };
+  std::vector<Slot> slots(names.size());
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const ColumnDef* d = findColumn(names[i]);
+    slots[i] = {d->stream, d->field};
+  }
+
+  std::string out;
+  out.reserve(n_rows * names.size() * 11 + 512);
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) out.push_back(',');
+    out += names[i];
+  }
+  out.push_back('\n');
+
+  using io_detail::appendDouble;
+  using io_detail::appendInt;
+  using io_detail::unscaleExactly;
+  for (std::size_t r = 0; r < n_rows; ++r) {
+    for (std::size_t i = 0; i < slots.size(); ++i) {
+      if (i > 0) out.push_back(',');
+      const auto [s, f] = slots[i];
+      if (r >= streamSize(flight, s)) continue;
+      switch (s) {
+        case Stream::kTdoa: {
+          const TdoaMeasurement& m = flight.tdoa[r];
+          if (f == 0) appendDouble(out, m.t_s);
+          else if (f == 1) appendInt(out, m.id_a);
+          else if (f == 2) appendInt(out, m.id_b);
+          else appendDouble(out, m.tdoa_m);
+          break;
+        }
+        case Stream::kTwr: {
+          const TwrMeasurement& m = flight.twr[r];
+          if (f == 0) appendDouble(out, m.t_s);
+          else if (f == 1) appendInt(out, m.anchor_id);
+          else appendDouble(out, m.range_m);
+          break;
+        }
+        case Stream::kAcc: {
+          const ImuSample& m = flight.acc[r];
+          if (f == 0) appendDouble(out, m.t_s);
+          else appendDouble(out, unscaleExactly(m.b_value[f - 1], kGravity_mps2));
+          break;
+        }
+        case Stream::kGyro: {
+          const ImuSample& m = flight.gyro[r];
+          if (f == 0) appendDouble(out, m.t_s);
+          else appendDouble(out, unscaleExactly(m.b_value[f - 1], kDegToRad));
+          break;
+        }
+        case Stream::kTof: appendDouble(out, f == 0 ? flight.tof[r].t_s : flight.tof[r].value); break;
+        case Stream::kBaro: appendDouble(out, f == 0 ? flight.baro[r].t_s : flight.baro[r].value); break;
+        case Stream::kFlow: {
+          const FlowSample& m = flight.flow[r];
+          appendDouble(out, f == 0 ? m.t_s : f == 1 ? m.delta_x : m.delta_y);
+          break;
+        }
+        case Stream::kPose: {
+          const PoseSample& m = flight.pose[r];
+          switch (f) {
+            case 0: appendDouble(out, m.t_s); break;
+            case 1: appendDouble(out, m.w_p_b.x()); break;
+            case 2: appendDouble(out, m.w_p_b.y()); break;
+            case 3: appendDouble(out, m.w_p_b.z()); break;
+            case 4: appendDouble(out, m.w_q_b.x()); break;
+            case 5: appendDouble(out, m.w_q_b.y()); break;
+            case 6: appendDouble(out, m.w_q_b.z()); break;
+            default: appendDouble(out, m.w_q_b.w()); break;
+          }
+          break;
+        }
+      }
+    }
+    out.push_back('\n');
+  }
+  return out;
+}
+
+void writeFlightCsv(const Flight& flight, const std::string& path) {
+  io_detail::writeWholeFile(path, formatFlightCsv(flight), "flight file");
+}
+
+}  // namespace uwb
