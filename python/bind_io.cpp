@@ -9,12 +9,15 @@
  *    pose: t, p (N, 3) [m, world], q (N, 4) body→world quaternion (x, y, z, w)
  */
 #include <array>
+#include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "bindings.h"
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/Flight.h"
+#include "uwb/io/PoseTrack.h"
 #include "uwb/io/UtilCsv.h"
 
 namespace uwb::python {
@@ -260,6 +263,46 @@ AnchorSurvey surveyFromArrays(const py::handle& ids, const py::handle& positions
   return s;
 }
 
+py::dict residualArrays(const std::vector<TdoaResidual>& v) {
+  const auto n = static_cast<Eigen::Index>(v.size());
+  py::array_t<std::int64_t> index(static_cast<py::ssize_t>(n));
+  auto ia = newIntArray(n), ib = newIntArray(n);
+  py::array_t<bool> airborne(static_cast<py::ssize_t>(n));
+  RowMat x(n, 4), p(n, 3), q(n, 4);
+  auto mi = index.mutable_unchecked<1>();
+  auto ma = ia.mutable_unchecked<1>(), mb = ib.mutable_unchecked<1>();
+  auto mair = airborne.mutable_unchecked<1>();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const TdoaResidual& r = v[i];
+    mi(i) = static_cast<std::int64_t>(r.index), ma(i) = r.id_a, mb(i) = r.id_b, mair(i) = r.airborne;
+    x.row(i) << r.t_s, r.measured_m, r.predicted_m, r.residual_m;
+    p.row(i) = r.w_p_b.transpose();
+    q.row(i) << r.w_q_b.x(), r.w_q_b.y(), r.w_q_b.z(), r.w_q_b.w();
+  }
+  py::dict d;
+  d["index"] = index, d["t"] = toNumpy(x.col(0), true), d["id_a"] = ia, d["id_b"] = ib;
+  d["measured"] = toNumpy(x.col(1), true), d["predicted"] = toNumpy(x.col(2), true);
+  d["residual"] = toNumpy(x.col(3), true), d["w_p_b"] = toNumpy(p), d["w_q_b"] = toNumpy(q);
+  d["airborne"] = airborne;
+  return d;
+}
+
+PoseTrackParams poseTrackParams(const py::dict& overrides) {
+  PoseTrackParams p;
+  for (const auto& [key, value] : overrides) {
+    const std::string name = py::str(key);
+    const double v = py::cast<double>(value);
+    if (name == "max_gap_s") p.max_gap_s = v;
+    else if (name == "max_attitude_jump_rad") p.max_attitude_jump_rad = v;
+    else if (name == "max_angular_rate_radps") p.max_angular_rate_radps = v;
+    else if (name == "max_glitch_run_s") p.max_glitch_run_s = v;
+    else if (name == "max_position_jump_m") p.max_position_jump_m = v;
+    else throw std::invalid_argument("unknown PoseTrack parameter '" + name + "'");
+  }
+  p.validate();
+  return p;
+}
+
 }  // namespace
 
 /// Positions of the anchors of each id in `ids` (N, 3); KeyError naming the id when absent.
@@ -378,6 +421,89 @@ void bindIo(py::module_& m) {
         const auto [t0, t1] = f.timeSpan();
         return r + " t=[" + std::to_string(t0) + ", " + std::to_string(t1) + "] s>";
       });
+
+  py::class_<PoseTrack>(m, "PoseTrack",
+                        "Ground truth as a function of time: the flight's pose samples minus detected glitches;\n"
+                        "linear position / slerp attitude interpolation.")
+      .def(py::init([](const Flight& f, const py::dict& params) { return PoseTrack(f, poseTrackParams(params)); }),
+           py::arg("flight"), py::arg("params") = py::dict(),
+           "params: overrides of PoseTrackParams (max_gap_s, max_attitude_jump_rad, max_angular_rate_radps,\n"
+           "max_glitch_run_s, max_position_jump_m).")
+      .def(
+          "interpolate",
+          [](const PoseTrack& track, const py::handle& t) {
+            const RowMat ts = toMatrix(t, 0, "t");
+            const Eigen::Index n = ts.rows();
+            RowMat p = RowMat::Constant(n, 3, std::numeric_limits<double>::quiet_NaN());
+            RowMat q = RowMat::Constant(n, 4, std::numeric_limits<double>::quiet_NaN());
+            py::array_t<bool> valid(static_cast<py::ssize_t>(n));
+            auto mv = valid.mutable_unchecked<1>();
+            for (Eigen::Index i = 0; i < n; ++i) {
+              const auto s = track.interpolate(ts(i, 0));
+              mv(i) = s.has_value();
+              if (!s) continue;
+              p.row(i) = s->w_p_b.transpose();
+              q.row(i) << s->w_q_b.x(), s->w_q_b.y(), s->w_q_b.z(), s->w_q_b.w();
+            }
+            py::dict d;
+            d["t"] = toNumpy(ts.col(0), true), d["p"] = toNumpy(p), d["q"] = toNumpy(q), d["valid"] = valid;
+            return d;
+          },
+          py::arg("t"),
+          "Pose at times t (N,): {t, p (N, 3), q (N, 4), valid (N,) bool}; NaN where there is no ground truth.")
+      .def_property_readonly("samples", [](const PoseTrack& t) { return poseDict(t.samples()); },
+                             "accepted samples {t, p, q}")
+      .def_property_readonly("glitches",
+                             [](const PoseTrack& t) {
+                               const auto& g = t.glitches();
+                               const auto n = static_cast<Eigen::Index>(g.size());
+                               py::array_t<std::int64_t> index(static_cast<py::ssize_t>(n));
+                               std::vector<std::string> kind;
+                               RowMat x(n, 2);
+                               auto mi = index.mutable_unchecked<1>();
+                               for (Eigen::Index i = 0; i < n; ++i) {
+                                 mi(i) = static_cast<std::int64_t>(g[i].index);
+                                 x.row(i) << g[i].t_s, g[i].magnitude;
+                                 kind.push_back(g[i].kind == PoseGlitchKind::kAttitude ? "attitude" : "position");
+                               }
+                               py::dict d;
+                               d["index"] = index, d["t"] = toNumpy(x.col(0), true);
+                               d["magnitude"] = toNumpy(x.col(1), true), d["kind"] = kind;
+                               return d;
+                             },
+                             "rejected samples {index, t, kind ('attitude'|'position'), magnitude}")
+      .def_property_readonly("start_time", &PoseTrack::startTime)
+      .def_property_readonly("end_time", &PoseTrack::endTime)
+      .def_property_readonly("has_orientation", &PoseTrack::hasOrientation)
+      .def("__len__", [](const PoseTrack& t) { return t.samples().size(); });
+
+  m.def(
+      "tdoa_residuals",
+      [](const Flight& flight, const AnchorSurvey& survey, const PoseTrack* track, const py::object& b_t_tag,
+         double airborne_min_z_m) {
+        TdoaResidualParams params;
+        if (!b_t_tag.is_none()) params.b_t_tag = row3(toMatrix(b_t_tag, 3, "b_t_tag"), 0);
+        params.airborne_min_z_m = airborne_min_z_m;
+        TdoaResidualReport report;
+        std::vector<TdoaResidual> r;
+        {
+          py::gil_scoped_release release;
+          const PoseTrack own = track ? PoseTrack() : PoseTrack(flight);
+          r = tdoaResiduals(flight, survey, track ? *track : own, params, &report);
+        }
+        py::dict d = residualArrays(r);
+        py::dict rep;
+        rep["n_measurements"] = report.n_measurements, rep["n_residuals"] = report.n_residuals;
+        rep["n_no_ground_truth"] = report.n_no_ground_truth, rep["n_unknown_anchor"] = report.n_unknown_anchor;
+        d["report"] = rep;
+        return d;
+      },
+      py::arg("flight"), py::arg("survey"), py::arg("track") = nullptr, py::arg("b_t_tag") = py::none(),
+      py::arg("airborne_min_z_m") = 0.3,
+      "TDoA residual r = measured − h(p_gt) of every measurement with ground truth (paper eq. 6, the GP target).\n"
+      "track defaults to PoseTrack(flight). Returns arrays {index (into flight.tdoa), t, id_a, id_b, measured,\n"
+      "predicted, residual, w_p_b (N, 3), w_q_b (N, 4), airborne} and report {n_measurements, n_residuals,\n"
+      "n_no_ground_truth, n_unknown_anchor}.");
 
   m.def(
       "read_flight_csv",

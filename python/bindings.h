@@ -130,5 +130,6 @@ void bindCore(py::module_& m);
 void bindIo(py::module_& m);
 void bindModel(py::module_& m);
 void bindGp(py::module_& m);
+void bindSim(py::module_& m);
 
 }  // namespace uwb::python

@@ -41,4 +41,5 @@ PYBIND11_MODULE(_uwbtdoa, m) {
   uwb::python::bindIo(m);
   uwb::python::bindModel(m);
   uwb::python::bindGp(m);
+  uwb::python::bindSim(m);
 }
