@@ -99,15 +99,18 @@ std::optional<InnovationStats> equalityRankOneInPlace(Eigen::Matrix<double, N, 1
     return std::nullopt;
   }
   st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
-  const Eigen::Matrix<double, N, 1> K = u / st.innovation_var_m2;
+  const double S = st.innovation_var_m2;
+  const Eigen::Matrix<double, N, 1> K = u / S;
   m.noalias() += K * st.innovation_m;
-  // Joseph form for a rank-one gain: (I − K a) V (I − K a)ᵀ + K var Kᵀ = V − K uᵀ − u Kᵀ + S K Kᵀ.
-  V.noalias() -= K * u.transpose();
-  V.noalias() -= u * K.transpose();
-  V.noalias() += (st.innovation_var_m2 * K) * K.transpose();
-  // Mirror the upper triangle so V stays exactly symmetric despite rounding (STYLE §6).
-  for (Eigen::Index j = 0; j < V.cols(); ++j) {
-    for (Eigen::Index i = j + 1; i < V.rows(); ++i) V(i, j) = V(j, i);
+  // Joseph form for a rank-one gain, (I − K a) V (I − K a)ᵀ + K var Kᵀ = V − K uᵀ − u Kᵀ + S K Kᵀ, evaluated on the
+  // upper triangle in one pass and mirrored, so V stays exactly symmetric (STYLE §6).
+  const Eigen::Index n = V.rows();
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double Kj = K[j], uj = u[j], SKj = S * Kj;
+    for (Eigen::Index i = 0; i <= j; ++i) V(i, j) += K[i] * (SKj - uj) - u[i] * Kj;
+  }
+  for (Eigen::Index j = 0; j < n; ++j) {
+    for (Eigen::Index i = j + 1; i < n; ++i) V(i, j) = V(j, i);
   }
   return st;
 }
