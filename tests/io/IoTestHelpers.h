@@ -1,0 +1,106 @@
+/** @file IoTestHelpers.h
+ *  @brief Helpers of the io tests: temporary files, bitwise flight comparison, real-data locations.
+ */
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include "support/TestSupport.h"
+#include "uwb/io/Flight.h"
+
+namespace uwb::test {
+
+/// A fresh directory under the system temp dir, removed at destruction.
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    path_ = std::filesystem::temp_directory_path() / ("uwb_io_test_" + std::to_string(rd()) + std::to_string(rd()));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  /// Writes `text` to a file named `name` in the directory and returns its path.
+  std::string write(const std::string& name, const std::string& text) const {
+    const auto p = path_ / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p.string();
+  }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+inline bool sameBits(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
+inline bool sameBits(const Vec3& a, const Vec3& b) {
+  return sameBits(a.x(), b.x()) && sameBits(a.y(), b.y()) && sameBits(a.z(), b.z());
+}
+inline bool sameBits(const Quat& a, const Quat& b) {
+  return sameBits(a.x(), b.x()) && sameBits(a.y(), b.y()) && sameBits(a.z(), b.z()) && sameBits(a.w(), b.w());
+}
+
+/// Every sample of every stream equal bit for bit (and the same columns and pose_has_orientation).
+inline ::testing::AssertionResult flightsIdentical(const Flight& a, const Flight& b) {
+  if (a.columns != b.columns) return ::testing::AssertionFailure() << "columns differ";
+  if (a.pose_has_orientation != b.pose_has_orientation) return ::testing::AssertionFailure() << "orientation flag";
+#define UWB_CMP_SIZE(s) \
+  if (a.s.size() != b.s.size()) return ::testing::AssertionFailure() << #s " size " << a.s.size() << " vs " << b.s.size();
+  UWB_CMP_SIZE(tdoa) UWB_CMP_SIZE(twr) UWB_CMP_SIZE(acc) UWB_CMP_SIZE(gyro) UWB_CMP_SIZE(tof) UWB_CMP_SIZE(flow)
+  UWB_CMP_SIZE(baro) UWB_CMP_SIZE(pose)
+#undef UWB_CMP_SIZE
+  for (std::size_t i = 0; i < a.tdoa.size(); ++i) {
+    const auto &x = a.tdoa[i], &y = b.tdoa[i];
+    if (!sameBits(x.t_s, y.t_s) || x.id_a != y.id_a || x.id_b != y.id_b || !sameBits(x.tdoa_m, y.tdoa_m))
+      return ::testing::AssertionFailure() << "tdoa[" << i << "]";
+  }
+  for (std::size_t i = 0; i < a.twr.size(); ++i) {
+    const auto &x = a.twr[i], &y = b.twr[i];
+    if (!sameBits(x.t_s, y.t_s) || x.anchor_id != y.anchor_id || !sameBits(x.range_m, y.range_m))
+      return ::testing::AssertionFailure() << "twr[" << i << "]";
+  }
+  for (std::size_t i = 0; i < a.acc.size(); ++i) {
+    if (!sameBits(a.acc[i].t_s, b.acc[i].t_s) || !sameBits(a.acc[i].b_value, b.acc[i].b_value))
+      return ::testing::AssertionFailure() << "acc[" << i << "] " << a.acc[i].b_value.transpose() << " vs "
+                                           << b.acc[i].b_value.transpose();
+  }
+  for (std::size_t i = 0; i < a.gyro.size(); ++i) {
+    if (!sameBits(a.gyro[i].t_s, b.gyro[i].t_s) || !sameBits(a.gyro[i].b_value, b.gyro[i].b_value))
+      return ::testing::AssertionFailure() << "gyro[" << i << "]";
+  }
+  for (std::size_t i = 0; i < a.tof.size(); ++i) {
+    if (!sameBits(a.tof[i].t_s, b.tof[i].t_s) || !sameBits(a.tof[i].value, b.tof[i].value))
+      return ::testing::AssertionFailure() << "tof[" << i << "]";
+  }
+  for (std::size_t i = 0; i < a.baro.size(); ++i) {
+    if (!sameBits(a.baro[i].t_s, b.baro[i].t_s) || !sameBits(a.baro[i].value, b.baro[i].value))
+      return ::testing::AssertionFailure() << "baro[" << i << "]";
+  }
+  for (std::size_t i = 0; i < a.flow.size(); ++i) {
+    const auto &x = a.flow[i], &y = b.flow[i];
+    if (!sameBits(x.t_s, y.t_s) || !sameBits(x.delta_x, y.delta_x) || !sameBits(x.delta_y, y.delta_y))
+      return ::testing::AssertionFailure() << "flow[" << i << "]";
+  }
+  for (std::size_t i = 0; i < a.pose.size(); ++i) {
+    const auto &x = a.pose[i], &y = b.pose[i];
+    if (!sameBits(x.t_s, y.t_s) || !sameBits(x.w_p_b, y.w_p_b) || !sameBits(x.w_q_b, y.w_q_b))
+      return ::testing::AssertionFailure() << "pose[" << i << "]";
+  }
+  return ::testing::AssertionSuccess();
+}
+
+inline std::filesystem::path realDir() { return dataDir() / "real"; }
+
+}  // namespace uwb::test

@@ -1,0 +1,265 @@
+/** @file PoseTrackTest.cpp
+ *  @brief Ground-truth track: interpolation, gaps, glitch rejection, TDoA residuals (synthetic and real).
+ */
+#include "uwb/io/PoseTrack.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "IoTestHelpers.h"
+#include "uwb/io/UtilCsv.h"
+#include "uwb/model/TdoaModel.h"
+
+namespace uwb {
+namespace {
+
+Quat yaw(double rad) { return Quat(Eigen::AngleAxisd(rad, Vec3::UnitZ())); }
+Quat roll(double rad) { return Quat(Eigen::AngleAxisd(rad, Vec3::UnitX())); }
+
+/// A circle at 1.5 m height, radius 1.5 m, ω rad/s, sampled at `rate_hz`, yawing slowly.
+std::vector<PoseSample> circle(double rate_hz, double duration_s, double omega = 1.0) {
+  std::vector<PoseSample> out;
+  for (int i = 0; i * (1.0 / rate_hz) <= duration_s; ++i) {
+    const double t = i / rate_hz;
+    out.push_back({t, Vec3(1.5 * std::cos(omega * t), 1.5 * std::sin(omega * t), 1.5), yaw(0.1 * t)});
+  }
+  return out;
+}
+
+AnchorSurvey cornerSurvey() {
+  AnchorSurvey s;
+  const double z[8] = {0.2, 2.9, 0.2, 3.2, 3.0, 0.2, 3.1, 0.2};
+  const double xy[8][2] = {{-3, -4}, {-3.2, 3.8}, {3.7, 3.7}, {4.1, -4.3}, {-3, -4.4}, {3.9, -3.8}, {4, 3.9}, {-3.2, 3.3}};
+  for (int i = 0; i < 8; ++i) s.anchors.push_back({i, Vec3(xy[i][0], xy[i][1], z[i]), Quat::Identity()});
+  return s;
+}
+
+TEST(PoseTrack, InterpolatesPositionLinearlyAndAttitudeBySlerp) {
+  // GIVEN two samples 10 ms apart, yaw 0 → 0.2 rad
+  const std::vector<PoseSample> s = {{1.0, Vec3(0, 0, 1), yaw(0.0)}, {1.01, Vec3(0.1, -0.2, 1.3), yaw(0.2)}};
+  const PoseTrack track(s, /*has_orientation=*/true);
+  // WHEN interpolated a quarter of the way
+  const auto p = track.interpolate(1.0025);
+  // THEN position is linear and the attitude is the slerp (yaw 0.05 rad)
+  ASSERT_TRUE(p.has_value());
+  EXPECT_NEAR(p->t_s, 1.0025, 0);
+  EXPECT_TRUE(p->w_p_b.isApprox(Vec3(0.025, -0.05, 1.075), 1e-12));
+  EXPECT_NEAR(p->w_q_b.angularDistance(yaw(0.05)), 0.0, 1e-9);
+  // and the end points are reproduced
+  EXPECT_TRUE(track.interpolate(1.0)->w_p_b.isApprox(s[0].w_p_b));
+  EXPECT_TRUE(track.interpolate(1.01)->w_p_b.isApprox(s[1].w_p_b));
+}
+
+TEST(PoseTrack, NoGroundTruthOutsideTheTrackOrAcrossAGap) {
+  // GIVEN samples at 0, 0.01, then a 60 ms gap to 0.07
+  const std::vector<PoseSample> s = {
+      {0.0, Vec3::Zero(), Quat::Identity()}, {0.01, Vec3::Zero(), Quat::Identity()}, {0.07, Vec3::Zero(), Quat::Identity()}};
+  const PoseTrack track(s, true);
+  EXPECT_FALSE(track.interpolate(-0.001).has_value());
+  EXPECT_FALSE(track.interpolate(0.0701).has_value());
+  EXPECT_TRUE(track.interpolate(0.005).has_value());
+  EXPECT_FALSE(track.interpolate(0.03).has_value()) << "across a gap > 50 ms";
+  EXPECT_TRUE(track.interpolate(0.07).has_value());
+  EXPECT_FALSE(PoseTrack().interpolate(0.0).has_value());
+}
+
+TEST(PoseTrack, PositionOnlyTrackInterpolatesIdentityAttitude) {
+  const std::vector<PoseSample> s = {{0.0, Vec3(0, 0, 0), roll(0.5)}, {0.01, Vec3(1, 0, 0), roll(0.5)}};
+  const PoseTrack track(s, /*has_orientation=*/false);
+  const auto p = track.interpolate(0.005);
+  ASSERT_TRUE(p);
+  EXPECT_TRUE(p->w_q_b.isApprox(Quat::Identity()));
+  EXPECT_FALSE(track.hasOrientation());
+}
+
+TEST(PoseTrack, SmoothFastCircleHasNoGlitches) {
+  // GIVEN a 2 m/s circle at 200 Hz with a few sparse stretches (every 8th sample kept for 1 s)
+  std::vector<PoseSample> s = circle(200.0, 10.0, /*omega=*/1.4);
+  std::vector<PoseSample> sparse;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s[i].t_s > 4.0 && s[i].t_s < 5.0 && i % 8 != 0) continue;
+    sparse.push_back(s[i]);
+  }
+  const PoseTrack track(sparse, true);
+  EXPECT_TRUE(track.glitches().empty()) << "first glitch at t=" << track.glitches().front().t_s;
+  EXPECT_EQ(track.samples().size(), sparse.size());
+}
+
+TEST(PoseTrack, SingleSampleRollFlipIsRejectedAndCounted) {
+  // GIVEN a circle with one sample rolled by 170° (the 0425-traj9 / 0426-traj12 glitch)
+  std::vector<PoseSample> s = circle(250.0, 4.0);
+  const std::size_t k = 500;
+  s[k].w_q_b = s[k].w_q_b * roll(170.0 * kDegToRad);
+  // WHEN the track is built
+  const PoseTrack track(s, true);
+  // THEN exactly that sample is rejected as an attitude glitch and interpolation skips it
+  ASSERT_EQ(track.glitches().size(), 1u);
+  EXPECT_EQ(track.glitches()[0].index, k);
+  EXPECT_EQ(track.glitches()[0].kind, PoseGlitchKind::kAttitude);
+  EXPECT_NEAR(track.glitches()[0].magnitude, 170.0 * kDegToRad, 0.01);
+  EXPECT_EQ(track.countGlitches(PoseGlitchKind::kAttitude), 1u);
+  EXPECT_EQ(track.samples().size(), s.size() - 1);
+  const auto p = track.interpolate(s[k].t_s);
+  ASSERT_TRUE(p);
+  EXPECT_LT(p->w_q_b.angularDistance(s[k - 1].w_q_b), 0.01);
+}
+
+TEST(PoseTrack, RunOfFlippedAttitudesIsRejected) {
+  // GIVEN six consecutive flipped samples (≈ 25 ms), as in 0425-traj9 at t ≈ 14.0 s
+  std::vector<PoseSample> s = circle(250.0, 4.0);
+  for (std::size_t k = 300; k < 306; ++k) s[k].w_q_b = s[k].w_q_b * roll(-171.0 * kDegToRad);
+  const PoseTrack track(s, true);
+  EXPECT_EQ(track.countGlitches(PoseGlitchKind::kAttitude), 6u);
+  EXPECT_TRUE(track.interpolate(s[302].t_s).has_value()) << "a 28 ms hole is still interpolated";
+}
+
+TEST(PoseTrack, GlitchAtTheVeryStartIsRejected) {
+  std::vector<PoseSample> s = circle(250.0, 1.0);
+  s[0].w_q_b = s[0].w_q_b * roll(kPi * 0.95);
+  const PoseTrack track(s, true);
+  ASSERT_EQ(track.glitches().size(), 1u);
+  EXPECT_EQ(track.glitches()[0].index, 0u);
+}
+
+TEST(PoseTrack, LastingAttitudeChangeIsMotionNotAGlitch) {
+  // GIVEN a step of 90° in yaw that lasts (not a physical motion, but it persists for 0.5 s)
+  std::vector<PoseSample> s = circle(250.0, 1.0);
+  for (std::size_t k = 100; k < s.size(); ++k) s[k].w_q_b = yaw(kPi / 2);
+  const PoseTrack track(s, true);
+  // THEN only the samples within max_glitch_run_s of the step are rejected, then it is accepted
+  EXPECT_LE(static_cast<double>(track.glitches().size()), 0.1 * 250.0 + 2);
+  EXPECT_TRUE(track.interpolate(0.9).has_value());
+  EXPECT_LT(track.interpolate(0.9)->w_q_b.angularDistance(yaw(kPi / 2)), 1e-9);
+}
+
+TEST(PoseTrack, PositionSpikeIsRejected) {
+  // GIVEN a 0.23 m single-sample jump (0425-traj9 t ≈ 9.69 s) and a 4.6 cm one (0425-traj10)
+  std::vector<PoseSample> s = circle(270.0, 3.0);
+  s[200].w_p_b += Vec3(0.23, 0.0, 0.0);
+  s[500].w_p_b += Vec3(0.0, -0.046, 0.0);
+  const PoseTrack track(s, true);
+  ASSERT_EQ(track.glitches().size(), 2u);
+  EXPECT_EQ(track.glitches()[0].index, 200u);
+  EXPECT_EQ(track.glitches()[0].kind, PoseGlitchKind::kPosition);
+  EXPECT_NEAR(track.glitches()[0].magnitude, 0.23, 0.005);
+  EXPECT_EQ(track.glitches()[1].index, 500u);
+  EXPECT_EQ(track.countGlitches(PoseGlitchKind::kPosition), 2u);
+}
+
+TEST(PoseTrack, InvalidParamsAndUnsortedSamplesThrow) {
+  PoseTrackParams bad;
+  bad.max_gap_s = 0.0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  EXPECT_THROW(PoseTrack({}, true, bad), std::invalid_argument);
+  const std::vector<PoseSample> unsorted = {{1.0, Vec3::Zero(), Quat::Identity()}, {0.5, Vec3::Zero(), Quat::Identity()}};
+  EXPECT_THROW(PoseTrack(unsorted, true), std::invalid_argument);
+}
+
+// ------------------------------------------------------------------------------------------------ residuals
+
+TEST(TdoaResiduals, NoiseFreeMeasurementsHaveZeroResidualWithTheLeverArmInTheBodyFrame) {
+  // GIVEN a flight whose TDoA is generated from the ground truth with the UTIL lever arm, rolled 20°
+  const AnchorSurvey survey = cornerSurvey();
+  Flight f;
+  f.pose = circle(200.0, 2.0);
+  for (auto& p : f.pose) p.w_q_b = p.w_q_b * roll(0.35);
+  f.pose_has_orientation = true;
+  for (int i = 0; i < 300; ++i) {
+    const double t = 0.0033 * i + 0.001;
+    const int a = i % 8;
+    const int b = (i + 1) % 8;
+    const PoseSample gt = *PoseTrack(f).interpolate(t);
+    f.tdoa.push_back({t, a, b, predictTdoa(gt.w_p_b, gt.w_q_b, kUtilTagOffset_b, survey.position(a), survey.position(b))});
+  }
+  // WHEN residuals are computed
+  TdoaResidualReport report;
+  const auto r = tdoaResiduals(f, survey, PoseTrack(f), {}, &report);
+  // THEN they vanish and everything is airborne
+  ASSERT_EQ(r.size(), 300u);
+  EXPECT_EQ(report.n_residuals, 300u);
+  EXPECT_EQ(report.n_no_ground_truth, 0u);
+  for (const auto& x : r) {
+    EXPECT_NEAR(x.residual_m, 0.0, 1e-12);
+    EXPECT_TRUE(x.airborne);
+    EXPECT_DOUBLE_EQ(x.measured_m - x.predicted_m, x.residual_m);
+  }
+  EXPECT_EQ(r[5].index, 5u);
+}
+
+TEST(TdoaResiduals, SignConventionIsRangeToBMinusRangeToA) {
+  // GIVEN a tag at the origin (no lever arm), anchor A at 1 m and anchor B at 3 m, measurement 2.5 m
+  AnchorSurvey survey;
+  survey.anchors = {{0, Vec3(1, 0, 0), Quat::Identity()}, {1, Vec3(0, 3, 0), Quat::Identity()}};
+  Flight f;
+  f.pose = {{0.0, Vec3::Zero(), Quat::Identity()}, {0.01, Vec3::Zero(), Quat::Identity()}};
+  f.pose_has_orientation = true;
+  f.tdoa = {{0.005, 0, 1, 2.5}};
+  TdoaResidualParams params;
+  params.b_t_tag = Vec3::Zero();
+  const auto r = tdoaResiduals(f, survey, PoseTrack(f), params);
+  ASSERT_EQ(r.size(), 1u);
+  EXPECT_NEAR(r[0].predicted_m, 2.0, 1e-12);  // |p − a_B| − |p − a_A| = 3 − 1
+  EXPECT_NEAR(r[0].residual_m, 0.5, 1e-12);
+  EXPECT_FALSE(r[0].airborne) << "z = 0";
+}
+
+TEST(TdoaResiduals, PositionOnlyTrackAddsTheLeverArmInTheWorldFrame) {
+  const AnchorSurvey survey = cornerSurvey();
+  Flight f;
+  f.pose = {{0.0, Vec3(0.5, 0.2, 1.0), Quat::Identity()}, {0.01, Vec3(0.5, 0.2, 1.0), Quat::Identity()}};
+  f.pose_has_orientation = false;
+  const Vec3 w_p_tag = Vec3(0.5, 0.2, 1.0) + kUtilTagOffset_b;
+  const double h = (w_p_tag - survey.position(3)).norm() - (w_p_tag - survey.position(2)).norm();
+  f.tdoa = {{0.004, 2, 3, h + 0.1}};
+  const auto r = tdoaResiduals(f, survey, PoseTrack(f));
+  ASSERT_EQ(r.size(), 1u);
+  EXPECT_NEAR(r[0].residual_m, 0.1, 1e-12);
+}
+
+TEST(TdoaResiduals, MeasurementsWithoutTruthOrAnchorAreCountedNotDropped) {
+  const AnchorSurvey survey = cornerSurvey();
+  Flight f;
+  f.pose = circle(200.0, 1.0);
+  f.pose_has_orientation = true;
+  f.tdoa = {{-0.5, 0, 1, 0.0}, {0.5, 0, 1, 0.0}, {0.6, 0, 9, 0.0}, {2.0, 1, 2, 0.0}};
+  TdoaResidualReport report;
+  const auto r = tdoaResiduals(f, survey, PoseTrack(f), {}, &report);
+  EXPECT_EQ(r.size(), 1u);
+  EXPECT_EQ(report.n_measurements, 4u);
+  EXPECT_EQ(report.n_no_ground_truth, 2u);
+  EXPECT_EQ(report.n_unknown_anchor, 1u);
+  EXPECT_EQ(report.n_residuals + report.n_no_ground_truth + report.n_unknown_anchor, report.n_measurements);
+}
+
+TEST(RealDataPoseTrack, Traj9GlitchesFromSourceMdAreFound) {
+  const auto path = test::pilotFlight("0425-traj9");
+  UWB_REQUIRE_REAL_DATA(path);
+  const Flight f = readFlightCsv(path->string());
+  const PoseTrack track(f);
+  // SOURCE.md: roll ≈ ±170° near t ≈ 14.1 s and a 0.23 m position jump
+  bool attitude_near_14 = false;
+  double max_position_jump = 0.0;
+  for (const auto& g : track.glitches()) {
+    if (g.kind == PoseGlitchKind::kAttitude && std::abs(g.t_s - 14.05) < 0.1) attitude_near_14 = true;
+    if (g.kind == PoseGlitchKind::kPosition) max_position_jump = std::max(max_position_jump, g.magnitude);
+  }
+  EXPECT_TRUE(attitude_near_14);
+  EXPECT_NEAR(max_position_jump, 0.23, 0.01);
+  EXPECT_LT(track.glitches().size(), 30u) << "glitches are rare";
+  // no accepted sample is rolled more than 90° (the drone never flips)
+  for (const auto& s : track.samples()) {
+    const Vec3 b_z_w = s.w_q_b.conjugate() * Vec3::UnitZ();
+    EXPECT_GT(b_z_w.z(), 0.0) << "t=" << s.t_s;
+  }
+}
+
+TEST(RealDataPoseTrack, FlightsWithoutKnownGlitchesHaveFew) {
+  const auto path = test::pilotFlight("0425-traj2");
+  UWB_REQUIRE_REAL_DATA(path);
+  const PoseTrack track(readFlightCsv(path->string()));
+  EXPECT_LE(track.glitches().size(), 3u);
+}
+
+}  // namespace
+}  // namespace uwb

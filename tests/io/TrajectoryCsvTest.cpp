@@ -1,0 +1,75 @@
+/** @file TrajectoryCsvTest.cpp
+ *  @brief Estimated-trajectory CSV: exact round trip and malformed input.
+ */
+#include "uwb/io/TrajectoryCsv.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "IoTestHelpers.h"
+#include "uwb/core/Error.h"
+
+namespace uwb {
+namespace {
+
+using test::TempDir;
+
+TEST(TrajectoryCsv, RoundTripIsExact) {
+  // GIVEN a trajectory with arbitrary doubles (seed 3)
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0.0, 1.0);
+  Trajectory traj;
+  for (int i = 0; i < 50; ++i) {
+    TrajectorySample s;
+    s.t_s = 0.01 * i;
+    s.w_p_b = Vec3(n(rng), n(rng), n(rng));
+    s.w_q_b = Quat(n(rng), n(rng), n(rng), n(rng)).normalized();
+    s.sigma_p_m = Vec3(n(rng), n(rng), n(rng)).cwiseAbs();
+    s.w_v_b = Vec3(n(rng), n(rng), n(rng));
+    traj.push_back(s);
+  }
+  // WHEN written and read back
+  TempDir dir;
+  writeTrajectoryCsv(traj, dir.file("t.csv"));
+  const Trajectory back = readTrajectoryCsv(dir.file("t.csv"));
+  // THEN bit-identical
+  ASSERT_EQ(back.size(), traj.size());
+  for (std::size_t i = 0; i < traj.size(); ++i) {
+    EXPECT_TRUE(test::sameBits(back[i].t_s, traj[i].t_s));
+    EXPECT_TRUE(test::sameBits(back[i].w_p_b, traj[i].w_p_b));
+    EXPECT_TRUE(test::sameBits(back[i].w_q_b, traj[i].w_q_b));
+    EXPECT_TRUE(test::sameBits(back[i].sigma_p_m, traj[i].sigma_p_m));
+    EXPECT_TRUE(test::sameBits(back[i].w_v_b, traj[i].w_v_b));
+  }
+}
+
+TEST(TrajectoryCsv, EmptyTrajectoryRoundTrips) {
+  TempDir dir;
+  writeTrajectoryCsv({}, dir.file("e.csv"));
+  EXPECT_TRUE(readTrajectoryCsv(dir.file("e.csv")).empty());
+}
+
+TEST(TrajectoryCsv, MalformedInputNamesTheLocation) {
+  TempDir dir;
+  const std::string header = "t,x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz\n";
+  const auto expectError = [&](const std::string& text, const std::string& part) {
+    const std::string path = dir.write("m.csv", text);
+    try {
+      (void)readTrajectoryCsv(path);
+      ADD_FAILURE() << text;
+    } catch (const InputError& e) {
+      EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr(part));
+    }
+  };
+  expectError("", "missing header");
+  expectError("t,x,y\n", "missing column 'z'");
+  expectError(header + "0,1,2,3,0,0,0,1,0.1,0.1,0.1,0,0,oops\n", ":2:14 (vz)");
+  expectError(header + "1,1,2,3,0,0,0,1,0.1,0.1,0.1,0,0,0\n0.5,1,2,3,0,0,0,1,0.1,0.1,0.1,0,0,0\n", "backwards");
+  expectError(header + "1,1,2,3\n", "row has 4 fields");
+  EXPECT_THROW((void)readTrajectoryCsv(dir.file("none.csv")), FileError);
+}
+
+}  // namespace
+}  // namespace uwb
