@@ -1,0 +1,251 @@
+/** @file cmd_localize.cpp
+ *  @brief `uwbtdoa localize FLIGHT.csv --anchors SURVEY.txt [--out TRAJ.csv] [--json] [--config FILE.json] ...`:
+ *         runs the localization filter (IMU-driven ESKF, or TDoA-only without IMU), writes the trajectory and
+ *         prints the position RMSE against the flight's ground truth (issue 3, "Command line").
+ */
+#include <chrono>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "Command.h"
+#include "uwb/core/Error.h"
+#include "uwb/eval/Localization.h"
+#include "uwb/io/UtilCsv.h"
+
+namespace {
+
+using nlohmann::json;
+
+Eigen::Vector3d parseVec3(const std::string& s, const char* what) {
+  std::stringstream ss(s);
+  std::string item;
+  std::vector<double> v;
+  while (std::getline(ss, item, ',')) {
+    try {
+      v.push_back(std::stod(item));
+    } catch (const std::exception&) {
+      throw std::invalid_argument(std::string(what) + ": expected x,y,z numbers, got '" + s + "'");
+    }
+  }
+  if (v.size() != 3) throw std::invalid_argument(std::string(what) + ": expected three numbers x,y,z, got '" + s + "'");
+  return {v[0], v[1], v[2]};
+}
+
+/// Reads the keys of a JSON object into EkfParams (names as the struct fields); unknown keys are an error.
+void applyConfig(const json& j, uwb::EkfParams& p) {
+  if (!j.is_object()) throw std::invalid_argument("config: expected a JSON object of EkfParams fields");
+  for (const auto& [key, value] : j.items()) {
+    auto num = [&]() {
+      if (!value.is_number()) throw std::invalid_argument("config: '" + key + "' must be a number");
+      return value.get<double>();
+    };
+    auto vec = [&]() {
+      if (!value.is_array() || value.size() != 3) throw std::invalid_argument("config: '" + key + "' must be [x,y,z]");
+      return Eigen::Vector3d(value[0].get<double>(), value[1].get<double>(), value[2].get<double>());
+    };
+    if (key == "acc_noise_mps2_sqrthz") p.acc_noise_mps2_sqrthz = num();
+    else if (key == "lateral_acc_noise_mps2_sqrthz") p.lateral_acc_noise_mps2_sqrthz = num();
+    else if (key == "gyro_noise_radps_sqrthz") p.gyro_noise_radps_sqrthz = num();
+    else if (key == "acc_bias_rw_mps3_sqrthz") p.acc_bias_rw_mps3_sqrthz = num();
+    else if (key == "gyro_bias_rw_radps2_sqrthz") p.gyro_bias_rw_radps2_sqrthz = num();
+    else if (key == "pos_noise_m_sqrts") p.pos_noise_m_sqrts = num();
+    else if (key == "cv_acc_noise_mps2_sqrthz") p.cv_acc_noise_mps2_sqrthz = num();
+    else if (key == "ca_jerk_noise_mps3_sqrthz") p.ca_jerk_noise_mps3_sqrthz = num();
+    else if (key == "accel_model") p.accel_model = uwb::parseAccelModel(value.get<std::string>());
+    else if (key == "process_model") p.process_model = uwb::parseProcessModel(value.get<std::string>());
+    else if (key == "init_pos_sigma_m") p.init_pos_sigma_m = num();
+    else if (key == "init_vel_sigma_mps") p.init_vel_sigma_mps = num();
+    else if (key == "init_att_sigma_rad") p.init_att_sigma_rad = num();
+    else if (key == "init_yaw_sigma_rad") p.init_yaw_sigma_rad = num();
+    else if (key == "init_acc_bias_sigma_mps2") p.init_acc_bias_sigma_mps2 = num();
+    else if (key == "init_gyro_bias_sigma_radps") p.init_gyro_bias_sigma_radps = num();
+    else if (key == "b_t_tag") p.b_t_tag = vec();
+    else if (key == "tdoa_sigma_m") p.tdoa_sigma_m = num();
+    else if (key == "anchor_sigma_m") p.anchor_sigma_m = num();
+    else if (key == "gate_sigma") p.gate_sigma = num();
+    else if (key == "robust_loss") p.robust_loss = uwb::parseRobustLoss(value.get<std::string>());
+    else if (key == "robust_k") p.robust_k = num();
+    else if (key == "robust_iterations") p.robust_iterations = static_cast<int>(num());
+    else if (key == "max_lost_s") p.max_lost_s = num();
+    else if (key == "max_predict_dt_s") p.max_predict_dt_s = num();
+    else if (key == "cov_period_s") p.cov_period_s = num();
+    else if (key == "max_gap_s") p.max_gap_s = num();
+    else if (key == "ground_phase") p.ground_phase = uwb::parseGroundPhase(value.get<std::string>());
+    else if (key == "takeoff_climb_mps") p.takeoff_climb_mps = num();
+    else if (key == "takeoff_acc_mps2") p.takeoff_acc_mps2 = num();
+    else if (key == "landing_height_m") p.landing_height_m = num();
+    else if (key == "landing_hold_s") p.landing_hold_s = num();
+    else if (key == "acquisition_s") p.acquisition_s = num();
+    else if (key == "acquisition_tdoa_sigma_m") p.acquisition_tdoa_sigma_m = num();
+    else if (key == "start_w_p_b") {
+      p.start_w_p_b = vec();
+      p.has_start_position = true;
+    } else if (key == "ground_z_m") p.ground_z_m = num();
+    else throw std::invalid_argument("config: unknown key '" + key + "'");
+  }
+}
+
+json statsJson(const uwb::PositionErrorStats& s) {
+  return {{"n", s.n},
+          {"rmse_m", s.rmse_m},
+          {"rmse_x_m", s.rmse_axis_m.x()},
+          {"rmse_y_m", s.rmse_axis_m.y()},
+          {"rmse_z_m", s.rmse_axis_m.z()},
+          {"mean_m", s.mean_m},
+          {"p50_m", s.p50_m},
+          {"p90_m", s.p90_m},
+          {"p99_m", s.p99_m},
+          {"max_m", s.max_m}};
+}
+
+struct LocalizeArgs {
+  std::string flight, anchors, out, config, bias_model;
+  bool json_out = false, tdoa_only = false, no_ground_detect = false;
+  std::optional<double> tdoa_sigma, gate, robust_k, acc_noise, lateral_acc_noise, gyro_noise, acc_bias_rw,
+      gyro_bias_rw, cov_period;
+  std::string robust_loss, accel_model, process_model, tag_offset, start;
+  double output_period = 0.01;
+};
+
+void runLocalize(const LocalizeArgs& a) {
+  uwb::EkfParams params;
+  if (!a.config.empty()) {
+    std::ifstream in(a.config);
+    if (!in) throw uwb::FileError("cannot open config file '" + a.config + "'");
+    json j;
+    try {
+      in >> j;
+    } catch (const json::parse_error& e) {
+      throw uwb::InputError(uwb::SourceLocation{a.config, 0, 0, ""}, std::string("invalid JSON: ") + e.what());
+    }
+    applyConfig(j, params);
+  }
+  if (a.tdoa_sigma) params.tdoa_sigma_m = *a.tdoa_sigma;
+  if (a.gate) params.gate_sigma = *a.gate;
+  if (a.robust_k) params.robust_k = *a.robust_k;
+  if (a.acc_noise) params.acc_noise_mps2_sqrthz = *a.acc_noise;
+  if (a.lateral_acc_noise) params.lateral_acc_noise_mps2_sqrthz = *a.lateral_acc_noise;
+  if (a.gyro_noise) params.gyro_noise_radps_sqrthz = *a.gyro_noise;
+  if (a.acc_bias_rw) params.acc_bias_rw_mps3_sqrthz = *a.acc_bias_rw;
+  if (a.gyro_bias_rw) params.gyro_bias_rw_radps2_sqrthz = *a.gyro_bias_rw;
+  if (a.cov_period) params.cov_period_s = *a.cov_period;
+  if (!a.robust_loss.empty()) params.robust_loss = uwb::parseRobustLoss(a.robust_loss);
+  if (!a.accel_model.empty()) params.accel_model = uwb::parseAccelModel(a.accel_model);
+  if (!a.process_model.empty()) params.process_model = uwb::parseProcessModel(a.process_model);
+  if (!a.tag_offset.empty()) params.b_t_tag = parseVec3(a.tag_offset, "--tag-offset");
+  if (!a.start.empty()) {
+    params.start_w_p_b = parseVec3(a.start, "--start");
+    params.has_start_position = true;
+  }
+  if (a.no_ground_detect) params.ground_phase = uwb::GroundPhase::kNone;
+  params.validate();
+  if (!a.bias_model.empty())
+    throw std::invalid_argument("--bias-model: no bias-model loader is available in this build yet");
+
+  const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(a.anchors);
+  uwb::FlightReadOptions read_opt;
+  read_opt.required = {uwb::Stream::kTdoa};
+  read_opt.survey = &survey;
+  uwb::ReadReport read_report;
+  const uwb::Flight flight = uwb::readFlightCsv(a.flight, read_opt, &read_report);
+
+  uwb::LocalizationOptions opt;
+  opt.params = params;
+  opt.output_period_s = a.output_period;
+  opt.tdoa_only = a.tdoa_only;
+  const auto t0 = std::chrono::steady_clock::now();
+  const uwb::LocalizationRun run = uwb::localizeFlight(flight, survey, opt);
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!a.out.empty()) uwb::writeTrajectoryCsv(run.trajectory, a.out);
+
+  const uwb::LocalizerSummary& s = run.summary;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  json j;
+  j["flight"] = a.flight;
+  j["duration_s"] = run.duration_s;
+  j["process_model"] = uwb::toString(s.process_model);
+  j["n_tdoa"] = s.n_tdoa_total;
+  j["n_tdoa_used"] = s.n_tdoa_used;
+  j["n_tdoa_rejected"] = s.n_tdoa_rejected;
+  j["n_tdoa_downweighted"] = s.n_tdoa_downweighted;
+  j["n_tdoa_not_used_ground"] = s.n_tdoa_ground;
+  j["n_tdoa_degenerate"] = s.n_tdoa_degenerate;
+  j["n_reacquisitions"] = s.n_reacquisitions;
+  j["takeoff_t_s"] = std::isnan(s.takeoff_t_s) ? json(nullptr) : json(s.takeoff_t_s);
+  j["landing_t_s"] = std::isnan(s.landing_t_s) ? json(nullptr) : json(s.landing_t_s);
+  j["start_position_m"] = {s.start_w_p_b.x(), s.start_w_p_b.y(), s.start_w_p_b.z()};
+  j["merge_notes"] = s.merge.notes();
+  j["read_notes"] = read_report.notes;
+  j["wall_time_s"] = wall_s;
+  j["real_time_factor"] = wall_s > 0 ? run.duration_s / wall_s : nan;
+  if (run.metrics) {
+    const uwb::TrajectoryMetrics& m = *run.metrics;
+    j["rmse_m"] = m.whole.rmse_m;
+    j["rmse_airborne_m"] = m.airborne.n ? json(m.airborne.rmse_m) : json(nullptr);
+    j["whole"] = statsJson(m.whole);
+    j["airborne"] = statsJson(m.airborne);
+    j["n_truth_glitches"] = run.n_truth_glitches;
+  } else {
+    j["rmse_m"] = nullptr;
+    j["rmse_airborne_m"] = nullptr;
+  }
+  if (a.json_out) {
+    std::cout << j.dump() << '\n';
+    return;
+  }
+  std::cout << "flight " << a.flight << ": " << run.duration_s << " s, model " << uwb::toString(s.process_model)
+            << ", TDoA used " << s.n_tdoa_used << " / rejected " << s.n_tdoa_rejected << " / not used on ground "
+            << s.n_tdoa_ground << " of " << s.n_tdoa_total << "\n";
+  if (!std::isnan(s.takeoff_t_s)) std::cout << "take-off detected at " << s.takeoff_t_s << " s\n";
+  for (const std::string& n : s.merge.notes()) std::cout << "note: " << n << "\n";
+  if (run.metrics) {
+    const auto print = [](const char* name, const uwb::PositionErrorStats& st) {
+      std::printf("%-9s n=%6zu  RMSE 3D %.3f m  (x %.3f, y %.3f, z %.3f)  p50 %.3f  p90 %.3f  p99 %.3f m\n", name,
+                  st.n, st.rmse_m, st.rmse_axis_m.x(), st.rmse_axis_m.y(), st.rmse_axis_m.z(), st.p50_m, st.p90_m,
+                  st.p99_m);
+    };
+    print("whole", run.metrics->whole);
+    print("airborne", run.metrics->airborne);
+  } else {
+    std::cout << "no ground truth in the flight: no RMSE\n";
+  }
+  if (!a.out.empty()) std::cout << "trajectory written to " << a.out << "\n";
+}
+
+const bool kRegistered = uwb::app::registerCommand(
+    {"localize", "Localize a flight with the TDoA filter; write the trajectory, print RMSE against ground truth",
+     [](CLI::App& sub) {
+       auto a = std::make_shared<LocalizeArgs>();
+       sub.add_option("flight", a->flight, "Flight CSV (UTIL layout)")->required();
+       sub.add_option("--anchors", a->anchors, "Anchor survey (UTIL survey text)")->required();
+       sub.add_option("--out", a->out, "Write the estimated trajectory CSV here");
+       sub.add_flag("--json", a->json_out, "Print one JSON object with the results");
+       sub.add_option("--config", a->config, "JSON object of EkfParams fields (flags override it)");
+       sub.add_option("--tdoa-sigma", a->tdoa_sigma, "TDoA noise std used by the filter [m]");
+       sub.add_option("--gate", a->gate, "Mahalanobis gate on the normalised innovation [sigma]; 0 disables");
+       sub.add_option("--robust-loss", a->robust_loss, "none | huber | cauchy");
+       sub.add_option("--robust-k", a->robust_k, "Robust-loss scale on the normalised residual");
+       sub.add_option("--accel-model", a->accel_model, "thrust (Mueller et al.) | full");
+       sub.add_option("--process-model", a->process_model, "imu | cv | ca");
+       sub.add_option("--acc-noise", a->acc_noise, "Accelerometer noise [m/s^2/sqrt(Hz)]");
+       sub.add_option("--lateral-acc-noise", a->lateral_acc_noise, "Lateral acceleration noise [m/s^2/sqrt(Hz)]");
+       sub.add_option("--gyro-noise", a->gyro_noise, "Gyroscope noise [rad/s/sqrt(Hz)]");
+       sub.add_option("--acc-bias-rw", a->acc_bias_rw, "Accelerometer-bias random walk [m/s^3/sqrt(Hz)]");
+       sub.add_option("--gyro-bias-rw", a->gyro_bias_rw, "Gyroscope-bias random walk [rad/s^2/sqrt(Hz)]");
+       sub.add_option("--cov-period", a->cov_period, "Covariance propagation period [s] (0: before every update)");
+       sub.add_option("--tag-offset", a->tag_offset, "Tag position in the body frame x,y,z [m]");
+       sub.add_option("--start", a->start, "Start position of the body x,y,z [m] (default: multilateration)");
+       sub.add_flag("--tdoa-only", a->tdoa_only, "Ignore the IMU: constant-velocity model");
+       sub.add_flag("--no-ground-detect", a->no_ground_detect, "Use TDoA from the start (no take-off detection)");
+       sub.add_option("--output-period", a->output_period, "Trajectory sample spacing [s]");
+       sub.add_option("--bias-model", a->bias_model, "Bias model JSON (GP) to correct the TDoA");
+       sub.callback([a] { runLocalize(*a); });
+     }});
+
+}  // namespace

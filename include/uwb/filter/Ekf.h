@@ -1,0 +1,101 @@
+/** @file Ekf.h
+ *  @brief Error-state Kalman filter core (Crazyflie kalman_core / PX4 shape): predict, correct, reset.
+ *         docs/math/filter.md F1–F8.
+ *
+ *  The nominal state is integrated at every prediction; the error-state covariance is propagated with the
+ *  accumulated transition Φ = F_k ⋯ F_1 only when asked (propagateCovariance, F7), e.g. before a TDoA update
+ *  or at a fixed rate as Crazyflie does at 100 Hz. Φ is kept in its block structure (9 blocks of 3×3), so
+ *  accumulating one step costs a few 3×3 products and folding it into P costs O(15²·3).
+ */
+#pragma once
+
+#include <optional>
+
+#include "uwb/filter/EkfParams.h"
+#include "uwb/filter/NavState.h"
+#include "uwb/filter/QuadImuProcess.h"
+#include "uwb/filter/StateIndex.h"
+#include "uwb/graph/TdoaCorrection.h"
+
+namespace uwb {
+
+/// Accumulated error-state transition Φ in block form (F7); the identity when empty.
+struct AccumulatedTransition {
+  double T_s = 0.0;                      ///< accumulated time = Φ_pv / I
+  Mat3 pos_att = Mat3::Zero();
+  Mat3 pos_accbias = Mat3::Zero();
+  Mat3 pos_gyrobias = Mat3::Zero();
+  Mat3 vel_att = Mat3::Zero();
+  Mat3 vel_accbias = Mat3::Zero();
+  Mat3 vel_gyrobias = Mat3::Zero();
+  Mat3 att_att = Mat3::Identity();
+  Mat3 att_gyrobias = Mat3::Zero();
+  Vec3 q_vel_diag = Vec3::Zero();        ///< accumulated velocity process noise (F7 Q), per world axis [m²/s²]
+
+  /// Φ ← F Φ for one IMU step (F7).
+  void accumulate(const ImuStepJacobian& J);
+  /// Dense Φ (tests).
+  ErrMat dense() const;
+  /// Returns Φ M for a 15×15 M using the block structure.
+  ErrMat leftMultiply(const ErrMat& M) const;
+  bool empty() const { return T_s == 0.0; }
+};
+
+class Ekf {
+ public:
+  explicit Ekf(const EkfParams& params);
+
+  /// Sets the state and covariance; forgets any pending transition.
+  void initialize(const NavState& x0, const ErrMat& P0);
+
+  const NavState& state() const { return x_; }
+  /// Covariance at the last propagation (pending Φ not yet applied; call propagateCovariance first if needed).
+  const ErrMat& covariance() const { return P_; }
+  const EkfParams& params() const { return params_; }
+  /// Time since the last covariance propagation [s].
+  double pendingDt() const { return phi_.T_s + pending_cv_dt_s_; }
+
+  /// IMU prediction (F2–F5): integrates the nominal state, accumulates Φ. dt_s ≤ 0 is ignored.
+  void predict(const ImuReading& imu, double dt_s);
+  /// TDoA-only prediction (F9), constant velocity or constant acceleration per params.process_model.
+  void predictTdoaOnly(double dt_s);
+  /// P ← Φ P Φᵀ + Q(T) (F7), resets Φ.
+  void propagateCovariance();
+
+  /// Correction with a rank-one Gaussian message on δx (from the graph's TDoA node, G16), through the graph's
+  /// equality node (G18), followed by the reset (F8). Returns nullopt and leaves the filter unchanged if the
+  /// equality node fails (S ≤ 0 or not finite).
+  std::optional<InnovationStats> correct(const ScalarLinearMessage<kDim>& message);
+  /// Innovation statistics of a message without applying it (G17).
+  InnovationStats innovation(const ScalarLinearMessage<kDim>& message) const;
+
+  /// Zero-velocity update v = 0 with std sigma_mps per axis (F14), three scalar corrections.
+  void zeroVelocityUpdate(double sigma_mps);
+  /// Scalar pseudo-measurement of the position along world axis `axis` (0..2): p_axis = value ± sigma.
+  void positionUpdate(int axis, double value_m, double sigma_m);
+  /// Adds sigma² to the position (and optionally velocity) variances: used on re-acquisition.
+  void inflatePosition(double sigma_m, double vel_sigma_mps);
+  /// Overwrites the position; keeps other state; sets the position block of P to sigma² I, clears its correlations.
+  void resetPosition(const Vec3& w_p_b, double sigma_m);
+
+  /// Switches how the accelerometer enters the prediction (e.g. full on the ground, thrust-only in flight).
+  void setAccelModel(AccelModel model) { params_.accel_model = model; }
+
+  /// Folds an error-state estimate into the nominal state (F8): x ← x ⊞ δx. (P is kept; the first-order
+  /// attitude reset Jacobian is the identity up to O(|δθ|).)
+  void inject(const ErrVec& dx);
+
+ private:
+  EkfParams params_;
+  NavState x_;
+  ErrMat P_ = ErrMat::Identity();
+  AccumulatedTransition phi_;
+  double pending_cv_dt_s_ = 0.0;  ///< TDoA-only models propagate densely, kept for pendingDt
+  ErrMat phi_cv_ = ErrMat::Identity();
+  ErrMat q_cv_ = ErrMat::Zero();
+};
+
+/// The initial covariance from the params' init_* sigmas (F1).
+ErrMat initialCovariance(const EkfParams& params);
+
+}  // namespace uwb

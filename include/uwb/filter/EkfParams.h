@@ -1,0 +1,105 @@
+/** @file EkfParams.h
+ *  @brief Every tunable number of the localization filter, with units and defaults (one source of defaults).
+ *
+ *  Defaults were tuned on the 16 UTIL pilot TDoA2 flights (scripts/localize_all.sh); see docs/math/filter.md.
+ */
+#pragma once
+
+#include <string>
+
+#include "uwb/core/Types.h"
+
+namespace uwb {
+
+/// How the accelerometer enters the prediction (docs/math/filter.md F3).
+enum class AccelModel {
+  kFull,        ///< all three axes as specific force (standard strapdown INS)
+  kThrustOnly,  ///< Mueller et al. / Crazyflie in flight: specific force = (0, 0, a_z); x/y readings unused
+};
+
+/// Process model of the filter (docs/math/filter.md F3, F9).
+enum class ProcessModel {
+  kImu,                   ///< IMU-driven quadrotor model (needs accelerometer and gyroscope)
+  kConstantVelocity,      ///< TDoA only: white-noise acceleration
+  kConstantAcceleration,  ///< TDoA only: white-noise jerk (acceleration kept in the acc-bias block)
+};
+
+/// Robust loss of the iteratively reweighted TDoA update (docs/math/filter.md F13).
+enum class RobustLoss { kNone, kHuber, kCauchy };
+
+/// Strategy for the time on the ground before take-off (docs/math/filter.md F15–F16).
+enum class GroundPhase {
+  kDetectTakeoff,  ///< hold at rest (zero-velocity updates), ignore TDoA until take-off is detected
+  kNone,           ///< use TDoA from the first sample (e.g. flights that start in the air)
+};
+
+struct EkfParams {
+  // --- process noise (continuous-time spectral densities) ---
+  double acc_noise_mps2_sqrthz = 0.5;         ///< accelerometer white noise on v (and vertical in kThrustOnly)
+  double lateral_acc_noise_mps2_sqrthz = 1.0; ///< extra white acceleration on horizontal v (drag, kThrustOnly)
+  double gyro_noise_radps_sqrthz = 0.01;      ///< gyroscope white noise on δθ
+  double acc_bias_rw_mps3_sqrthz = 0.05;      ///< accelerometer-bias random walk
+  double gyro_bias_rw_radps2_sqrthz = 1e-4;   ///< gyroscope-bias random walk
+  double pos_noise_m_sqrts = 0.0;             ///< direct position random walk (Crazyflie procNoisePos)
+  double cv_acc_noise_mps2_sqrthz = 2.0;      ///< TDoA-only constant-velocity model: white acceleration
+  double ca_jerk_noise_mps3_sqrthz = 8.0;     ///< TDoA-only constant-acceleration model: white jerk
+  AccelModel accel_model = AccelModel::kThrustOnly;
+  ProcessModel process_model = ProcessModel::kImu;
+
+  // --- initial uncertainty ---
+  double init_pos_sigma_m = 2.0;
+  double init_vel_sigma_mps = 0.1;
+  double init_att_sigma_rad = 0.05;
+  double init_yaw_sigma_rad = 0.2;
+  double init_acc_bias_sigma_mps2 = 0.5;
+  double init_gyro_bias_sigma_radps = 0.05;
+
+  // --- TDoA measurement ---
+  Vec3 b_t_tag = kUtilTagOffset_b;       ///< tag (antenna) position in the body frame [m]
+  double tdoa_sigma_m = 0.35;            ///< TDoA noise std used by the filter (inflated for correlation, F12)
+  double anchor_sigma_m = 0.0;           ///< std of each surveyed anchor coordinate [m] (graph node anchors)
+  double gate_sigma = 4.0;               ///< Mahalanobis gate on the normalised innovation (χ²₁ = gate²)
+  RobustLoss robust_loss = RobustLoss::kHuber;
+  double robust_k = 1.5;                 ///< loss scale on the normalised innovation
+  int robust_iterations = 2;             ///< IRLS iterations per TDoA update (≥ 1)
+  double max_lost_s = 1.0;               ///< all TDoA rejected this long → re-acquire (inflate P, open gate)
+
+  // --- scheduling ---
+  double max_predict_dt_s = 0.005;       ///< IMU samples are averaged over at most this interval [s]
+  double cov_period_s = 0.01;            ///< covariance propagated with the accumulated Φ at this period [s]
+  double max_gap_s = 0.2;                ///< a sensor gap longer than this is reported [s]
+
+  // --- ground phase and start ---
+  GroundPhase ground_phase = GroundPhase::kDetectTakeoff;
+  double takeoff_climb_mps = 0.25;       ///< take-off: vertical velocity from the accelerometer above this
+  double takeoff_acc_mps2 = 0.6;         ///< …or mean vertical specific-force excess over 0.1 s above this
+  double landing_height_m = 0.12;        ///< landed: estimate this close to the take-off height …
+  double landing_hold_s = 0.5;           ///< … and nearly still for this long
+  double acquisition_s = 1.0;            ///< after take-off: robust, gate-free acquisition window [s]
+  double acquisition_tdoa_sigma_m = 0.6; ///< TDoA std used during acquisition
+  bool has_start_position = false;       ///< true: start at start_w_p_b instead of multilateration
+  Vec3 start_w_p_b = Vec3::Zero();       ///< user-given start (body origin, world) [m]
+  double ground_z_m = 0.0;               ///< floor height for the pre-take-off height prior [m]
+
+  /// Throws std::invalid_argument naming the first field that is out of range.
+  void validate() const;
+
+  /// The defaults: tuned on the UTIL pilot flights.
+  static EkfParams defaults() { return {}; }
+  /// Crazyflie kalman_core-like: thrust-only accelerometer, Crazyflie-style noise levels, no robust loss.
+  static EkfParams crazyflieLike();
+  /// TDoA only (no IMU): constant-velocity process model, no take-off detection.
+  static EkfParams tdoaOnly();
+};
+
+std::string toString(AccelModel m);
+std::string toString(ProcessModel m);
+std::string toString(RobustLoss l);
+std::string toString(GroundPhase g);
+/// Parse the names printed by toString; throws std::invalid_argument for an unknown name.
+AccelModel parseAccelModel(const std::string& s);
+ProcessModel parseProcessModel(const std::string& s);
+RobustLoss parseRobustLoss(const std::string& s);
+GroundPhase parseGroundPhase(const std::string& s);
+
+}  // namespace uwb

@@ -1,0 +1,68 @@
+/** @file SensorEvents.h
+ *  @brief Merging the IMU and TDoA streams into one time-ordered event sequence, with duplicates,
+ *         out-of-order stamps, non-finite values and gaps counted (docs/math/filter.md F17).
+ */
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "uwb/filter/NavState.h"
+#include "uwb/filter/TdoaUpdate.h"
+
+namespace uwb {
+
+/// A time-stamped 3-vector (one accelerometer or gyroscope sample) [s], [SI].
+struct TimedVec3 {
+  double t_s = 0.0;
+  Vec3 value = Vec3::Zero();
+};
+
+/// A paired IMU sample.
+struct TimedImu {
+  double t_s = 0.0;
+  ImuReading imu;
+};
+
+/// Sensor streams as the filter consumes them.
+struct SensorLog {
+  std::vector<TimedImu> imu;
+  std::vector<TdoaObservation> tdoa;
+};
+
+/// What merging found; nothing is dropped silently.
+struct MergeReport {
+  std::size_t n_imu_in = 0, n_tdoa_in = 0;
+  std::size_t n_imu_duplicate = 0;      ///< identical stamp as the previous IMU sample (later one dropped)
+  std::size_t n_tdoa_duplicate = 0;     ///< identical stamp, pair and value (later one dropped)
+  std::size_t n_imu_out_of_order = 0;   ///< stamp earlier than its predecessor in the file (re-sorted)
+  std::size_t n_tdoa_out_of_order = 0;
+  std::size_t n_nonfinite = 0;          ///< samples with a non-finite stamp or value (dropped)
+  std::size_t n_imu_gaps = 0;           ///< gaps longer than max_gap_s between consecutive IMU samples
+  std::size_t n_tdoa_gaps = 0;
+  double max_imu_gap_s = 0.0;
+  double max_tdoa_gap_s = 0.0;
+  std::size_t n_imu_unpaired = 0;       ///< acc samples without a gyro sample close in time (held gyro used)
+  /// Human-readable one-liners of everything non-zero above.
+  std::vector<std::string> notes() const;
+};
+
+/// Pairs accelerometer and gyroscope streams into IMU samples at the accelerometer stamps; the gyro value is
+/// the latest gyro sample at or before that stamp (zero-order hold; the first gyro sample before any).
+std::vector<TimedImu> pairImuStreams(const std::vector<TimedVec3>& acc, const std::vector<TimedVec3>& gyro,
+                                     MergeReport* report = nullptr);
+
+/// One event of the merged sequence: an index into SensorLog::imu or SensorLog::tdoa.
+struct SensorEvent {
+  enum class Kind : unsigned char { kImu, kTdoa };
+  double t_s = 0.0;
+  Kind kind = Kind::kImu;
+  unsigned index = 0;
+};
+
+/// Cleans `log` in place (drops non-finite samples and duplicates, stably sorts each stream by time) and returns
+/// the merged event sequence, ordered by time; at equal stamps IMU comes before TDoA.
+std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, MergeReport* report = nullptr);
+
+}  // namespace uwb

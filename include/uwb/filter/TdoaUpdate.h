@@ -1,0 +1,71 @@
+/** @file TdoaUpdate.h
+ *  @brief One TDoA correction of the filter through the graph's TDoA node (paper III-A, Fig. 2–3):
+ *         bias correction (issue 5, paper III-B), χ² gate, robust IRLS weight, equality node, reset.
+ *         docs/math/filter.md F10–F13; docs/math/message-passing.md G11–G18.
+ */
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "uwb/filter/Ekf.h"
+#include "uwb/filter/OutlierGate.h"
+#include "uwb/graph/GaussianMessage.h"
+#include "uwb/model/TdoaFeature.h"
+
+namespace uwb {
+
+/// Anchor beliefs addressed by id (the graph node treats anchors as Gaussian variables, paper III-A).
+class AnchorTable {
+ public:
+  /// Adds or replaces anchor `id` (≥ 0) with mean w_p [m] and isotropic std sigma_m.
+  void set(int id, const Vec3& w_p, double sigma_m = 0.0);
+  /// nullptr when the id is unknown.
+  const Moments3* find(int id) const {
+    return (id >= 0 && id < static_cast<int>(anchors_.size()) && known_[id]) ? &anchors_[id] : nullptr;
+  }
+  std::vector<int> ids() const;
+  std::size_t size() const;
+
+ private:
+  std::vector<Moments3> anchors_;
+  std::vector<bool> known_;
+};
+
+/// One TDoA as the filter sees it: tdoa_m = |p_tag − a_B| − |p_tag − a_A| (UTIL convention).
+struct TdoaObservation {
+  double t_s = 0.0;
+  int id_a = 0;
+  int id_b = 0;
+  double tdoa_m = 0.0;
+};
+
+struct TdoaUpdateOptions {
+  double sigma_m = 0.35;       ///< measurement std before bias-model variance [m]
+  double gate_sigma = 4.0;     ///< χ² gate on √NIS; ≤ 0 disables the gate
+  RobustLoss loss = RobustLoss::kHuber;
+  double robust_k = 1.5;
+  int robust_iterations = 2;
+  Vec3 b_t_tag = kUtilTagOffset_b;
+};
+
+struct TdoaUpdateResult {
+  UpdateOutcome outcome = UpdateOutcome::kSkipped;
+  double innovation_m = 0.0;  ///< z_corrected − ẑ (prior)
+  double nis = 0.0;           ///< r²/S with the unweighted measurement variance
+  double weight = 1.0;        ///< IRLS weight applied (1 = full)
+  double bias_mean_m = 0.0;   ///< bias-model correction subtracted from z
+};
+
+/// The TDoA message on the error state from the graph's TDoA node (G11–G16), without applying it.
+/// nullopt when an anchor is unknown or the geometry is degenerate (tag on an anchor).
+std::optional<ScalarLinearMessage<kDim>> tdoaMessage(const NavState& x, const AnchorTable& anchors,
+                                                     const TdoaObservation& z, double z_corrected_m, double var_m2,
+                                                     const Vec3& b_t_tag);
+
+/// Full TDoA update of `ekf` (F10–F13). The covariance should be propagated (Ekf::propagateCovariance) by the
+/// caller according to its schedule. `bias` may be null (no bias correction).
+TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObservation& z,
+                            const TdoaUpdateOptions& options, const BiasPredictor* bias = nullptr);
+
+}  // namespace uwb

@@ -1,0 +1,68 @@
+/** @file Localization.cpp
+ *  @brief Flight → filter → trajectory and metrics.
+ */
+#include "uwb/eval/Localization.h"
+
+#include "uwb/io/PoseTrack.h"
+
+namespace uwb {
+
+SensorLog sensorLogFromFlight(const Flight& flight, MergeReport* report) {
+  SensorLog log;
+  if (flight.hasImu()) {
+    std::vector<TimedVec3> acc, gyro;
+    acc.reserve(flight.acc.size());
+    gyro.reserve(flight.gyro.size());
+    for (const ImuSample& s : flight.acc) acc.push_back({s.t_s, s.b_value});
+    for (const ImuSample& s : flight.gyro) gyro.push_back({s.t_s, s.b_value});
+    log.imu = pairImuStreams(acc, gyro, report);
+  }
+  log.tdoa.reserve(flight.tdoa.size());
+  for (const TdoaMeasurement& m : flight.tdoa) log.tdoa.push_back({m.t_s, m.id_a, m.id_b, m.tdoa_m});
+  return log;
+}
+
+AnchorTable anchorTableFromSurvey(const AnchorSurvey& survey, double anchor_sigma_m) {
+  AnchorTable table;
+  for (const Anchor& a : survey.anchors) table.set(a.id, a.w_p, anchor_sigma_m);
+  return table;
+}
+
+Trajectory toTrajectory(const std::vector<LocalizerEstimate>& estimates) {
+  Trajectory out;
+  out.reserve(estimates.size());
+  for (const LocalizerEstimate& e : estimates) {
+    TrajectorySample s;
+    s.t_s = e.t_s;
+    s.w_p_b = e.x.w_p_b;
+    s.w_q_b = e.x.w_q_b;
+    s.sigma_p_m = e.sigma_p_m;
+    s.w_v_b = e.x.w_v_b;
+    out.push_back(s);
+  }
+  return out;
+}
+
+LocalizationRun localizeFlight(const Flight& flight, const AnchorSurvey& survey, const LocalizationOptions& options,
+                               const BiasPredictor& bias) {
+  EkfParams params = options.params;
+  if (options.tdoa_only && params.process_model == ProcessModel::kImu)
+    params.process_model = ProcessModel::kConstantVelocity;
+  MergeReport pair_report;
+  SensorLog log = sensorLogFromFlight(flight, &pair_report);
+  const TdoaLocalizer localizer(params, anchorTableFromSurvey(survey, params.anchor_sigma_m), bias);
+  LocalizerResult res = localizer.run(std::move(log), options.output_period_s);
+  res.summary.merge.n_imu_unpaired = pair_report.n_imu_unpaired;
+  LocalizationRun run;
+  run.trajectory = toTrajectory(res.estimates);
+  run.summary = res.summary;
+  run.duration_s = res.summary.end_t_s - res.summary.start_t_s;
+  if (flight.hasGroundTruth()) {
+    const PoseTrack track(flight);
+    run.n_truth_glitches = track.glitches().size();
+    run.metrics = computeTrajectoryMetrics(run.trajectory, track.samples(), options.metrics);
+  }
+  return run;
+}
+
+}  // namespace uwb

@@ -1,0 +1,203 @@
+/** @file Ekf.cpp
+ *  @brief Error-state Kalman filter core; docs/math/filter.md F1–F8, F14. The correction goes through the
+ *         graph's equality node (paper Fig. 3; docs/math/message-passing.md G18).
+ */
+#include "uwb/filter/Ekf.h"
+
+#include <stdexcept>
+
+namespace uwb {
+
+void AccumulatedTransition::accumulate(const ImuStepJacobian& J) {
+  // docs/math/filter.md (F7): Φ ← F Φ with F from (F4); only the non-trivial blocks change.
+  const double dt = J.dt_s;
+  const Mat3 F_p_att = 0.5 * dt * J.F_v_att;
+  const Mat3 F_p_ba = 0.5 * dt * J.F_v_accbias;
+  pos_att += dt * vel_att + F_p_att * att_att;
+  pos_accbias += dt * vel_accbias + F_p_ba;
+  pos_gyrobias += dt * vel_gyrobias + F_p_att * att_gyrobias;
+  vel_att += J.F_v_att * att_att;
+  vel_accbias += J.F_v_accbias;
+  vel_gyrobias += J.F_v_att * att_gyrobias;
+  att_gyrobias = J.F_att_att * att_gyrobias + J.F_att_gyrobias;
+  att_att = J.F_att_att * att_att;
+  T_s += dt;
+}
+
+ErrMat AccumulatedTransition::dense() const {
+  ErrMat F = ErrMat::Identity();
+  F.block<3, 3>(kPos, kVel) = T_s * Mat3::Identity();
+  F.block<3, 3>(kPos, kAtt) = pos_att;
+  F.block<3, 3>(kPos, kAccBias) = pos_accbias;
+  F.block<3, 3>(kPos, kGyroBias) = pos_gyrobias;
+  F.block<3, 3>(kVel, kAtt) = vel_att;
+  F.block<3, 3>(kVel, kAccBias) = vel_accbias;
+  F.block<3, 3>(kVel, kGyroBias) = vel_gyrobias;
+  F.block<3, 3>(kAtt, kAtt) = att_att;
+  F.block<3, 3>(kAtt, kGyroBias) = att_gyrobias;
+  return F;
+}
+
+ErrMat AccumulatedTransition::leftMultiply(const ErrMat& M) const {
+  // Row blocks of Φ M; bias rows of Φ are identity rows.
+  ErrMat out = M;
+  out.middleRows<3>(kPos).noalias() += T_s * M.middleRows<3>(kVel);
+  out.middleRows<3>(kPos).noalias() += pos_att * M.middleRows<3>(kAtt);
+  out.middleRows<3>(kPos).noalias() += pos_accbias * M.middleRows<3>(kAccBias);
+  out.middleRows<3>(kPos).noalias() += pos_gyrobias * M.middleRows<3>(kGyroBias);
+  out.middleRows<3>(kVel).noalias() += vel_att * M.middleRows<3>(kAtt);
+  out.middleRows<3>(kVel).noalias() += vel_accbias * M.middleRows<3>(kAccBias);
+  out.middleRows<3>(kVel).noalias() += vel_gyrobias * M.middleRows<3>(kGyroBias);
+  out.middleRows<3>(kAtt).noalias() = att_att * M.middleRows<3>(kAtt);
+  out.middleRows<3>(kAtt).noalias() += att_gyrobias * M.middleRows<3>(kGyroBias);
+  return out;
+}
+
+Ekf::Ekf(const EkfParams& params) : params_(params) {
+  params_.validate();
+  P_ = initialCovariance(params_);
+}
+
+ErrMat initialCovariance(const EkfParams& p) {
+  ErrMat P = ErrMat::Zero();
+  P.block<3, 3>(kPos, kPos).diagonal().setConstant(p.init_pos_sigma_m * p.init_pos_sigma_m);
+  P.block<3, 3>(kVel, kVel).diagonal().setConstant(p.init_vel_sigma_mps * p.init_vel_sigma_mps);
+  P.block<3, 3>(kAtt, kAtt).diagonal() << p.init_att_sigma_rad * p.init_att_sigma_rad,
+      p.init_att_sigma_rad * p.init_att_sigma_rad, p.init_yaw_sigma_rad * p.init_yaw_sigma_rad;
+  P.block<3, 3>(kAccBias, kAccBias).diagonal().setConstant(p.init_acc_bias_sigma_mps2 * p.init_acc_bias_sigma_mps2);
+  P.block<3, 3>(kGyroBias, kGyroBias)
+      .diagonal()
+      .setConstant(p.init_gyro_bias_sigma_radps * p.init_gyro_bias_sigma_radps);
+  return P;
+}
+
+void Ekf::initialize(const NavState& x0, const ErrMat& P0) {
+  if (!P0.allFinite()) throw std::invalid_argument("Ekf::initialize: P0 not finite");
+  x_ = x0;
+  P_ = 0.5 * (P0 + P0.transpose());
+  phi_ = AccumulatedTransition{};
+  pending_cv_dt_s_ = 0.0;
+  phi_cv_.setIdentity();
+  q_cv_.setZero();
+}
+
+void Ekf::predict(const ImuReading& imu, double dt_s) {
+  if (!(dt_s > 0.0)) return;
+  const ProcessStep step = quadImuProcess(x_, imu, dt_s, params_.accel_model);  // (F2–F4)
+  x_ = step.next;
+  phi_.accumulate(step.J);  // (F7)
+  // velocity process noise per world axis (F7 Q): vertical/isotropic accelerometer noise, plus lateral
+  // model noise when the x/y readings are not integrated (drag and other unmodelled forces).
+  const double qa = params_.acc_noise_mps2_sqrthz * params_.acc_noise_mps2_sqrthz * dt_s;
+  phi_.q_vel_diag += Vec3::Constant(qa);
+  if (params_.accel_model == AccelModel::kThrustOnly) {
+    const double ql = params_.lateral_acc_noise_mps2_sqrthz * params_.lateral_acc_noise_mps2_sqrthz * dt_s;
+    phi_.q_vel_diag.x() += ql;
+    phi_.q_vel_diag.y() += ql;
+  }
+}
+
+void Ekf::predictTdoaOnly(double dt_s) {
+  if (!(dt_s > 0.0)) return;
+  const ErrMat F = tdoaOnlyProcess(x_, dt_s, params_.process_model);  // (F9)
+  phi_cv_ = F * phi_cv_;
+  // (F9) discrete white-acceleration / white-jerk noise, added at this step and carried by later F's.
+  ErrMat Q = ErrMat::Zero();
+  const double dt2 = dt_s * dt_s, dt3 = dt2 * dt_s;
+  if (params_.process_model == ProcessModel::kConstantAcceleration) {
+    const double q = params_.ca_jerk_noise_mps3_sqrthz * params_.ca_jerk_noise_mps3_sqrthz;
+    const double dt4 = dt3 * dt_s, dt5 = dt4 * dt_s;
+    for (int i = 0; i < 3; ++i) {
+      Q(kPos + i, kPos + i) = q * dt5 / 20.0;
+      Q(kPos + i, kVel + i) = Q(kVel + i, kPos + i) = q * dt4 / 8.0;
+      Q(kPos + i, kAccBias + i) = Q(kAccBias + i, kPos + i) = q * dt3 / 6.0;
+      Q(kVel + i, kVel + i) = q * dt3 / 3.0;
+      Q(kVel + i, kAccBias + i) = Q(kAccBias + i, kVel + i) = q * dt2 / 2.0;
+      Q(kAccBias + i, kAccBias + i) = q * dt_s;
+    }
+  } else {
+    const double q = params_.cv_acc_noise_mps2_sqrthz * params_.cv_acc_noise_mps2_sqrthz;
+    for (int i = 0; i < 3; ++i) {
+      Q(kPos + i, kPos + i) = q * dt3 / 3.0;
+      Q(kPos + i, kVel + i) = Q(kVel + i, kPos + i) = q * dt2 / 2.0;
+      Q(kVel + i, kVel + i) = q * dt_s;
+    }
+  }
+  q_cv_ = F * q_cv_ * F.transpose() + Q;
+  pending_cv_dt_s_ += dt_s;
+}
+
+void Ekf::propagateCovariance() {
+  if (pending_cv_dt_s_ > 0.0) {
+    P_ = phi_cv_ * P_ * phi_cv_.transpose() + q_cv_;
+    P_ = 0.5 * (P_ + P_.transpose());
+    phi_cv_.setIdentity();
+    q_cv_.setZero();
+    pending_cv_dt_s_ = 0.0;
+  }
+  if (phi_.empty()) return;
+  // docs/math/filter.md (F7): P ← Φ P Φᵀ + Q(T); Φ P Φᵀ = Φ (Φ P)ᵀ since P is symmetric.
+  const ErrMat A = phi_.leftMultiply(P_);
+  const ErrMat At = A.transpose();
+  P_ = phi_.leftMultiply(At);
+  const double T = phi_.T_s;
+  P_.diagonal().segment<3>(kVel) += phi_.q_vel_diag;
+  P_.diagonal().segment<3>(kPos).array() += params_.pos_noise_m_sqrts * params_.pos_noise_m_sqrts * T;
+  P_.diagonal().segment<3>(kAtt).array() += params_.gyro_noise_radps_sqrthz * params_.gyro_noise_radps_sqrthz * T;
+  P_.diagonal().segment<3>(kAccBias).array() +=
+      params_.acc_bias_rw_mps3_sqrthz * params_.acc_bias_rw_mps3_sqrthz * T;
+  P_.diagonal().segment<3>(kGyroBias).array() +=
+      params_.gyro_bias_rw_radps2_sqrthz * params_.gyro_bias_rw_radps2_sqrthz * T;
+  phi_ = AccumulatedTransition{};
+}
+
+InnovationStats Ekf::innovation(const ScalarLinearMessage<kDim>& message) const {
+  return innovationOf<kDim>(message, ErrVec::Zero(), P_);
+}
+
+std::optional<InnovationStats> Ekf::correct(const ScalarLinearMessage<kDim>& message) {
+  // Paper Fig. 3: equality node between the predicted error state N(0, P) and the TDoA message (G18).
+  ErrVec dx = ErrVec::Zero();
+  const std::optional<InnovationStats> st = equalityRankOneInPlace<kDim>(dx, P_, message);
+  if (!st) return std::nullopt;
+  inject(dx);  // (F8)
+  return st;
+}
+
+void Ekf::zeroVelocityUpdate(double sigma_mps) {
+  // (F14) v = 0 observed per world axis.
+  for (int i = 0; i < 3; ++i) {
+    ScalarLinearMessage<kDim> m;
+    m.a.setZero();
+    m.a(kVel + i) = 1.0;
+    m.y = -x_.w_v_b(i);
+    m.var = sigma_mps * sigma_mps;
+    correct(m);
+  }
+}
+
+void Ekf::positionUpdate(int axis, double value_m, double sigma_m) {
+  if (axis < 0 || axis > 2) throw std::invalid_argument("Ekf::positionUpdate: axis must be 0, 1 or 2");
+  ScalarLinearMessage<kDim> m;
+  m.a.setZero();
+  m.a(kPos + axis) = 1.0;
+  m.y = value_m - x_.w_p_b(axis);
+  m.var = sigma_m * sigma_m;
+  correct(m);
+}
+
+void Ekf::inflatePosition(double sigma_m, double vel_sigma_mps) {
+  P_.diagonal().segment<3>(kPos).array() += sigma_m * sigma_m;
+  P_.diagonal().segment<3>(kVel).array() += vel_sigma_mps * vel_sigma_mps;
+}
+
+void Ekf::resetPosition(const Vec3& w_p_b, double sigma_m) {
+  x_.w_p_b = w_p_b;
+  P_.middleRows<3>(kPos).setZero();
+  P_.middleCols<3>(kPos).setZero();
+  P_.block<3, 3>(kPos, kPos).diagonal().setConstant(sigma_m * sigma_m);
+}
+
+void Ekf::inject(const ErrVec& dx) { x_ = boxPlus(x_, dx); }
+
+}  // namespace uwb

@@ -1,0 +1,120 @@
+/** @file EkfParams.cpp
+ *  @brief Validation, presets and enum names of the filter parameters.
+ */
+#include "uwb/filter/EkfParams.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace uwb {
+namespace {
+void requirePositive(double v, const char* name) {
+  if (!(std::isfinite(v) && v > 0.0)) throw std::invalid_argument(std::string("EkfParams.") + name + " must be > 0");
+}
+void requireNonNegative(double v, const char* name) {
+  if (!(std::isfinite(v) && v >= 0.0)) throw std::invalid_argument(std::string("EkfParams.") + name + " must be >= 0");
+}
+}  // namespace
+
+void EkfParams::validate() const {
+  requireNonNegative(acc_noise_mps2_sqrthz, "acc_noise_mps2_sqrthz");
+  requireNonNegative(lateral_acc_noise_mps2_sqrthz, "lateral_acc_noise_mps2_sqrthz");
+  requireNonNegative(gyro_noise_radps_sqrthz, "gyro_noise_radps_sqrthz");
+  requireNonNegative(acc_bias_rw_mps3_sqrthz, "acc_bias_rw_mps3_sqrthz");
+  requireNonNegative(gyro_bias_rw_radps2_sqrthz, "gyro_bias_rw_radps2_sqrthz");
+  requireNonNegative(pos_noise_m_sqrts, "pos_noise_m_sqrts");
+  requirePositive(cv_acc_noise_mps2_sqrthz, "cv_acc_noise_mps2_sqrthz");
+  requirePositive(ca_jerk_noise_mps3_sqrthz, "ca_jerk_noise_mps3_sqrthz");
+  requirePositive(init_pos_sigma_m, "init_pos_sigma_m");
+  requirePositive(init_vel_sigma_mps, "init_vel_sigma_mps");
+  requirePositive(init_att_sigma_rad, "init_att_sigma_rad");
+  requirePositive(init_yaw_sigma_rad, "init_yaw_sigma_rad");
+  requirePositive(init_acc_bias_sigma_mps2, "init_acc_bias_sigma_mps2");
+  requirePositive(init_gyro_bias_sigma_radps, "init_gyro_bias_sigma_radps");
+  if (!b_t_tag.allFinite()) throw std::invalid_argument("EkfParams.b_t_tag must be finite");
+  requirePositive(tdoa_sigma_m, "tdoa_sigma_m");
+  requireNonNegative(anchor_sigma_m, "anchor_sigma_m");
+  requirePositive(gate_sigma, "gate_sigma");
+  requirePositive(robust_k, "robust_k");
+  if (robust_iterations < 1 || robust_iterations > 20)
+    throw std::invalid_argument("EkfParams.robust_iterations must be in [1, 20]");
+  requirePositive(max_lost_s, "max_lost_s");
+  requirePositive(max_predict_dt_s, "max_predict_dt_s");
+  requireNonNegative(cov_period_s, "cov_period_s");
+  requirePositive(max_gap_s, "max_gap_s");
+  requirePositive(takeoff_climb_mps, "takeoff_climb_mps");
+  requirePositive(takeoff_acc_mps2, "takeoff_acc_mps2");
+  requirePositive(landing_height_m, "landing_height_m");
+  requirePositive(landing_hold_s, "landing_hold_s");
+  requireNonNegative(acquisition_s, "acquisition_s");
+  requirePositive(acquisition_tdoa_sigma_m, "acquisition_tdoa_sigma_m");
+  if (!start_w_p_b.allFinite()) throw std::invalid_argument("EkfParams.start_w_p_b must be finite");
+  if (!std::isfinite(ground_z_m)) throw std::invalid_argument("EkfParams.ground_z_m must be finite");
+}
+
+EkfParams EkfParams::crazyflieLike() {
+  EkfParams p;
+  p.accel_model = AccelModel::kThrustOnly;
+  p.robust_loss = RobustLoss::kNone;
+  p.robust_iterations = 1;
+  p.tdoa_sigma_m = 0.15;  // Crazyflie measNoiseTdoa
+  p.gate_sigma = 4.0;
+  p.acc_noise_mps2_sqrthz = 0.5;
+  p.lateral_acc_noise_mps2_sqrthz = 0.0;
+  p.gyro_noise_radps_sqrthz = 0.01;
+  p.acc_bias_rw_mps3_sqrthz = 0.0;
+  p.gyro_bias_rw_radps2_sqrthz = 0.0;
+  p.pos_noise_m_sqrts = 0.0;
+  return p;
+}
+
+EkfParams EkfParams::tdoaOnly() {
+  EkfParams p;
+  p.process_model = ProcessModel::kConstantVelocity;
+  p.ground_phase = GroundPhase::kNone;
+  return p;
+}
+
+std::string toString(AccelModel m) { return m == AccelModel::kFull ? "full" : "thrust"; }
+std::string toString(ProcessModel m) {
+  switch (m) {
+    case ProcessModel::kImu: return "imu";
+    case ProcessModel::kConstantVelocity: return "cv";
+    case ProcessModel::kConstantAcceleration: return "ca";
+  }
+  return "?";
+}
+std::string toString(RobustLoss l) {
+  switch (l) {
+    case RobustLoss::kNone: return "none";
+    case RobustLoss::kHuber: return "huber";
+    case RobustLoss::kCauchy: return "cauchy";
+  }
+  return "?";
+}
+std::string toString(GroundPhase g) { return g == GroundPhase::kNone ? "none" : "detect"; }
+
+AccelModel parseAccelModel(const std::string& s) {
+  if (s == "full") return AccelModel::kFull;
+  if (s == "thrust") return AccelModel::kThrustOnly;
+  throw std::invalid_argument("unknown accelerometer model '" + s + "' (full, thrust)");
+}
+ProcessModel parseProcessModel(const std::string& s) {
+  if (s == "imu") return ProcessModel::kImu;
+  if (s == "cv") return ProcessModel::kConstantVelocity;
+  if (s == "ca") return ProcessModel::kConstantAcceleration;
+  throw std::invalid_argument("unknown process model '" + s + "' (imu, cv, ca)");
+}
+RobustLoss parseRobustLoss(const std::string& s) {
+  if (s == "none") return RobustLoss::kNone;
+  if (s == "huber") return RobustLoss::kHuber;
+  if (s == "cauchy") return RobustLoss::kCauchy;
+  throw std::invalid_argument("unknown robust loss '" + s + "' (none, huber, cauchy)");
+}
+GroundPhase parseGroundPhase(const std::string& s) {
+  if (s == "detect") return GroundPhase::kDetectTakeoff;
+  if (s == "none") return GroundPhase::kNone;
+  throw std::invalid_argument("unknown ground phase '" + s + "' (detect, none)");
+}
+
+}  // namespace uwb

@@ -1,0 +1,137 @@
+/** @file QuadImuProcess.cpp
+ *  @brief Quadrotor IMU process model (Mueller, Hamer, D'Andrea 2015) and TDoA-only models;
+ *         docs/math/filter.md F2–F6, F9.
+ */
+#include "uwb/filter/QuadImuProcess.h"
+
+#include <cmath>
+
+#include "uwb/model/TdoaModel.h"  // skew
+
+namespace uwb {
+
+Quat expQuat(const Vec3& phi) {
+  const double angle = phi.norm();
+  if (angle < 1e-8) {
+    // second-order Taylor expansion; normalised
+    Quat q(1.0, 0.5 * phi.x(), 0.5 * phi.y(), 0.5 * phi.z());
+    q.normalize();
+    return q;
+  }
+  const double half = 0.5 * angle;
+  const double s = std::sin(half) / angle;
+  return Quat(std::cos(half), s * phi.x(), s * phi.y(), s * phi.z());
+}
+
+Vec3 logQuat(const Quat& q_in) {
+  Quat q = q_in;
+  if (q.w() < 0.0) q.coeffs() = -q.coeffs();  // shortest rotation
+  const Vec3 v = q.vec();
+  const double s = v.norm();
+  if (s < 1e-10) return 2.0 * v / q.w();
+  const double angle = 2.0 * std::atan2(s, q.w());
+  return (angle / s) * v;
+}
+
+Mat3 rightJacobianSo3(const Vec3& phi) {
+  // docs/math/filter.md (F6): J_r(φ) = I − (1−cos θ)/θ² [φ]× + (θ − sin θ)/θ³ [φ]×²
+  const double theta2 = phi.squaredNorm();
+  const Mat3 S = skew(phi);
+  if (theta2 < 1e-10) return Mat3::Identity() - 0.5 * S + (1.0 / 6.0) * S * S;
+  const double theta = std::sqrt(theta2);
+  return Mat3::Identity() - (1.0 - std::cos(theta)) / theta2 * S + (theta - std::sin(theta)) / (theta2 * theta) * S * S;
+}
+
+ProcessStep quadImuProcess(const NavState& x, const ImuReading& imu, double dt_s, AccelModel accel_model) {
+  ProcessStep out;
+  const Mat3 w_R_b = x.w_q_b.toRotationMatrix();
+  // (F2) specific force after bias removal; S selects the axes that are integrated (F3)
+  Vec3 b_f = imu.b_acc_mps2 - x.b_acc_bias;
+  Mat3 S = Mat3::Identity();
+  if (accel_model == AccelModel::kThrustOnly) {
+    b_f.x() = 0.0;
+    b_f.y() = 0.0;
+    S.diagonal() << 0.0, 0.0, 1.0;
+  }
+  const Vec3 b_omega = imu.b_gyro_radps - x.b_gyro_bias;
+  const Vec3 w_a = w_R_b * b_f + kWorldGravity_mps2;
+  const Vec3 phi = b_omega * dt_s;
+
+  out.next.w_p_b = x.w_p_b + x.w_v_b * dt_s + 0.5 * dt_s * dt_s * w_a;
+  out.next.w_v_b = x.w_v_b + dt_s * w_a;
+  out.next.w_q_b = (x.w_q_b * expQuat(phi)).normalized();
+  out.next.b_acc_bias = x.b_acc_bias;
+  out.next.b_gyro_bias = x.b_gyro_bias;
+
+  // (F4) error-state Jacobian blocks
+  out.J.dt_s = dt_s;
+  out.J.F_v_att = -(w_R_b * skew(b_f)) * dt_s;
+  out.J.G_v_acc = w_R_b * S * dt_s;
+  out.J.F_v_accbias = -out.J.G_v_acc;
+  out.J.F_att_att = expQuat(phi).toRotationMatrix().transpose();
+  out.J.F_att_gyrobias = -rightJacobianSo3(phi) * dt_s;
+  return out;
+}
+
+ErrMat ProcessStep::F() const {
+  ErrMat F = ErrMat::Identity();
+  const double dt = J.dt_s;
+  F.block<3, 3>(kPos, kVel) = dt * Mat3::Identity();
+  F.block<3, 3>(kPos, kAtt) = 0.5 * dt * J.F_v_att;
+  F.block<3, 3>(kPos, kAccBias) = 0.5 * dt * J.F_v_accbias;
+  F.block<3, 3>(kVel, kAtt) = J.F_v_att;
+  F.block<3, 3>(kVel, kAccBias) = J.F_v_accbias;
+  F.block<3, 3>(kAtt, kAtt) = J.F_att_att;
+  F.block<3, 3>(kAtt, kGyroBias) = J.F_att_gyrobias;
+  return F;
+}
+
+NoiseMat ProcessStep::G() const {
+  // (F5) reading noise n_a, n_g enters like a bias with opposite sign; bias increments enter directly.
+  NoiseMat G = NoiseMat::Zero();
+  const double dt = J.dt_s;
+  G.block<3, 3>(kPos, kNoiseAcc) = 0.5 * dt * J.G_v_acc;
+  G.block<3, 3>(kVel, kNoiseAcc) = J.G_v_acc;
+  G.block<3, 3>(kAtt, kNoiseGyro) = -J.F_att_gyrobias;
+  G.block<3, 3>(kAccBias, kNoiseAccBias) = Mat3::Identity();
+  G.block<3, 3>(kGyroBias, kNoiseGyroBias) = Mat3::Identity();
+  return G;
+}
+
+ErrMat tdoaOnlyProcess(NavState& x, double dt_s, ProcessModel model) {
+  // (F9) constant velocity: p' = p + v dt; constant acceleration: p' = p + v dt + ½ a dt², v' = v + a dt.
+  ErrMat F = ErrMat::Identity();
+  F.block<3, 3>(kPos, kVel) = dt_s * Mat3::Identity();
+  if (model == ProcessModel::kConstantAcceleration) {
+    const Vec3& w_a = x.b_acc_bias;  // world-frame acceleration in this model
+    x.w_p_b += x.w_v_b * dt_s + 0.5 * dt_s * dt_s * w_a;
+    x.w_v_b += w_a * dt_s;
+    F.block<3, 3>(kPos, kAccBias) = 0.5 * dt_s * dt_s * Mat3::Identity();
+    F.block<3, 3>(kVel, kAccBias) = dt_s * Mat3::Identity();
+  } else {
+    x.w_p_b += x.w_v_b * dt_s;
+  }
+  return F;
+}
+
+ErrVec boxMinus(const NavState& x1, const NavState& x0) {
+  ErrVec d;
+  d.segment<3>(kPos) = x1.w_p_b - x0.w_p_b;
+  d.segment<3>(kVel) = x1.w_v_b - x0.w_v_b;
+  d.segment<3>(kAtt) = logQuat(x0.w_q_b.conjugate() * x1.w_q_b);
+  d.segment<3>(kAccBias) = x1.b_acc_bias - x0.b_acc_bias;
+  d.segment<3>(kGyroBias) = x1.b_gyro_bias - x0.b_gyro_bias;
+  return d;
+}
+
+NavState boxPlus(const NavState& x, const ErrVec& dx) {
+  NavState y;
+  y.w_p_b = x.w_p_b + dx.segment<3>(kPos);
+  y.w_v_b = x.w_v_b + dx.segment<3>(kVel);
+  y.w_q_b = (x.w_q_b * expQuat(dx.segment<3>(kAtt))).normalized();
+  y.b_acc_bias = x.b_acc_bias + dx.segment<3>(kAccBias);
+  y.b_gyro_bias = x.b_gyro_bias + dx.segment<3>(kGyroBias);
+  return y;
+}
+
+}  // namespace uwb

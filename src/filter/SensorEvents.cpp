@@ -1,0 +1,120 @@
+/** @file SensorEvents.cpp
+ *  @brief Stream pairing and merging (docs/math/filter.md F17).
+ */
+#include "uwb/filter/SensorEvents.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace uwb {
+
+std::vector<std::string> MergeReport::notes() const {
+  std::vector<std::string> out;
+  auto add = [&](std::size_t n, const char* what) {
+    if (n) out.push_back(std::to_string(n) + " " + what);
+  };
+  add(n_imu_duplicate, "duplicate IMU timestamps dropped");
+  add(n_tdoa_duplicate, "duplicate TDoA samples dropped");
+  add(n_imu_out_of_order, "out-of-order IMU samples re-sorted");
+  add(n_tdoa_out_of_order, "out-of-order TDoA samples re-sorted");
+  add(n_nonfinite, "non-finite samples dropped");
+  add(n_imu_gaps, "IMU gaps longer than the limit");
+  add(n_tdoa_gaps, "TDoA gaps longer than the limit");
+  add(n_imu_unpaired, "accelerometer samples without a nearby gyro sample");
+  return out;
+}
+
+std::vector<TimedImu> pairImuStreams(const std::vector<TimedVec3>& acc_in, const std::vector<TimedVec3>& gyro_in,
+                                     MergeReport* report) {
+  auto sorted = [](std::vector<TimedVec3> v) {
+    std::stable_sort(v.begin(), v.end(), [](const TimedVec3& a, const TimedVec3& b) { return a.t_s < b.t_s; });
+    return v;
+  };
+  const std::vector<TimedVec3> acc = sorted(acc_in);
+  const std::vector<TimedVec3> gyro = sorted(gyro_in);
+  std::vector<TimedImu> out;
+  out.reserve(acc.size());
+  if (gyro.empty()) return out;
+  std::size_t g = 0;
+  std::size_t unpaired = 0;
+  for (const TimedVec3& a : acc) {
+    while (g + 1 < gyro.size() && gyro[g + 1].t_s <= a.t_s) ++g;
+    if (std::abs(gyro[g].t_s - a.t_s) > 0.005) ++unpaired;
+    TimedImu s;
+    s.t_s = a.t_s;
+    s.imu.b_acc_mps2 = a.value;
+    s.imu.b_gyro_radps = gyro[g].value;
+    out.push_back(s);
+  }
+  if (report) report->n_imu_unpaired += unpaired;
+  return out;
+}
+
+std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, MergeReport* report) {
+  MergeReport rep;
+  rep.n_imu_in = log.imu.size();
+  rep.n_tdoa_in = log.tdoa.size();
+  // drop non-finite samples
+  const auto imu_bad = [](const TimedImu& s) {
+    return !std::isfinite(s.t_s) || !s.imu.b_acc_mps2.allFinite() || !s.imu.b_gyro_radps.allFinite();
+  };
+  const auto tdoa_bad = [](const TdoaObservation& z) { return !std::isfinite(z.t_s) || !std::isfinite(z.tdoa_m); };
+  const std::size_t n0 = log.imu.size() + log.tdoa.size();
+  std::erase_if(log.imu, imu_bad);
+  std::erase_if(log.tdoa, tdoa_bad);
+  rep.n_nonfinite = n0 - log.imu.size() - log.tdoa.size();
+  // count out-of-order stamps, then sort stably
+  for (std::size_t i = 1; i < log.imu.size(); ++i) rep.n_imu_out_of_order += log.imu[i].t_s < log.imu[i - 1].t_s;
+  for (std::size_t i = 1; i < log.tdoa.size(); ++i)
+    rep.n_tdoa_out_of_order += log.tdoa[i].t_s < log.tdoa[i - 1].t_s;
+  if (rep.n_imu_out_of_order)
+    std::stable_sort(log.imu.begin(), log.imu.end(), [](const TimedImu& a, const TimedImu& b) { return a.t_s < b.t_s; });
+  if (rep.n_tdoa_out_of_order)
+    std::stable_sort(log.tdoa.begin(), log.tdoa.end(),
+                     [](const TdoaObservation& a, const TdoaObservation& b) { return a.t_s < b.t_s; });
+  // duplicates: IMU with the same stamp; TDoA with same stamp, pair and value (same stamp, other pair is legal)
+  const std::size_t ni = log.imu.size();
+  log.imu.erase(std::unique(log.imu.begin(), log.imu.end(),
+                            [](const TimedImu& a, const TimedImu& b) { return a.t_s == b.t_s; }),
+                log.imu.end());
+  rep.n_imu_duplicate = ni - log.imu.size();
+  const std::size_t nt = log.tdoa.size();
+  log.tdoa.erase(std::unique(log.tdoa.begin(), log.tdoa.end(),
+                             [](const TdoaObservation& a, const TdoaObservation& b) {
+                               return a.t_s == b.t_s && a.id_a == b.id_a && a.id_b == b.id_b && a.tdoa_m == b.tdoa_m;
+                             }),
+                 log.tdoa.end());
+  rep.n_tdoa_duplicate = nt - log.tdoa.size();
+  // gaps
+  for (std::size_t i = 1; i < log.imu.size(); ++i) {
+    const double gap = log.imu[i].t_s - log.imu[i - 1].t_s;
+    rep.max_imu_gap_s = std::max(rep.max_imu_gap_s, gap);
+    rep.n_imu_gaps += gap > max_gap_s;
+  }
+  for (std::size_t i = 1; i < log.tdoa.size(); ++i) {
+    const double gap = log.tdoa[i].t_s - log.tdoa[i - 1].t_s;
+    rep.max_tdoa_gap_s = std::max(rep.max_tdoa_gap_s, gap);
+    rep.n_tdoa_gaps += gap > max_gap_s;
+  }
+  // linear merge
+  std::vector<SensorEvent> events;
+  events.reserve(log.imu.size() + log.tdoa.size());
+  std::size_t i = 0, j = 0;
+  while (i < log.imu.size() || j < log.tdoa.size()) {
+    const bool take_imu = j >= log.tdoa.size() || (i < log.imu.size() && log.imu[i].t_s <= log.tdoa[j].t_s);
+    if (take_imu) {
+      events.push_back({log.imu[i].t_s, SensorEvent::Kind::kImu, static_cast<unsigned>(i)});
+      ++i;
+    } else {
+      events.push_back({log.tdoa[j].t_s, SensorEvent::Kind::kTdoa, static_cast<unsigned>(j)});
+      ++j;
+    }
+  }
+  if (report) {
+    rep.n_imu_unpaired = report->n_imu_unpaired;
+    *report = rep;
+  }
+  return events;
+}
+
+}  // namespace uwb

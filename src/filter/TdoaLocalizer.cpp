@@ -1,0 +1,376 @@
+/** @file TdoaLocalizer.cpp
+ *  @brief The estimator's event loop: docs/math/filter.md F14–F18 (ground phase, take-off, start by
+ *         multilateration, acquisition, gating/robust tracking, re-acquisition, landing, TDoA-only mode).
+ */
+#include "uwb/filter/TdoaLocalizer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "uwb/filter/Multilateration.h"
+
+namespace uwb {
+namespace {
+
+/// Roll and pitch from a specific-force reading at rest, yaw = 0 (F15).
+Quat levelFromGravity(const Vec3& b_acc) {
+  const double roll = std::atan2(b_acc.y(), b_acc.z());
+  const double pitch = std::atan2(-b_acc.x(), std::sqrt(b_acc.y() * b_acc.y() + b_acc.z() * b_acc.z()));
+  return Quat(Eigen::AngleAxisd(pitch, Vec3::UnitY()) * Eigen::AngleAxisd(roll, Vec3::UnitX()));
+}
+
+Vec3 sqrtDiag(const ErrMat& P) { return P.diagonal().segment<3>(kPos).cwiseMax(0.0).cwiseSqrt(); }
+
+/// Constant time of the take-off detector's leaky vertical-velocity integrator [s] (F15).
+constexpr double kTakeoffLeak_s = 1.0;
+/// Zero-velocity updates on the ground at this period [s] and std [m/s] (F14).
+constexpr double kZuptPeriod_s = 0.01;
+constexpr double kZuptSigma_mps = 0.02;
+/// Multilateration window after take-off / at the start [s], and the minimum number of TDoAs (F16).
+constexpr double kMlatWindow_s = 0.4;
+constexpr std::size_t kMlatMinSamples = 40;
+constexpr double kMlatMaxWindow_s = 3.0;
+/// Stillness (motors off): acc std and gyro rms thresholds, EMA time constant (F18).
+constexpr double kStillAccStd_mps2 = 0.12;
+constexpr double kStillGyro_radps = 0.03;
+constexpr double kStillTau_s = 0.1;
+
+}  // namespace
+
+TdoaLocalizer::TdoaLocalizer(const EkfParams& params, AnchorTable anchors, BiasPredictor bias)
+    : params_(params), anchors_(std::move(anchors)), bias_(std::move(bias)) {
+  params_.validate();
+  if (anchors_.size() < 4) throw std::invalid_argument("TdoaLocalizer: at least 4 anchors are needed");
+}
+
+LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const {
+  LocalizerResult result;
+  LocalizerSummary& sum = result.summary;
+  const std::vector<SensorEvent> events = mergeSensorStreams(log, params_.max_gap_s, &sum.merge);
+  if (events.empty()) return result;
+
+  EkfParams p = params_;
+  const bool imu_mode = !log.imu.empty() && p.process_model == ProcessModel::kImu;
+  if (!imu_mode) {
+    if (p.process_model == ProcessModel::kImu) p.process_model = ProcessModel::kConstantVelocity;
+    p.ground_phase = GroundPhase::kNone;
+  }
+  sum.process_model = p.process_model;
+  sum.start_t_s = events.front().t_s;
+  sum.end_t_s = events.back().t_s;
+  const BiasPredictor* bias = bias_ ? &bias_ : nullptr;
+
+  TdoaUpdateOptions track_opt;
+  track_opt.sigma_m = p.tdoa_sigma_m;
+  track_opt.gate_sigma = p.gate_sigma;
+  track_opt.loss = p.robust_loss;
+  track_opt.robust_k = p.robust_k;
+  track_opt.robust_iterations = p.robust_iterations;
+  track_opt.b_t_tag = p.b_t_tag;
+  TdoaUpdateOptions acq_opt = track_opt;
+  acq_opt.sigma_m = p.acquisition_tdoa_sigma_m;
+  acq_opt.gate_sigma = 0.0;  // (F16) no gate while acquiring; the robust loss limits outliers
+  if (acq_opt.loss == RobustLoss::kNone) acq_opt.loss = RobustLoss::kHuber;
+
+  // Anchor centroid: the starting guesses for multilateration.
+  Vec3 centroid = Vec3::Zero();
+  const std::vector<int> ids = anchors_.ids();
+  for (int id : ids) centroid += anchors_.find(id)->m;
+  centroid /= static_cast<double>(ids.size());
+
+  Ekf ekf(p);
+  FlightPhase phase = FlightPhase::kAcquisition;
+  bool position_known = p.has_start_position;
+  bool initialized = false;
+  double t_pred = events.front().t_s;
+  double t_last_out = -1e300;
+  double t_last_zupt = -1e300;
+  double t_acq_end = -1e300;
+  double t_last_accept = events.front().t_s;
+  std::size_t n_rejected_streak = 0;
+
+  // IMU averaging (F17)
+  Vec3 acc_sum = Vec3::Zero(), gyro_sum = Vec3::Zero();
+  int n_imu_acc = 0;
+  ImuReading last_imu;
+  // initialisation window for levelling
+  Vec3 init_acc_sum = Vec3::Zero(), init_gyro_sum = Vec3::Zero();
+  int n_init = 0;
+  double t_first_imu = std::numeric_limits<double>::quiet_NaN();
+  // take-off detector (F15) and stillness detector (F18)
+  double g_ref = kGravity_mps2;
+  double v_det = 0.0;
+  double t_last_imu = std::numeric_limits<double>::quiet_NaN();
+  double acc_mean = kGravity_mps2, acc_var = 1.0, gyro_ms = 1.0;
+  double z_takeoff = p.ground_z_m;
+  double t_low_slow = std::numeric_limits<double>::quiet_NaN();
+  // multilateration buffer (F16)
+  std::vector<MultilaterationSample> mlat;
+  double t_mlat_start = std::numeric_limits<double>::quiet_NaN();
+  Vec3 mlat_ref_p = Vec3::Zero();
+
+  auto emit = [&](double t, bool force = false) {
+    if (!force && t - t_last_out < output_period_s) return;
+    LocalizerEstimate e;
+    e.t_s = t;
+    e.x = ekf.state();
+    e.sigma_p_m = sqrtDiag(ekf.covariance());
+    e.phase = phase;
+    result.estimates.push_back(e);
+    t_last_out = t;
+  };
+
+  auto predictTo = [&](double t) {
+    const double dt = t - t_pred;
+    if (!(dt > 0.0)) return;
+    if (imu_mode) {
+      ImuReading m = last_imu;
+      if (n_imu_acc > 0) {
+        m.b_acc_mps2 = acc_sum / n_imu_acc;
+        m.b_gyro_radps = gyro_sum / n_imu_acc;
+      }
+      ekf.predict(m, dt);
+    } else {
+      ekf.predictTdoaOnly(dt);
+    }
+    acc_sum.setZero();
+    gyro_sum.setZero();
+    n_imu_acc = 0;
+    t_pred = t;
+    ++sum.n_predictions;
+  };
+  auto propagate = [&](bool force) {
+    if (ekf.pendingDt() > 0.0 && (force || ekf.pendingDt() >= p.cov_period_s)) {
+      ekf.propagateCovariance();
+      ++sum.n_covariance_propagations;
+    }
+  };
+
+  auto startFromPosition = [&](const Vec3& w_p_b, double sigma_m) {
+    ekf.resetPosition(w_p_b, sigma_m);
+    position_known = true;
+  };
+
+  auto enterGround = [&](FlightPhase ph) {
+    phase = ph;
+    if (imu_mode) ekf.setAccelModel(AccelModel::kFull);
+    v_det = 0.0;
+  };
+
+  auto takeoff = [&](double t) {
+    if (std::isnan(sum.takeoff_t_s)) sum.takeoff_t_s = t;
+    ekf.setAccelModel(p.accel_model);
+    // the climb that the detector saw becomes the vertical velocity (F15)
+    ErrVec dx = ErrVec::Zero();
+    dx(kVel + 2) = v_det - ekf.state().w_v_b.z();
+    ekf.inject(dx);
+    ekf.inflatePosition(0.0, 0.3);
+    z_takeoff = ekf.state().w_p_b.z();
+    t_low_slow = std::numeric_limits<double>::quiet_NaN();
+    if (position_known) {
+      phase = FlightPhase::kAcquisition;
+      t_acq_end = t + 0.5 * p.acquisition_s;
+    } else {
+      phase = FlightPhase::kAcquisition;
+      t_mlat_start = t;
+      mlat_ref_p = ekf.state().w_p_b;
+      mlat.clear();
+    }
+    t_last_accept = t;
+  };
+
+  auto finishMultilateration = [&](double t) -> bool {
+    std::vector<Vec3> guesses = {Vec3(centroid.x(), centroid.y(), 0.5), Vec3(centroid.x(), centroid.y(), 1.5),
+                                 Vec3(centroid.x(), centroid.y(), centroid.z())};
+    const std::optional<MultilaterationResult> r = multilaterate(mlat, anchors_, p.b_t_tag, guesses);
+    if (!r) return false;
+    const Vec3 d_now = ekf.state().w_p_b - mlat_ref_p;
+    const double sigma = std::clamp(std::sqrt(r->covariance.trace()), 0.2, p.init_pos_sigma_m);
+    startFromPosition(r->w_p0 + d_now, sigma);
+    sum.start_w_p_b = r->w_p0;
+    sum.start_rms_residual_m = r->rms_residual_m;
+    // ground-phase outputs: the body sat at the take-off point
+    for (LocalizerEstimate& e : result.estimates)
+      if (e.phase == FlightPhase::kGround && e.t_s <= t_mlat_start) {
+        e.x.w_p_b = r->w_p0;
+        e.sigma_p_m = Vec3::Constant(sigma);
+      }
+    z_takeoff = r->w_p0.z();
+    t_acq_end = t + p.acquisition_s;
+    mlat.clear();
+    t_mlat_start = std::numeric_limits<double>::quiet_NaN();
+    (void)t;
+    return true;
+  };
+
+  auto initialize = [&](double t, const Vec3& acc_mean_b, const Vec3& gyro_mean_b) {
+    NavState x0;
+    x0.w_q_b = imu_mode ? levelFromGravity(acc_mean_b) : Quat::Identity();
+    x0.w_p_b = p.has_start_position ? p.start_w_p_b : Vec3(centroid.x(), centroid.y(), p.ground_z_m);
+    (void)gyro_mean_b;
+    ErrMat P0 = initialCovariance(p);
+    if (p.has_start_position) P0.block<3, 3>(kPos, kPos) = Mat3::Identity() * 0.05 * 0.05;
+    ekf.initialize(x0, P0);
+    g_ref = imu_mode ? acc_mean_b.norm() : kGravity_mps2;
+    t_pred = t;
+    initialized = true;
+    if (imu_mode && p.ground_phase == GroundPhase::kDetectTakeoff) {
+      enterGround(FlightPhase::kGround);
+    } else if (p.has_start_position) {
+      phase = FlightPhase::kAcquisition;
+      t_acq_end = t + 0.5 * p.acquisition_s;
+      if (imu_mode) ekf.setAccelModel(p.accel_model);
+    } else {
+      phase = FlightPhase::kAcquisition;
+      t_mlat_start = t;
+      mlat_ref_p = x0.w_p_b;
+      if (imu_mode) ekf.setAccelModel(p.accel_model);
+      if (!imu_mode) ekf.inflatePosition(0.0, 1.0);
+    }
+  };
+
+  for (const SensorEvent& ev : events) {
+    const double t = ev.t_s;
+    if (ev.kind == SensorEvent::Kind::kImu) {
+      if (!imu_mode) continue;
+      const ImuReading& imu = log.imu[ev.index].imu;
+      if (!initialized) {
+        if (std::isnan(t_first_imu)) t_first_imu = t;
+        init_acc_sum += imu.b_acc_mps2;
+        init_gyro_sum += imu.b_gyro_radps;
+        ++n_init;
+        if (t - t_first_imu >= 0.1 || n_init >= 100) initialize(t, init_acc_sum / n_init, init_gyro_sum / n_init);
+        last_imu = imu;
+        t_last_imu = t;
+        continue;
+      }
+      const double dt_imu = std::isnan(t_last_imu) ? 0.0 : std::min(t - t_last_imu, 0.05);
+      t_last_imu = t;
+      last_imu = imu;
+      acc_sum += imu.b_acc_mps2;
+      gyro_sum += imu.b_gyro_radps;
+      ++n_imu_acc;
+      // stillness statistics (F18)
+      if (dt_imu > 0.0) {
+        const double a = std::exp(-dt_imu / kStillTau_s);
+        const double an = imu.b_acc_mps2.norm();
+        acc_mean = a * acc_mean + (1 - a) * an;
+        acc_var = a * acc_var + (1 - a) * (an - acc_mean) * (an - acc_mean);
+        gyro_ms = a * gyro_ms + (1 - a) * imu.b_gyro_radps.squaredNorm();
+      }
+      const bool still = std::sqrt(acc_var) < kStillAccStd_mps2 && std::sqrt(gyro_ms) < kStillGyro_radps;
+      if (phase == FlightPhase::kGround || phase == FlightPhase::kLanded) {
+        // (F15) take-off detector: leaky integral of the vertical specific-force excess
+        const double a_up = (ekf.state().w_q_b * imu.b_acc_mps2).z();
+        if (dt_imu > 0.0) {
+          v_det = std::exp(-dt_imu / kTakeoffLeak_s) * v_det + dt_imu * (a_up - g_ref);
+          if (still || v_det < 0.05) g_ref += (dt_imu / 2.0) * (a_up - g_ref);
+        }
+        if (v_det > p.takeoff_climb_mps && !still) {
+          predictTo(t);
+          propagate(true);
+          takeoff(t);
+        }
+      }
+      if (t - t_pred >= p.max_predict_dt_s) {
+        predictTo(t);
+        if (phase == FlightPhase::kGround || phase == FlightPhase::kLanded) {
+          if (t - t_last_zupt >= kZuptPeriod_s) {
+            propagate(true);
+            ekf.zeroVelocityUpdate(kZuptSigma_mps);  // (F14)
+            t_last_zupt = t;
+          }
+        } else {
+          propagate(false);
+        }
+      }
+      // landing (F18): nearly still, or low and slow for landing_hold_s
+      if (phase == FlightPhase::kTracking) {
+        const NavState& x = ekf.state();
+        const bool low_slow = x.w_p_b.z() - z_takeoff < p.landing_height_m && x.w_v_b.norm() < 0.25;
+        if (still || low_slow) {
+          if (std::isnan(t_low_slow)) t_low_slow = t;
+          if (t - t_low_slow >= (still ? 0.3 : p.landing_hold_s)) {
+            if (std::isnan(sum.landing_t_s) || sum.landing_t_s < sum.takeoff_t_s) sum.landing_t_s = t;
+            enterGround(FlightPhase::kLanded);
+          }
+        } else {
+          t_low_slow = std::numeric_limits<double>::quiet_NaN();
+        }
+      }
+      emit(t);
+      continue;
+    }
+
+    // ---- TDoA event ----
+    const TdoaObservation& z = log.tdoa[ev.index];
+    ++sum.n_tdoa_total;
+    if (!initialized) {
+      if (imu_mode) {
+        ++sum.n_tdoa_ground;
+        continue;
+      }
+      initialize(t, Vec3(0, 0, kGravity_mps2), Vec3::Zero());
+    }
+    predictTo(t);
+    if (phase == FlightPhase::kGround || phase == FlightPhase::kLanded) {
+      ++sum.n_tdoa_ground;
+      emit(t);
+      continue;
+    }
+    if (!std::isnan(t_mlat_start)) {
+      // (F16) collecting the multilateration batch; the displacement comes from the prediction
+      MultilaterationSample s;
+      s.z = z;
+      s.w_d_b = ekf.state().w_p_b - mlat_ref_p;
+      s.w_q_b = ekf.state().w_q_b;
+      mlat.push_back(s);
+      ++sum.n_tdoa_ground;
+      if (t - t_mlat_start >= kMlatWindow_s && mlat.size() >= kMlatMinSamples) {
+        propagate(true);
+        if (!finishMultilateration(t) && t - t_mlat_start > kMlatMaxWindow_s) {
+          // give up: EKF acquisition from the centroid with a wide prior
+          startFromPosition(Vec3(centroid.x(), centroid.y(), 1.0), p.init_pos_sigma_m);
+          t_acq_end = t + 2.0 * p.acquisition_s;
+          mlat.clear();
+          t_mlat_start = std::numeric_limits<double>::quiet_NaN();
+        }
+        t_last_accept = t;
+      }
+      emit(t);
+      continue;
+    }
+    if (phase == FlightPhase::kAcquisition && t >= t_acq_end) phase = FlightPhase::kTracking;
+    propagate(!imu_mode);
+    const bool acquiring = phase == FlightPhase::kAcquisition;
+    const TdoaUpdateResult r = updateTdoa(ekf, anchors_, z, acquiring ? acq_opt : track_opt, bias);
+    switch (r.outcome) {
+      case UpdateOutcome::kApplied:
+        ++sum.n_tdoa_used;
+        if (r.weight < 1.0) ++sum.n_tdoa_downweighted;
+        t_last_accept = t;
+        n_rejected_streak = 0;
+        break;
+      case UpdateOutcome::kRejectedOutlier:
+        ++sum.n_tdoa_rejected;
+        ++n_rejected_streak;
+        break;
+      case UpdateOutcome::kUnknownAnchor: ++sum.n_tdoa_unknown_anchor; break;
+      default: ++sum.n_tdoa_degenerate; break;
+    }
+    // (F16) lost: nothing accepted for max_lost_s → re-acquire with an inflated covariance
+    if (phase == FlightPhase::kTracking && t - t_last_accept > p.max_lost_s && n_rejected_streak > 20) {
+      ekf.inflatePosition(0.5, 0.5);
+      phase = FlightPhase::kAcquisition;
+      t_acq_end = t + p.acquisition_s;
+      ++sum.n_reacquisitions;
+      t_last_accept = t;
+    }
+    emit(t);
+  }
+  if (initialized) emit(events.back().t_s, true);
+  return result;
+}
+
+}  // namespace uwb
