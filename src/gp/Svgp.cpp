@@ -237,7 +237,7 @@ ElboTerms Svgp::elbo(const MatX& X_raw, const VecX& y, double num_data, SvgpGrad
   g.Z += 2.0 * gZ_zz;
   kernel_.accumulateDiagGradient(-0.5 * beta * Bd, g.kernel);  // k̄_n = −β/2 for every n
   g.AAt = std::move(AAt);
-  g.Ar_centered = std::move(Ar);
+  g.Ar = std::move(Ar);
   return out;
 }
 

@@ -37,7 +37,7 @@ struct SvgpGradient {
   VecX m;                 ///< M
   MatX L;                 ///< M×M, lower triangle (zeros above)
   MatX AAt;               ///< by-product: A Aᵀ of the batch (used by natural-gradient steps)
-  VecX Ar_centered;       ///< by-product: A (y − c)
+  VecX Ar;               ///< by-product: A r, r = y − mean_f (A (y − c) = A r + A Aᵀ m)
 };
 
 /// How the O(M²B) products are formed. kExact: triangular solves with A = Lz⁻¹Kzx (reference formulas,

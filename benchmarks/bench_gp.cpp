@@ -1,0 +1,120 @@
+/** @file bench_gp.cpp
+ *  @brief SVGP speed against the GPyTorch 1.10 reference measured on this machine (issue 4):
+ *         N = 50,000, D = 4, minibatch 1024, one thread, float64, RBF-ARD kernel.
+ *         GPyTorch (Adam): 0.51 s/epoch at M = 30, 1.51 s/epoch at M = 170.
+ *         Targets: ≥ 10× faster at M = 30, ≥ 3× at M = 170; 10,000 predictions at M = 170 in < 10 ms.
+ *
+ *  Run: build-gp/benchmarks/bench_gp --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+ */
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+#include "uwb/gp/SvgpTrainer.h"
+
+namespace {
+
+using uwb::MatX;
+using uwb::VecX;
+using namespace uwb::gp;
+
+struct Problem {
+  MatX X;
+  VecX y;
+};
+
+const Problem& problem() {
+  static const Problem p = [] {
+    Problem q;
+    std::mt19937_64 rng(42);
+    std::uniform_real_distribution<double> u(-2.0, 2.0);
+    std::normal_distribution<double> n(0.0, 0.1);
+    const int N = 50000, D = 4;
+    q.X.resize(N, D);
+    q.y.resize(N);
+    for (int i = 0; i < N; ++i) {
+      for (int d = 0; d < D; ++d) q.X(i, d) = u(rng);
+      q.y[i] = std::sin(q.X(i, 0)) * std::cos(q.X(i, 1)) + 0.3 * q.X(i, 2) - 0.2 * q.X(i, 3) * q.X(i, 3) + n(rng);
+    }
+    return q;
+  }();
+  return p;
+}
+
+Kernel rbfArd() {
+  PartSpec s{PartType::kRbf, {0, 1, 2, 3}, 1.0, {1.0, 1.0, 1.0, 1.0}};
+  return Kernel::sum({s});
+}
+
+Svgp makeModel(int M) {
+  const Problem& p = problem();
+  return initSvgp(rbfArd(), p.X, p.y, M, /*seed=*/1);
+}
+
+/// One epoch (49 minibatches) of Adam on every parameter (hyperparameters, noise, mean, Z, m, L): GPyTorch's setup.
+void BM_SvgpEpochAdam(benchmark::State& state) {
+  const int M = static_cast<int>(state.range(0));
+  const ElboMode mode = state.range(1) ? ElboMode::kFast : ElboMode::kExact;
+  Svgp gp = makeModel(M);
+  SvgpTrainParams params;
+  params.epochs = 1;
+  params.batch_size = 1024;
+  params.natgrad_step = 0.0;  // Adam for m, L too
+  params.mode = mode;
+  for (auto _ : state) {
+    trainSvgp(gp, problem().X, problem().y, params);
+    benchmark::ClobberMemory();
+  }
+  state.SetLabel(mode == ElboMode::kFast ? "fast" : "exact");
+}
+BENCHMARK(BM_SvgpEpochAdam)->Args({30, 1})->Args({170, 1})->Args({30, 0})->Args({170, 0})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// One epoch of Adam (hyperparameters, Z) + natural-gradient steps on q(v), the default training.
+void BM_SvgpEpochNatgrad(benchmark::State& state) {
+  const int M = static_cast<int>(state.range(0));
+  Svgp gp = makeModel(M);
+  SvgpTrainParams params;
+  params.epochs = 1;
+  params.batch_size = 1024;
+  params.natgrad_step = 0.2;
+  for (auto _ : state) {
+    trainSvgp(gp, problem().X, problem().y, params);
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_SvgpEpochNatgrad)->Arg(30)->Arg(170)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// Batch prediction of 10,000 points (mean, var_f, var_y) with a precomputed predictor.
+void BM_SvgpPredictBatch(benchmark::State& state) {
+  const int M = static_cast<int>(state.range(0));
+  const Svgp gp = makeModel(M);
+  const SvgpPredictor pred = gp.predictor();
+  const MatX Xt = problem().X.topRows(10000);
+  for (auto _ : state) {
+    SvgpPrediction p = pred.predict(Xt);
+    benchmark::DoNotOptimize(p.mean.data());
+  }
+  state.SetItemsProcessed(state.iterations() * Xt.rows());
+}
+BENCHMARK(BM_SvgpPredictBatch)->Arg(30)->Arg(170)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// Single-point prediction (what the filter calls once per TDoA measurement).
+void BM_SvgpPredictOne(benchmark::State& state) {
+  const int M = static_cast<int>(state.range(0));
+  const Svgp gp = makeModel(M);
+  const SvgpPredictor pred = gp.predictor();
+  const MatX& X = problem().X;
+  Eigen::Index i = 0;
+  for (auto _ : state) {
+    double mean = 0, var = 0;
+    pred.predictOne(X.row(i), mean, var);
+    benchmark::DoNotOptimize(mean);
+    benchmark::DoNotOptimize(var);
+    i = (i + 1) % 10000;
+  }
+}
+BENCHMARK(BM_SvgpPredictOne)->Arg(30)->Arg(170)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,72 @@
+/** @file BiasDataset.h
+ *  @brief Training data for the TDoA bias GP from flights with ground truth (paper eq. 6, III-B;
+ *         docs/math/gp.md P25).
+ *
+ *  For every TDoA measurement z (UTIL convention z = |p_tag − a_B| − |p_tag − a_A|):
+ *    ε = z − (‖p_tag − a_B‖ − ‖p_tag − a_A‖),  p_tag = w_p_b + w_R_b b_t_tag        (paper eq. 6 with lever arm)
+ *  and the GP inputs from the interpolated ground-truth pose (model/TdoaFeature.h: makeTdoaFeature).
+ *  Exclusion rules are explicit, user-settable and each one's count is reported (util-pilot SOURCE.md Caveats).
+ */
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "uwb/core/Types.h"
+#include "uwb/io/AnchorSurvey.h"
+#include "uwb/io/Flight.h"
+#include "uwb/io/PoseTrack.h"
+#include "uwb/model/TdoaFeature.h"
+
+namespace uwb {
+
+/// The exclusion rules, applied in this order; a sample is counted under the first rule that removes it.
+struct BiasDatasetParams {
+  Vec3 b_t_tag = kUtilTagOffset_b;  ///< tag (antenna) offset in the body frame [m]
+  double min_z_m = 0.3;             ///< on the ground: ground-truth body z below this is excluded [m]
+  double glitch_margin_s = 0.05;    ///< measurements within this time of a rejected (glitch) pose sample [s]
+  double max_abs_error_m = 1.0;     ///< gross outliers: |ε| above this [m]; ≤ 0 disables the rule
+  bool neighbour_pairs_only = false;  ///< keep only cyclic neighbour pairs (0,1)…(7,0) (UTIL TDoA2)
+  PoseTrackParams pose_track;       ///< ground-truth glitch detection and interpolation
+  /// Throws std::invalid_argument naming the bad field.
+  void validate() const;
+};
+
+/// One training sample: the feature from the ground-truth pose and the measurement error ε (paper eq. 6).
+struct BiasSample {
+  TdoaFeature feature;
+  double error_m = 0.0;  ///< ε [m]
+  double t_s = 0.0;
+  int flight = 0;        ///< index of the source flight
+};
+
+/// Per-flight bookkeeping: every measurement lands in exactly one counter.
+struct BiasFlightReport {
+  std::string source;
+  std::size_t n_measurements = 0;
+  std::size_t n_unknown_anchor = 0;    ///< anchor id missing from the survey
+  std::size_t n_no_ground_truth = 0;   ///< outside the pose track or in a pose gap
+  std::size_t n_pose_glitch = 0;       ///< within glitch_margin_s of a rejected pose sample
+  std::size_t n_on_ground = 0;         ///< ground-truth z < min_z_m
+  std::size_t n_non_neighbour = 0;     ///< non-neighbour pair (only when neighbour_pairs_only)
+  std::size_t n_outlier = 0;           ///< |ε| > max_abs_error_m
+  std::size_t n_used = 0;
+  std::size_t n_pose_glitches_detected = 0;  ///< rejected pose samples (attitude + position)
+};
+
+struct BiasDataset {
+  std::vector<BiasSample> samples;
+  std::vector<BiasFlightReport> flights;
+  BiasDatasetParams params;
+
+  /// Human-readable table of the exclusion counts per flight.
+  std::string reportText() const;
+};
+
+/// Builds the dataset. Throws InputError when a flight has no ground-truth pose or no pose orientation (the
+/// body-frame features need it), and std::invalid_argument for bad params.
+BiasDataset buildBiasDataset(const std::vector<Flight>& flights, const AnchorSurvey& survey,
+                             const BiasDatasetParams& params = {});
+
+}  // namespace uwb

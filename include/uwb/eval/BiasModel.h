@@ -1,0 +1,121 @@
+/** @file BiasModel.h
+ *  @brief A trained TDoA bias model: SVGP(s) plus the feature mapping, as a uwb::BiasPredictor for the filter.
+ *
+ *  Paper III-B: the measurement is corrected by the GP mean and the GP variance is added to the measurement
+ *  variance. Presets (docs/math/gp.md P26):
+ *   - "z1"   periodic(yaw_a) + periodic(yaw_b)                 inputs [yaw_a, yaw_b]        (paper eq. 7)
+ *   - "z2"   Matérn-5/2(yaw_a) + Matérn-5/2(yaw_b)             inputs [yaw_a, yaw_b]        (paper eq. 8)
+ *   - "tdoa" k_L(b_p_a) + k_L(b_p_b)                           inputs [b_p_a, b_p_b]        (paper eq. 9)
+ *   beyond the paper:
+ *   - "pair-tdoa" one "tdoa" GP per anchor pair
+ *   - "pair-pos"  one GP per anchor pair, RBF-ARD on the body position w_p_b (standardized inputs)
+ *  A pair without a model predicts {0, 0} (no correction, no added variance).
+ *  Model file: JSON, {"format": "uwbtdoa-bias-model", "version": 1, ...}; see toJson().
+ */
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "uwb/eval/BiasDataset.h"
+#include "uwb/gp/Svgp.h"
+#include "uwb/gp/SvgpTrainer.h"
+#include "uwb/model/TdoaFeature.h"
+
+namespace uwb {
+
+/// Which TdoaFeature fields form the GP input row.
+enum class FeatureMap {
+  kYawAngles,      ///< [yaw_a_rad, yaw_b_rad]
+  kBodyPositions,  ///< [b_p_a (3), b_p_b (3)] [m]
+  kWorldPosition,  ///< [w_p_b (3)] [m]
+};
+std::string toString(FeatureMap map);
+FeatureMap featureMapFromString(const std::string& name);
+int featureDim(FeatureMap map);
+/// Writes the GP input row of f into row (featureDim(map) values).
+void featureRow(FeatureMap map, const TdoaFeature& f, double* row);
+MatX featureMatrix(FeatureMap map, const std::vector<TdoaFeature>& features);
+
+/// Paper and extra presets: kernel, feature map, one GP per pair or one global GP.
+struct BiasPreset {
+  std::string name;
+  FeatureMap features = FeatureMap::kYawAngles;
+  bool per_pair = false;
+  gp::InputNormalization normalization = gp::InputNormalization::kNone;
+  gp::Kernel kernel() const;  ///< fresh kernel with default hyperparameters
+  static BiasPreset byName(const std::string& name);  ///< throws std::invalid_argument listing the presets
+  static std::vector<std::string> names();
+};
+
+struct BiasTrainParams {
+  std::string preset = "z1";
+  int num_inducing = 30;            ///< M (per GP)
+  gp::SvgpTrainParams svgp;         ///< epochs, batch, seed, learning rates, natural-gradient step
+  double holdout_fraction = 0.2;    ///< share of the data held out (whole time blocks) for the before/after RMSE
+  double holdout_block_s = 5.0;     ///< block length of the held-out split [s] (the error is correlated in time)
+  int min_samples_per_inducing = 2; ///< need ≥ this × M training samples (per GP)
+  void validate() const;
+};
+
+/// What training did; RMSEs on the held-out part.
+struct BiasTrainReport {
+  std::size_t n_train = 0, n_holdout = 0;
+  double bias_rmse_before_m = 0.0;  ///< RMSE of raw ε on the held-out part
+  double bias_rmse_after_m = 0.0;   ///< RMSE of ε − predicted mean on the held-out part
+  double mean_predicted_std_m = 0.0;  ///< mean predictive std (latent) on the held-out part
+  double train_seconds = 0.0;
+  int num_models = 0;
+};
+
+/// Progress: (model index, number of models, epoch report).
+using BiasTrainProgress = std::function<void(int, int, const gp::EpochReport&)>;
+
+class BiasModel {
+ public:
+  struct Entry {
+    int id_a = -1, id_b = -1;  ///< -1: the global model (all pairs)
+    gp::Svgp gp;
+  };
+
+  BiasModel() = default;
+  BiasModel(std::string preset, FeatureMap features, std::vector<Entry> entries);
+
+  /// Predicted bias (mean, latent variance) for one measurement's feature. {0, 0} when no model covers the pair.
+  BiasPrediction predict(const TdoaFeature& f) const;
+  /// A cheap-to-copy, thread-compatible callable for the filter (shares this model's immutable state).
+  BiasPredictor predictor() const;
+
+  const std::string& preset() const { return preset_; }
+  FeatureMap features() const { return features_; }
+  const std::vector<Entry>& entries() const { return entries_; }
+
+  nlohmann::json toJson() const;
+  static BiasModel fromJson(const nlohmann::json& j);  ///< throws std::invalid_argument (clear message)
+  void save(const std::string& path) const;             ///< throws FileError
+  static BiasModel load(const std::string& path);       ///< throws FileError / InputError naming the file
+
+  /// Extra metadata stored with the model (training summary); free-form JSON object.
+  std::string metadata_json = "{}";
+
+ private:
+  void buildPredictors();
+  std::string preset_;
+  FeatureMap features_ = FeatureMap::kYawAngles;
+  std::vector<Entry> entries_;
+  std::shared_ptr<const std::vector<gp::SvgpPredictor>> predictors_;
+};
+
+/// Splits the dataset into train / held-out by time blocks (deterministic), trains the preset's GP(s) and reports
+/// the held-out bias RMSE before and after. Throws std::invalid_argument when there are too few samples for M.
+BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params, BiasTrainReport* report = nullptr,
+                         const BiasTrainProgress& progress = {});
+
+/// Indices of held-out samples: every k-th block of `block_s` seconds of each flight, k = round(1/fraction).
+std::vector<bool> holdoutMask(const std::vector<BiasSample>& samples, double fraction, double block_s);
+
+}  // namespace uwb

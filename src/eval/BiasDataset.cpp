@@ -1,0 +1,112 @@
+/** @file BiasDataset.cpp
+ *  @brief GP training samples from flights with ground truth (paper eq. 6; docs/math/gp.md P25).
+ */
+#include "uwb/eval/BiasDataset.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "uwb/core/Error.h"
+#include "uwb/io/FlightSummary.h"
+
+namespace uwb {
+
+void BiasDatasetParams::validate() const {
+  if (!std::isfinite(min_z_m)) throw std::invalid_argument("BiasDatasetParams.min_z_m must be finite");
+  if (!(glitch_margin_s >= 0)) throw std::invalid_argument("BiasDatasetParams.glitch_margin_s must be ≥ 0");
+  if (!std::isfinite(max_abs_error_m)) throw std::invalid_argument("BiasDatasetParams.max_abs_error_m must be finite");
+  if (!b_t_tag.allFinite()) throw std::invalid_argument("BiasDatasetParams.b_t_tag must be finite");
+  pose_track.validate();
+}
+
+BiasDataset buildBiasDataset(const std::vector<Flight>& flights, const AnchorSurvey& survey,
+                             const BiasDatasetParams& params) {
+  params.validate();
+  BiasDataset ds;
+  ds.params = params;
+  std::vector<int> ids;
+  for (const Anchor& a : survey.anchors) ids.push_back(a.id);
+  std::sort(ids.begin(), ids.end());
+
+  for (std::size_t fi = 0; fi < flights.size(); ++fi) {
+    const Flight& flight = flights[fi];
+    const std::string name = flight.source.empty() ? "flight #" + std::to_string(fi + 1) : flight.source;
+    if (!flight.hasGroundTruth())
+      throw InputError(SourceLocation{flight.source, 0, 0, "pose_x"},
+                       "training flight " + name + " has no ground-truth pose (pose_* columns are empty)");
+    if (!flight.pose_has_orientation)
+      throw InputError(SourceLocation{flight.source, 0, 0, "pose_qw"},
+                       "training flight " + name +
+                           " has no ground-truth orientation; the bias features need the body frame");
+    const PoseTrack track(flight, params.pose_track);
+    TdoaResidualParams rp;
+    rp.b_t_tag = params.b_t_tag;
+    rp.airborne_min_z_m = params.min_z_m;
+    TdoaResidualReport rr;
+    const std::vector<TdoaResidual> residuals = tdoaResiduals(flight, survey, track, rp, &rr);
+
+    BiasFlightReport rep;
+    rep.source = name;
+    rep.n_measurements = rr.n_measurements;
+    rep.n_unknown_anchor = rr.n_unknown_anchor;
+    rep.n_no_ground_truth = rr.n_no_ground_truth;
+    rep.n_pose_glitches_detected = track.glitches().size();
+    std::vector<double> glitch_times;
+    for (const auto& g : track.glitches()) glitch_times.push_back(g.t_s);
+    std::sort(glitch_times.begin(), glitch_times.end());
+
+    for (const TdoaResidual& r : residuals) {
+      // rule: near a pose glitch
+      if (!glitch_times.empty()) {
+        const auto it = std::lower_bound(glitch_times.begin(), glitch_times.end(), r.t_s - params.glitch_margin_s);
+        if (it != glitch_times.end() && *it <= r.t_s + params.glitch_margin_s) {
+          ++rep.n_pose_glitch;
+          continue;
+        }
+      }
+      // rule: on the ground (TDoA grossly wrong there, SOURCE.md Caveats)
+      if (r.w_p_b.z() < params.min_z_m) {
+        ++rep.n_on_ground;
+        continue;
+      }
+      // rule: neighbour pairs only (optional)
+      if (params.neighbour_pairs_only && !isNeighbourPair(r.id_a, r.id_b, ids) && !isNeighbourPair(r.id_b, r.id_a, ids)) {
+        ++rep.n_non_neighbour;
+        continue;
+      }
+      // paper eq. (6) with the UTIL sign convention and the lever arm (computed by tdoaResiduals)
+      const double eps = r.residual_m;
+      if (!std::isfinite(eps) || (params.max_abs_error_m > 0 && std::abs(eps) > params.max_abs_error_m)) {
+        ++rep.n_outlier;
+        continue;
+      }
+      BiasSample s;
+      s.feature = makeTdoaFeature(r.id_a, r.id_b, r.w_p_b, r.w_q_b, survey.position(r.id_a), survey.position(r.id_b));
+      s.error_m = eps;
+      s.t_s = r.t_s;
+      s.flight = static_cast<int>(fi);
+      ds.samples.push_back(s);
+      ++rep.n_used;
+    }
+    ds.flights.push_back(rep);
+  }
+  return ds;
+}
+
+std::string BiasDataset::reportText() const {
+  std::ostringstream os;
+  os << "training data (paper eq. 6): rules min_z=" << params.min_z_m << " m, glitch margin=" << params.glitch_margin_s
+     << " s, |eps| > " << params.max_abs_error_m << " m, neighbour pairs only=" << (params.neighbour_pairs_only ? "yes" : "no")
+     << "\n";
+  os << "  flight: measurements | unknown anchor | no ground truth | pose glitch | on ground | non-neighbour | outlier | used\n";
+  for (const auto& f : flights) {
+    os << "  " << f.source << ": " << f.n_measurements << " | " << f.n_unknown_anchor << " | " << f.n_no_ground_truth
+       << " | " << f.n_pose_glitch << " (" << f.n_pose_glitches_detected << " glitch samples) | " << f.n_on_ground << " | "
+       << f.n_non_neighbour << " | " << f.n_outlier << " | " << f.n_used << "\n";
+  }
+  return os.str();
+}
+
+}  // namespace uwb

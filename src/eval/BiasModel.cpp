@@ -1,0 +1,308 @@
+/** @file BiasModel.cpp
+ *  @brief Bias-model presets, training from a BiasDataset, prediction and model files (docs/math/gp.md P25–P27).
+ */
+#include "uwb/eval/BiasModel.h"
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "uwb/core/Error.h"
+
+namespace uwb {
+
+std::string toString(FeatureMap map) {
+  switch (map) {
+    case FeatureMap::kYawAngles: return "yaw_angles";
+    case FeatureMap::kBodyPositions: return "body_positions";
+    case FeatureMap::kWorldPosition: return "world_position";
+  }
+  return "unknown";
+}
+
+FeatureMap featureMapFromString(const std::string& name) {
+  if (name == "yaw_angles") return FeatureMap::kYawAngles;
+  if (name == "body_positions") return FeatureMap::kBodyPositions;
+  if (name == "world_position") return FeatureMap::kWorldPosition;
+  throw std::invalid_argument("unknown feature map '" + name + "' (yaw_angles, body_positions, world_position)");
+}
+
+int featureDim(FeatureMap map) {
+  switch (map) {
+    case FeatureMap::kYawAngles: return 2;
+    case FeatureMap::kBodyPositions: return 6;
+    case FeatureMap::kWorldPosition: return 3;
+  }
+  return 0;
+}
+
+void featureRow(FeatureMap map, const TdoaFeature& f, double* row) {
+  switch (map) {
+    case FeatureMap::kYawAngles:  // paper eq. (7)/(8): [α_A, α_B]
+      row[0] = f.yaw_a_rad;
+      row[1] = f.yaw_b_rad;
+      return;
+    case FeatureMap::kBodyPositions:  // paper eq. (9): [x_kA, x_kB]
+      for (int i = 0; i < 3; ++i) {
+        row[i] = f.b_p_a[i];
+        row[3 + i] = f.b_p_b[i];
+      }
+      return;
+    case FeatureMap::kWorldPosition:
+      for (int i = 0; i < 3; ++i) row[i] = f.w_p_b[i];
+      return;
+  }
+}
+
+MatX featureMatrix(FeatureMap map, const std::vector<TdoaFeature>& features) {
+  const int D = featureDim(map);
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> X(features.size(), D);
+  for (std::size_t i = 0; i < features.size(); ++i) featureRow(map, features[i], X.row(static_cast<Eigen::Index>(i)).data());
+  return X;
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+
+gp::Kernel BiasPreset::kernel() const {
+  if (name == "z1" || name == "z2" || name == "tdoa") return gp::Kernel::preset(name);
+  if (name == "pair-tdoa") return gp::Kernel::preset("tdoa");
+  if (name == "pair-pos") {
+    gp::PartSpec s{gp::PartType::kRbf, {0, 1, 2}, 0.02, {0.5, 0.5, 0.5}};
+    return gp::Kernel::sum({s});
+  }
+  throw std::invalid_argument("unknown bias-model preset '" + name + "'");
+}
+
+BiasPreset BiasPreset::byName(const std::string& name) {
+  BiasPreset p;
+  p.name = name;
+  if (name == "z1" || name == "z2") {
+    p.features = FeatureMap::kYawAngles;
+  } else if (name == "tdoa") {
+    p.features = FeatureMap::kBodyPositions;
+  } else if (name == "pair-tdoa") {
+    p.features = FeatureMap::kBodyPositions;
+    p.per_pair = true;
+  } else if (name == "pair-pos") {
+    p.features = FeatureMap::kWorldPosition;
+    p.per_pair = true;
+    p.normalization = gp::InputNormalization::kStandardize;
+  } else {
+    throw std::invalid_argument("unknown bias-model kernel/preset '" + name + "' (expected z1, z2, tdoa, pair-tdoa, pair-pos)");
+  }
+  return p;
+}
+
+std::vector<std::string> BiasPreset::names() { return {"z1", "z2", "tdoa", "pair-tdoa", "pair-pos"}; }
+
+void BiasTrainParams::validate() const {
+  BiasPreset::byName(preset);
+  if (num_inducing < 1) throw std::invalid_argument("number of inducing points must be ≥ 1");
+  if (!(holdout_fraction >= 0) || holdout_fraction >= 1) throw std::invalid_argument("holdout_fraction must be in [0, 1)");
+  if (!(holdout_block_s > 0)) throw std::invalid_argument("holdout_block_s must be > 0");
+  if (min_samples_per_inducing < 1) throw std::invalid_argument("min_samples_per_inducing must be ≥ 1");
+  svgp.validate();
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+
+BiasModel::BiasModel(std::string preset, FeatureMap features, std::vector<Entry> entries)
+    : preset_(std::move(preset)), features_(features), entries_(std::move(entries)) {
+  for (const auto& e : entries_) {
+    if (e.gp.inputDim() != featureDim(features_))
+      throw std::invalid_argument("bias model: GP input dimension " + std::to_string(e.gp.inputDim()) +
+                                  " does not match the feature map " + toString(features_) + " (" +
+                                  std::to_string(featureDim(features_)) + ")");
+  }
+  buildPredictors();
+}
+
+void BiasModel::buildPredictors() {
+  auto preds = std::make_shared<std::vector<gp::SvgpPredictor>>();
+  preds->reserve(entries_.size());
+  for (const auto& e : entries_) preds->emplace_back(e.gp);
+  predictors_ = preds;
+}
+
+namespace {
+BiasPrediction predictWith(const std::vector<BiasModel::Entry>& entries, const std::vector<gp::SvgpPredictor>& preds,
+                           FeatureMap map, const TdoaFeature& f) {
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const auto& e = entries[i];
+    if (e.id_a >= 0 && (e.id_a != f.id_a || e.id_b != f.id_b)) continue;
+    double row[6];
+    featureRow(map, f, row);
+    double mean = 0, var = 0;
+    preds[i].predictOne(Eigen::Map<const RowVecX>(row, featureDim(map)), mean, var);
+    return {mean, std::max(var, 0.0)};
+  }
+  return {0.0, 0.0};
+}
+}  // namespace
+
+BiasPrediction BiasModel::predict(const TdoaFeature& f) const { return predictWith(entries_, *predictors_, features_, f); }
+
+BiasPredictor BiasModel::predictor() const {
+  auto self = std::make_shared<const BiasModel>(*this);
+  return [self](const TdoaFeature& f) { return self->predict(f); };
+}
+
+nlohmann::json BiasModel::toJson() const {
+  nlohmann::json models = nlohmann::json::array();
+  for (const auto& e : entries_) models.push_back({{"id_a", e.id_a}, {"id_b", e.id_b}, {"svgp", e.gp.toJson()}});
+  nlohmann::json meta = nlohmann::json::parse(metadata_json, nullptr, false);
+  if (meta.is_discarded()) meta = nlohmann::json::object();
+  return {{"format", "uwbtdoa-bias-model"},
+          {"version", 1},
+          {"preset", preset_},
+          {"features", toString(features_)},
+          {"feature_columns", featureDim(features_)},
+          {"per_pair", !entries_.empty() && entries_[0].id_a >= 0},
+          {"models", models},
+          {"training", meta}};
+}
+
+BiasModel BiasModel::fromJson(const nlohmann::json& j) {
+  try {
+    if (!j.is_object()) throw std::invalid_argument("not a JSON object");
+    if (j.value("format", std::string()) != "uwbtdoa-bias-model")
+      throw std::invalid_argument("\"format\" is not \"uwbtdoa-bias-model\" (is this a bias model file?)");
+    const int version = j.at("version").get<int>();
+    if (version != 1) throw std::invalid_argument("unsupported bias model version " + std::to_string(version) + " (expected 1)");
+    const FeatureMap map = featureMapFromString(j.at("features").get<std::string>());
+    if (j.contains("feature_columns") && j.at("feature_columns").get<int>() != featureDim(map))
+      throw std::invalid_argument("feature_columns does not match the feature map");
+    std::vector<Entry> entries;
+    for (const auto& m : j.at("models")) entries.push_back({m.at("id_a").get<int>(), m.at("id_b").get<int>(), gp::Svgp::fromJson(m.at("svgp"))});
+    if (entries.empty()) throw std::invalid_argument("no models in the file");
+    BiasModel model(j.at("preset").get<std::string>(), map, std::move(entries));
+    if (j.contains("training")) model.metadata_json = j.at("training").dump();
+    return model;
+  } catch (const nlohmann::json::exception& e) {
+    throw std::invalid_argument(std::string("bias model: ") + e.what());
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("bias model: ") + e.what());
+  }
+}
+
+void BiasModel::save(const std::string& path) const {
+  std::ofstream out(path);
+  if (!out) throw FileError("cannot write bias model '" + path + "'");
+  out << toJson().dump(1) << '\n';
+  if (!out) throw FileError("error while writing bias model '" + path + "'");
+}
+
+BiasModel BiasModel::load(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw FileError("cannot open bias model '" + path + "'");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(SourceLocation{path, 0, 0, ""}, std::string("not valid JSON (corrupt model file?): ") + e.what());
+  }
+  try {
+    return fromJson(j);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(SourceLocation{path, 0, 0, ""}, e.what());
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+
+std::vector<bool> holdoutMask(const std::vector<BiasSample>& samples, double fraction, double block_s) {
+  std::vector<bool> mask(samples.size(), false);
+  if (fraction <= 0) return mask;
+  const long k = std::max(2L, std::lround(1.0 / fraction));
+  std::map<int, double> t0;
+  for (const auto& s : samples) {
+    auto it = t0.find(s.flight);
+    if (it == t0.end() || s.t_s < it->second) t0[s.flight] = s.t_s;
+  }
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const long block = static_cast<long>(std::floor((samples[i].t_s - t0[samples[i].flight]) / block_s));
+    mask[i] = (block % k) == k - 1;
+  }
+  return mask;
+}
+
+BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params, BiasTrainReport* report,
+                         const BiasTrainProgress& progress) {
+  params.validate();
+  const BiasPreset preset = BiasPreset::byName(params.preset);
+  const auto t_start = std::chrono::steady_clock::now();
+  const std::vector<bool> hold = holdoutMask(data.samples, params.holdout_fraction, params.holdout_block_s);
+
+  // groups: one per pair (per-pair presets) or one global
+  std::map<std::pair<int, int>, std::vector<std::size_t>> groups;
+  for (std::size_t i = 0; i < data.samples.size(); ++i) {
+    const auto& f = data.samples[i].feature;
+    groups[preset.per_pair ? std::make_pair(f.id_a, f.id_b) : std::make_pair(-1, -1)].push_back(i);
+  }
+  const std::size_t need = static_cast<std::size_t>(params.min_samples_per_inducing) * params.num_inducing;
+  std::size_t n_train_total = 0;
+  for (const auto& [key, idx] : groups)
+    for (std::size_t i : idx) n_train_total += hold[i] ? 0 : 1;
+  if (n_train_total < need)
+    throw std::invalid_argument("too few usable training samples: " + std::to_string(n_train_total) + " after exclusions and hold-out, need ≥ " +
+                                std::to_string(need) + " for " + std::to_string(params.num_inducing) +
+                                " inducing points (reduce --inducing or add flights)");
+
+  std::vector<BiasModel::Entry> entries;
+  int model_index = 0;
+  const int num_models = static_cast<int>(groups.size());
+  for (const auto& [key, idx] : groups) {
+    std::vector<TdoaFeature> ftr, fho;
+    std::vector<double> ytr, yho;
+    for (std::size_t i : idx) {
+      (hold[i] ? fho : ftr).push_back(data.samples[i].feature);
+      (hold[i] ? yho : ytr).push_back(data.samples[i].error_m);
+    }
+    ++model_index;
+    if (ftr.size() < need) continue;  // per-pair: too few for this pair → no model (predicts 0)
+    const MatX X = featureMatrix(preset.features, ftr);
+    const VecX y = Eigen::Map<const VecX>(ytr.data(), static_cast<Eigen::Index>(ytr.size()));
+    const MatX Xh = featureMatrix(preset.features, fho);
+    const VecX yh = Eigen::Map<const VecX>(yho.data(), static_cast<Eigen::Index>(yho.size()));
+    gp::Svgp svgp = gp::initSvgp(preset.kernel(), X, y, params.num_inducing, params.svgp.seed, preset.normalization);
+    const int mi = model_index;
+    gp::trainSvgp(svgp, X, y, params.svgp, yh.size() > 0 ? &Xh : nullptr, yh.size() > 0 ? &yh : nullptr,
+                  [&](const gp::EpochReport& r) {
+                    if (progress) progress(mi, num_models, r);
+                  });
+    entries.push_back({key.first, key.second, std::move(svgp)});
+  }
+  if (entries.empty()) throw std::invalid_argument("no anchor pair has enough training samples for the requested inducing points");
+  BiasModel model(preset.name, preset.features, std::move(entries));
+
+  if (report) {
+    BiasTrainReport r;
+    r.train_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    r.num_models = static_cast<int>(model.entries().size());
+    double se_before = 0, se_after = 0, sum_std = 0;
+    for (std::size_t i = 0; i < data.samples.size(); ++i) {
+      if (!hold[i]) {
+        ++r.n_train;
+        continue;
+      }
+      ++r.n_holdout;
+      const double eps = data.samples[i].error_m;
+      const BiasPrediction p = model.predict(data.samples[i].feature);
+      se_before += eps * eps;
+      se_after += (eps - p.mean_m) * (eps - p.mean_m);
+      sum_std += std::sqrt(p.variance_m2);
+    }
+    const double n = static_cast<double>(r.n_holdout);
+    r.bias_rmse_before_m = n > 0 ? std::sqrt(se_before / n) : std::nan("");
+    r.bias_rmse_after_m = n > 0 ? std::sqrt(se_after / n) : std::nan("");
+    r.mean_predicted_std_m = n > 0 ? sum_std / n : std::nan("");
+    *report = r;
+  }
+  return model;
+}
+
+}  // namespace uwb
