@@ -305,6 +305,42 @@ PoseTrackParams poseTrackParams(const py::dict& overrides) {
 
 }  // namespace
 
+py::dict poseSamplesToDict(const std::vector<PoseSample>& samples) { return poseDict(samples); }
+
+py::dict trajectoryToDict(const Trajectory& v) {
+  const auto n = static_cast<Eigen::Index>(v.size());
+  RowMat t(n, 1), p(n, 3), q(n, 4), s(n, 3), vel(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    t(i, 0) = v[i].t_s;
+    p.row(i) = v[i].w_p_b.transpose();
+    q.row(i) << v[i].w_q_b.x(), v[i].w_q_b.y(), v[i].w_q_b.z(), v[i].w_q_b.w();
+    s.row(i) = v[i].sigma_p_m.transpose();
+    vel.row(i) = v[i].w_v_b.transpose();
+  }
+  py::dict d;
+  d["t"] = toNumpy(t, true), d["p"] = toNumpy(p), d["q"] = toNumpy(q), d["sigma_p"] = toNumpy(s);
+  d["v"] = toNumpy(vel);
+  return d;
+}
+
+Trajectory trajectoryFromDict(const py::dict& d) {
+  const Eigen::VectorXd t = column(d, "t", "trajectory");
+  const auto n = t.size();
+  const RowMat p = block(d, "p", "trajectory", 3, n);
+  const RowMat q = d.contains("q") ? block(d, "q", "trajectory", 4, n) : RowMat();
+  const RowMat s = d.contains("sigma_p") ? block(d, "sigma_p", "trajectory", 3, n) : RowMat();
+  const RowMat vel = d.contains("v") ? block(d, "v", "trajectory", 3, n) : RowMat();
+  Trajectory out(static_cast<std::size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    out[i].t_s = t(i);
+    out[i].w_p_b = row3(p, i);
+    if (q.size()) out[i].w_q_b = rowQuat(q, i);
+    if (s.size()) out[i].sigma_p_m = row3(s, i);
+    if (vel.size()) out[i].w_v_b = row3(vel, i);
+  }
+  return out;
+}
+
 /// Positions of the anchors of each id in `ids` (N, 3); KeyError naming the id when absent.
 RowMat anchorPositions(const AnchorSurvey& survey, const Eigen::VectorXi& ids) {
   RowMat out(ids.size(), 3);
@@ -535,6 +571,16 @@ void bindIo(py::module_& m) {
         writeFlightCsv(f, path);
       },
       py::arg("flight"), py::arg("path"), "Writes a flight in the UTIL layout (read_flight_csv reads it back exactly).");
+  m.def(
+      "read_trajectory_csv", [](const std::string& path) { return trajectoryToDict(readTrajectoryCsv(path)); },
+      py::arg("path"),
+      "Reads an estimated trajectory (t,x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz) into\n"
+      "{t, p (N, 3), q (N, 4), sigma_p (N, 3), v (N, 3)}.");
+  m.def(
+      "write_trajectory_csv",
+      [](const py::dict& trajectory, const std::string& path) { writeTrajectoryCsv(trajectoryFromDict(trajectory), path); },
+      py::arg("trajectory"), py::arg("path"),
+      "Writes a trajectory dict {t, p[, q, sigma_p, v]} as the trajectory CSV (missing fields: identity / zeros).");
   m.def("read_anchor_survey", &readAnchorSurvey, py::arg("path"), "Reads a UTIL anchor survey text file.");
   m.def("write_anchor_survey", &writeAnchorSurvey, py::arg("survey"), py::arg("path"),
         "Writes a survey that read_anchor_survey reads back exactly.");

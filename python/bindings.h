@@ -16,6 +16,8 @@
 #include <string>
 
 #include "uwb/core/Types.h"
+#include "uwb/io/Flight.h"
+#include "uwb/io/TrajectoryCsv.h"
 
 namespace uwb::python {
 
@@ -126,10 +128,17 @@ inline py::object requireKey(const py::dict& d, const char* key, const char* wha
   return d[key];
 }
 
+/// Trajectory ↔ dict {t (N,), p (N, 3), q (N, 4) (x, y, z, w), sigma_p (N, 3), v (N, 3)} (bind_io.cpp).
+py::dict trajectoryToDict(const Trajectory& trajectory);
+Trajectory trajectoryFromDict(const py::dict& d);
+/// Pose samples → {t, p, q} (bind_io.cpp).
+py::dict poseSamplesToDict(const std::vector<PoseSample>& samples);
+
 void bindCore(py::module_& m);
 void bindIo(py::module_& m);
 void bindModel(py::module_& m);
 void bindGp(py::module_& m);
 void bindSim(py::module_& m);
+void bindGpTrain(py::module_& m);
 
 }  // namespace uwb::python

@@ -41,5 +41,6 @@ PYBIND11_MODULE(_uwbtdoa, m) {
   uwb::python::bindIo(m);
   uwb::python::bindModel(m);
   uwb::python::bindGp(m);
+  uwb::python::bindGpTrain(m);
   uwb::python::bindSim(m);
 }

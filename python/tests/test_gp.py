@@ -66,3 +66,23 @@ def test_svgp_errors(tmp_path, X):
     bad.write_text("{not json")
     with pytest.raises(ValueError, match="bad.json: invalid JSON"):
         u.Svgp.load(str(bad))
+
+
+def test_training_reduces_the_error_of_a_learnable_function():
+    # GIVEN noisy samples of a smooth periodic function of two angles
+    rng = np.random.default_rng(8)
+    X = rng.uniform(-np.pi, np.pi, (1500, 2))
+    y = 0.1 * np.sin(X[:, 0]) + 0.05 * np.cos(2 * X[:, 1]) + rng.normal(0, 0.02, len(X))
+    gp = u.init_svgp(u.Kernel.preset("z1"), X, y, 20, seed=3)
+    assert gp.num_inducing == 20
+    epochs = []
+    # WHEN it is trained
+    summary = u.train_svgp(gp, X, y, epochs=15, batch_size=256, seed=3, on_epoch=epochs.append)
+    # THEN the ELBO history is reported and the fit explains most of the variance
+    assert len(epochs) == 15 and summary["elbo"].shape == (15,)
+    rmse = np.sqrt(np.mean((gp.predict(X)["mean"] - y) ** 2))
+    assert rmse < 0.5 * np.std(y)
+    with pytest.raises(ValueError, match="unknown training parameter 'epoch'"):
+        u.train_svgp(gp, X, y, epoch=3)
+    Z = u.kmeans_pp(X, 7, seed=1)
+    assert Z.shape == (7, 2)

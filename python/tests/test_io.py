@@ -118,3 +118,19 @@ def test_real_flight_reads_into_arrays_and_matches_the_model():
     airborne = pose["p"][i, 2] > 0.5
     z = u.predict_tdoa(pose["p"][i], pose["q"][i], survey.positions_of(tdoa["id_a"]), survey.positions_of(tdoa["id_b"]))
     assert np.median(np.abs(tdoa["tdoa"] - z)[airborne]) < 0.3
+
+
+def test_trajectory_csv_round_trip(tmp_path):
+    rng = np.random.default_rng(5)
+    n = 30
+    q = rng.normal(size=(n, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    traj = {"t": np.arange(n) * 0.01, "p": rng.normal(size=(n, 3)), "q": q,
+            "sigma_p": rng.uniform(0.01, 0.5, (n, 3)), "v": rng.normal(size=(n, 3))}
+    path = tmp_path / "traj.csv"
+    u.write_trajectory_csv(traj, str(path))
+    back = u.read_trajectory_csv(str(path))
+    for key in traj:
+        np.testing.assert_allclose(back[key], traj[key], rtol=1e-6, atol=1e-6, err_msg=key)
+    with pytest.raises(ValueError, match=r"trajectory\['p'\]"):
+        u.write_trajectory_csv({"t": np.zeros(3), "p": np.zeros((2, 3))}, str(path))
