@@ -1,0 +1,422 @@
+/** @file Evaluation.cpp
+ *  @brief The paper's evaluation pipeline (III-D, IV, Fig. 5–7): train, localize without/with correction, report.
+ */
+#include "uwb/eval/Evaluation.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <thread>
+
+#include "uwb/core/Error.h"
+
+namespace uwb {
+namespace {
+
+struct Job {
+  std::string kernel;
+  int inducing = 0;
+  int repeat = 0;
+};
+
+struct JobOutput {
+  std::vector<EvaluationRun> runs;  ///< one per test flight
+  std::map<std::string, LocalizationRun> corrected;  ///< kept for repeat 0 only
+  std::vector<std::pair<std::string, PositionErrorSample>> errors;
+  BiasModel model;  ///< kept for repeat 0 only
+};
+
+std::string configKey(const std::string& kernel, int inducing) { return fmt::format("{}/{}", kernel, inducing); }
+
+/// Airborne samples of a metrics object, decimated to at most rate_hz.
+std::vector<PositionErrorSample> decimatedAirborne(const TrajectoryMetrics& metrics, double rate_hz) {
+  std::vector<PositionErrorSample> out;
+  double next_t = -std::numeric_limits<double>::infinity();
+  for (const auto& s : metrics.samples) {
+    if (!s.airborne || s.t_s < next_t) continue;
+    out.push_back(s);
+    next_t = s.t_s + 1.0 / rate_hz;
+  }
+  return out;
+}
+
+/// RMSE of ε and of ε − GP mean over a dataset's samples (features from ground truth).
+std::pair<double, double> biasRmse(const BiasDataset& data, const BiasModel& model) {
+  double before = 0.0, after = 0.0;
+  for (const auto& s : data.samples) {
+    const double r = s.error_m - model.predict(s.feature).mean_m;
+    before += s.error_m * s.error_m;
+    after += r * r;
+  }
+  const double n = std::max<std::size_t>(data.samples.size(), 1);
+  return {std::sqrt(before / n), std::sqrt(after / n)};
+}
+
+double airborneRmse(const LocalizationRun& run, const std::string& flight) {
+  if (!run.metrics || run.metrics->airborne.n == 0) {
+    throw InputError(fmt::format("{}: no airborne ground truth (z > 0.3 m) to evaluate against", flight));
+  }
+  return run.metrics->airborne.rmse_m;
+}
+
+/// Fig. 7 data: the pair with the most training samples, GP mean on a grid over the two anchor yaw angles.
+BiasAngleFigure angleFigure(const BiasModel& model, const BiasDataset& train, const std::string& kernel, int inducing) {
+  BiasAngleFigure fig;
+  if (model.features() != FeatureMap::kYawAngles) return fig;
+  std::map<std::pair<int, int>, int> counts;
+  for (const auto& s : train.samples) ++counts[{s.feature.id_a, s.feature.id_b}];
+  if (counts.empty()) return fig;
+  const auto best = std::max_element(counts.begin(), counts.end(),
+                                     [](const auto& a, const auto& b) { return a.second < b.second; });
+  fig.kernel = kernel;
+  fig.inducing = inducing;
+  fig.id_a = best->first.first;
+  fig.id_b = best->first.second;
+  for (const auto& s : train.samples) {
+    if (s.feature.id_a != fig.id_a || s.feature.id_b != fig.id_b) continue;
+    fig.alpha_a_rad.push_back(s.feature.yaw_a_rad);
+    fig.alpha_b_rad.push_back(s.feature.yaw_b_rad);
+    fig.error_m.push_back(s.error_m);
+  }
+  constexpr int kGrid = 73;  // 5° steps over (−π, π]
+  for (int i = 0; i < kGrid; ++i) {
+    const double a = -kPi + 2.0 * kPi * i / (kGrid - 1);
+    fig.grid_alpha_a_rad.push_back(a);
+    fig.grid_alpha_b_rad.push_back(a);
+  }
+  fig.grid_mean_m.resize(kGrid, kGrid);
+  TdoaFeature f;
+  f.id_a = fig.id_a;
+  f.id_b = fig.id_b;
+  for (int r = 0; r < kGrid; ++r) {
+    for (int c = 0; c < kGrid; ++c) {
+      f.yaw_a_rad = fig.grid_alpha_a_rad[c];
+      f.yaw_b_rad = fig.grid_alpha_b_rad[r];
+      fig.grid_mean_m(r, c) = model.predict(f).mean_m;
+    }
+  }
+  for (const auto& entry : model.entries()) {
+    const bool covers = entry.id_a < 0 || (entry.id_a == fig.id_a && entry.id_b == fig.id_b);
+    if (!covers) continue;
+    MatX Z = entry.gp.inducing();  // in the GP's transformed input space
+    if (entry.gp.inputShift().size() == Z.cols()) {
+      Z = ((Z.array().rowwise() * entry.gp.inputScale().transpose().array()).rowwise() +
+           entry.gp.inputShift().transpose().array())
+              .matrix();
+    }
+    for (Eigen::Index i = 0; i < Z.rows(); ++i) {
+      fig.inducing_alpha_a_rad.push_back(Z(i, 0));
+      fig.inducing_alpha_b_rad.push_back(Z(i, 1));
+    }
+    break;
+  }
+  fig.valid = true;
+  return fig;
+}
+
+}  // namespace
+
+void EvaluationParams::validate() const {
+  if (kernels.empty()) throw std::invalid_argument("evaluation: no kernel given");
+  for (const auto& k : kernels) BiasPreset::byName(k);  // throws with the list of presets
+  if (inducing.empty()) throw std::invalid_argument("evaluation: no number of inducing points given");
+  for (int m : inducing) {
+    if (m < 1) throw std::invalid_argument(fmt::format("evaluation: inducing must be ≥ 1, got {}", m));
+  }
+  if (repeats < 1) throw std::invalid_argument(fmt::format("evaluation: repeats must be ≥ 1, got {}", repeats));
+  if (threads < 1) throw std::invalid_argument(fmt::format("evaluation: threads must be ≥ 1, got {}", threads));
+  if (!(figure_rate_hz > 0.0)) throw std::invalid_argument("evaluation: figure_rate_hz must be > 0");
+  train.validate();
+  dataset.validate();
+}
+
+EvaluationResult runEvaluation(const std::vector<NamedFlight>& train, const std::vector<NamedFlight>& test,
+                               const AnchorSurvey& survey, const EvaluationParams& params,
+                               const EvaluationProgress& progress) {
+  params.validate();
+  if (train.empty()) throw std::invalid_argument("evaluation: no training flight given");
+  if (test.empty()) throw std::invalid_argument("evaluation: no test flight given");
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto say = [&](const std::string& line) {
+    if (progress) progress(line);
+  };
+  EvaluationResult result;
+
+  // Training data (paper eq. 6) from the training flights' ground truth.
+  std::vector<Flight> train_flights;
+  for (const auto& f : train) train_flights.push_back(f.flight);
+  const BiasDataset train_data = buildBiasDataset(train_flights, survey, params.dataset);
+  result.dataset_report = train_data.reportText();
+  result.n_train_samples = train_data.samples.size();
+  say(fmt::format("training data: {} samples from {} flight(s)", train_data.samples.size(), train.size()));
+
+  // Test data for the bias RMSE (ground-truth features), and the uncorrected localization once per flight.
+  std::map<std::string, BiasDataset> test_data;
+  for (const auto& f : test) {
+    test_data.emplace(f.name, buildBiasDataset({f.flight}, survey, params.dataset));
+    LocalizationRun run = localizeFlight(f.flight, survey, params.localization);
+    say(fmt::format("{}: uncorrected airborne RMSE {:.3f} m", f.name, airborneRmse(run, f.name)));
+    result.uncorrected.emplace(f.name, std::move(run));
+  }
+
+  std::vector<Job> jobs;
+  for (const auto& kernel : params.kernels) {
+    for (int m : params.inducing) {
+      for (int r = 0; r < params.repeats; ++r) jobs.push_back({kernel, m, r});
+    }
+  }
+  std::vector<JobOutput> outputs(jobs.size());
+  std::atomic<std::size_t> next{0};
+  std::atomic<std::size_t> done{0};
+  std::mutex mutex;
+  std::exception_ptr failure;
+
+  const auto worker = [&] {
+    for (std::size_t j = next++; j < jobs.size(); j = next++) {
+      try {
+        const Job& job = jobs[j];
+        BiasTrainParams tp = params.train;
+        tp.preset = job.kernel;
+        tp.num_inducing = job.inducing;
+        tp.svgp.seed = static_cast<std::uint64_t>(job.repeat + 1);
+        BiasTrainReport report;
+        BiasModel model = trainBiasModel(train_data, tp, &report);
+        const BiasPredictor predictor = model.predictor();
+        JobOutput& out = outputs[j];
+        std::string line;
+        for (const auto& f : test) {
+          LocalizationRun run = localizeFlight(f.flight, survey, params.localization, predictor);
+          EvaluationRun er;
+          er.kernel = job.kernel;
+          er.inducing = job.inducing;
+          er.repeat = job.repeat;
+          er.flight = f.name;
+          er.rmse_uncorrected_m = airborneRmse(result.uncorrected.at(f.name), f.name);
+          er.rmse_corrected_m = airborneRmse(run, f.name);
+          std::tie(er.bias_rmse_before_m, er.bias_rmse_after_m) = biasRmse(test_data.at(f.name), model);
+          er.train_seconds = report.train_seconds;
+          out.runs.push_back(er);
+          for (const auto& s : decimatedAirborne(*run.metrics, params.figure_rate_hz)) out.errors.emplace_back(f.name, s);
+          line += fmt::format(" {} {:.3f}→{:.3f} m", f.name, er.rmse_uncorrected_m, er.rmse_corrected_m);
+          if (job.repeat == 0) out.corrected.emplace(f.name, std::move(run));
+        }
+        if (job.repeat == 0) out.model = std::move(model);
+        std::lock_guard<std::mutex> lock(mutex);
+        say(fmt::format("[{}/{}] {} M={} repeat {}: trained in {:.1f} s;{}", ++done, jobs.size(), job.kernel,
+                        job.inducing, job.repeat + 1, report.train_seconds, line));
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!failure) failure = std::current_exception();
+        next = jobs.size();
+      }
+    }
+  };
+  const int n_threads = std::min<int>(params.threads, static_cast<int>(jobs.size()));
+  std::vector<std::thread> pool;
+  for (int i = 1; i < n_threads; ++i) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
+
+  for (auto& out : outputs) {
+    result.runs.insert(result.runs.end(), out.runs.begin(), out.runs.end());
+  }
+  result.rows = aggregateRuns(result.runs);
+  for (std::size_t j = 0; j < jobs.size(); ++j) {
+    auto& dst = result.corrected_errors[configKey(jobs[j].kernel, jobs[j].inducing)];
+    dst.insert(dst.end(), outputs[j].errors.begin(), outputs[j].errors.end());
+  }
+
+  // The best configuration (highest improvement) gives the trajectories; Fig. 7 uses the yaw-angle kernel
+  // (z1 first, as in the paper) with its best M.
+  const auto best_row = std::max_element(result.rows.begin(), result.rows.end(), [](const auto& a, const auto& b) {
+    return a.improvement_pct < b.improvement_pct;
+  });
+  result.best_kernel = best_row->kernel;
+  result.best_inducing = best_row->inducing;
+  const auto findJob = [&](const std::string& kernel, int inducing) {
+    for (std::size_t j = 0; j < jobs.size(); ++j) {
+      if (jobs[j].kernel == kernel && jobs[j].inducing == inducing && jobs[j].repeat == 0) return j;
+    }
+    throw std::logic_error("evaluation: configuration not found");
+  };
+  result.best_corrected = std::move(outputs[findJob(result.best_kernel, result.best_inducing)].corrected);
+  for (const std::string kernel : {"z1", "z2"}) {
+    if (std::find(params.kernels.begin(), params.kernels.end(), kernel) == params.kernels.end()) continue;
+    const EvaluationRow* best_m = nullptr;
+    for (const auto& row : result.rows) {
+      if (row.kernel == kernel && (best_m == nullptr || row.improvement_pct > best_m->improvement_pct)) best_m = &row;
+    }
+    result.angle_figure = angleFigure(outputs[findJob(kernel, best_m->inducing)].model, train_data, kernel,
+                                      best_m->inducing);
+    if (result.angle_figure.valid) break;
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
+}
+
+namespace {
+
+void writeText(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path);
+  if (!out) throw FileError(fmt::format("cannot write {}", path.string()));
+  out << text;
+  if (!out) throw FileError(fmt::format("error while writing {}", path.string()));
+}
+
+std::string trajectoryRows(const std::string& flight, const std::string& variant, const Trajectory& traj,
+                           double rate_hz) {
+  std::string out;
+  double next_t = -std::numeric_limits<double>::infinity();
+  for (const auto& s : traj) {
+    if (s.t_s < next_t) continue;
+    out += fmt::format("{},{},{:.4f},{:.4f},{:.4f},{:.4f}\n", flight, variant, s.t_s, s.w_p_b.x(), s.w_p_b.y(),
+                       s.w_p_b.z());
+    next_t = s.t_s + 1.0 / rate_hz;
+  }
+  return out;
+}
+
+nlohmann::json toVector(const std::vector<double>& v) { return nlohmann::json(v); }
+
+}  // namespace
+
+void writeEvaluation(const EvaluationResult& result, const AnchorSurvey& survey, const std::string& dir,
+                     const std::string& command, const std::vector<std::string>& figures) {
+  namespace fs = std::filesystem;
+  const fs::path root(dir);
+  std::error_code ec;
+  fs::create_directories(root / "figdata", ec);
+  if (ec) throw FileError(fmt::format("cannot create {}: {}", (root / "figdata").string(), ec.message()));
+
+  writeText(root / "table.md", toMarkdown(result.rows));
+  writeText(root / "table.csv", toCsv(result.rows));
+  writeText(root / "results.json", toJson(result.rows).dump(2) + "\n");
+  writeText(root / "runs.csv", runsToCsv(result.runs));
+
+  // figdata/errors.csv (Fig. 6): uncorrected rows as kernel "none", inducing 0.
+  std::string errors = "kernel,inducing,flight,corrected,t,error_m\n";
+  const double rate_hz = 50.0;
+  for (const auto& [flight, run] : result.uncorrected) {
+    for (const auto& s : decimatedAirborne(*run.metrics, rate_hz)) {
+      errors += fmt::format("none,0,{},0,{:.4f},{:.5f}\n", flight, s.t_s, s.error_norm_m);
+    }
+  }
+  for (const auto& [key, samples] : result.corrected_errors) {
+    const auto slash = key.find('/');
+    const std::string kernel = key.substr(0, slash);
+    const std::string m = key.substr(slash + 1);
+    for (const auto& [flight, s] : samples) {
+      errors += fmt::format("{},{},{},1,{:.4f},{:.5f}\n", kernel, m, flight, s.t_s, s.error_norm_m);
+    }
+  }
+  writeText(root / "figdata" / "errors.csv", errors);
+
+  // figdata/trajectories.csv (top view): ground truth, uncorrected, best corrected.
+  std::string traj = "flight,variant,t,x,y,z\n";
+  const std::string corrected_label = fmt::format("corrected {} M={}", result.best_kernel, result.best_inducing);
+  for (const auto& [flight, run] : result.uncorrected) {
+    if (run.metrics) {
+      double next_t = -std::numeric_limits<double>::infinity();
+      for (const auto& s : run.metrics->samples) {
+        if (s.t_s < next_t) continue;
+        traj += fmt::format("{},ground_truth,{:.4f},{:.4f},{:.4f},{:.4f}\n", flight, s.t_s, s.w_p_true.x(),
+                            s.w_p_true.y(), s.w_p_true.z());
+        next_t = s.t_s + 1.0 / rate_hz;
+      }
+    }
+    traj += trajectoryRows(flight, "uncorrected", run.trajectory, rate_hz);
+    if (const auto it = result.best_corrected.find(flight); it != result.best_corrected.end()) {
+      traj += trajectoryRows(flight, corrected_label, it->second.trajectory, rate_hz);
+    }
+  }
+  writeText(root / "figdata" / "trajectories.csv", traj);
+
+  std::string anchors = "id,x,y,z\n";
+  for (const auto& a : survey.anchors) {
+    anchors += fmt::format("{},{:.6f},{:.6f},{:.6f}\n", a.id, a.w_p.x(), a.w_p.y(), a.w_p.z());
+  }
+  writeText(root / "figdata" / "anchors.csv", anchors);
+
+  const auto& fig = result.angle_figure;
+  if (fig.valid) {
+    nlohmann::json grid = nlohmann::json::array();
+    for (Eigen::Index r = 0; r < fig.grid_mean_m.rows(); ++r) {
+      std::vector<double> row(fig.grid_mean_m.cols());
+      for (Eigen::Index c = 0; c < fig.grid_mean_m.cols(); ++c) row[c] = fig.grid_mean_m(r, c);
+      grid.push_back(row);
+    }
+    const nlohmann::json j = {{"kernel", fig.kernel},
+                              {"inducing", fig.inducing},
+                              {"id_a", fig.id_a},
+                              {"id_b", fig.id_b},
+                              {"alpha_i_rad", toVector(fig.alpha_a_rad)},
+                              {"alpha_j_rad", toVector(fig.alpha_b_rad)},
+                              {"error_m", toVector(fig.error_m)},
+                              {"grid_alpha_i_rad", toVector(fig.grid_alpha_a_rad)},
+                              {"grid_alpha_j_rad", toVector(fig.grid_alpha_b_rad)},
+                              {"grid_mean_m", grid},
+                              {"inducing_alpha_i_rad", toVector(fig.inducing_alpha_a_rad)},
+                              {"inducing_alpha_j_rad", toVector(fig.inducing_alpha_b_rad)}};
+    writeText(root / "figdata" / "fig7.json", j.dump() + "\n");
+  } else {
+    fs::remove(root / "figdata" / "fig7.json", ec);
+  }
+
+  // REPORT.md
+  std::string md = "# uwbtdoa evaluation report\n\n";
+  md += "Made by\n\n```sh\n" + command + "\n```\n\n";
+  md += fmt::format(
+      "Bias models trained on {} samples; each configuration trained {} time(s) (seeds 1…); airborne RMSE "
+      "(ground-truth z > 0.3 m) of the filter without and with the GP correction, the GP fed from the filter's own "
+      "estimate (paper III-D). Improvement = 100 (1 − corrected / uncorrected); positive means the correction "
+      "helps. Total time {:.0f} s.\n\n",
+      result.n_train_samples, result.rows.empty() ? 0 : result.rows.front().n_repeats, result.seconds);
+  md += "## Localization error per kernel and number of inducing points (paper Fig. 5)\n\n";
+  md += toMarkdown(result.rows) + "\n";
+  md += "The bias RMSE column is the TDoA measurement error on the test flights before and after subtracting the GP "
+        "mean, with GP inputs from the ground-truth pose.\n\n";
+  md += "Uncorrected filter per test flight:\n\n| flight | airborne RMSE [m] | p50 [m] | p90 [m] | p99 [m] |\n"
+        "|---|---:|---:|---:|---:|\n";
+  for (const auto& [flight, run] : result.uncorrected) {
+    const auto& a = run.metrics->airborne;
+    md += fmt::format("| {} | {:.3f} | {:.3f} | {:.3f} | {:.3f} |\n", flight, a.rmse_m, a.p50_m, a.p90_m, a.p99_m);
+  }
+  md += fmt::format("\nBest configuration: **{} with M = {}**.\n\n", result.best_kernel, result.best_inducing);
+  const auto hasFigure = [&](const std::string& name) {
+    return figures.empty() || std::find(figures.begin(), figures.end(), name) != figures.end();
+  };
+  md += "## Figures\n\n";
+  if (hasFigure("fig5_improvement.png")) {
+    md += "Improvement against the number of inducing points per kernel, with the spread over repeats (Fig. 5):\n\n"
+          "![Fig. 5](fig5_improvement.png)\n\n";
+  }
+  if (hasFigure("fig6_error_distribution.png")) {
+    md += "Distribution of the airborne position error without and with correction, best configuration (Fig. 6):\n\n"
+          "![Fig. 6](fig6_error_distribution.png)\n\n";
+  }
+  if (fig.valid && hasFigure("fig7_bias_vs_angles.png")) {
+    md += fmt::format(
+        "Measured TDoA error of anchor pair ({}, {}) over the two anchor yaw angles, next to the GP mean of the {} "
+        "kernel with M = {} and its inducing points (Fig. 7):\n\n![Fig. 7](fig7_bias_vs_angles.png)\n\n",
+        fig.id_a, fig.id_b, fig.kernel, fig.inducing);
+  }
+  for (const auto& [flight, run] : result.uncorrected) {
+    const std::string png = "trajectory_" + flight + ".png";
+    if (hasFigure(png)) md += fmt::format("Top view of {} (ground truth, uncorrected, corrected):\n\n![{}]({})\n\n", flight, flight, png);
+  }
+  md += "## Training data\n\n```\n" + result.dataset_report + "\n```\n\n";
+  md += "Files: `table.md`, `table.csv`, `results.json` (one object per kernel and M), `runs.csv` (every repeat and "
+        "flight), `figdata/` (the data behind every figure; see docs/python.md).\n";
+  writeText(root / "REPORT.md", md);
+}
+
+}  // namespace uwb
