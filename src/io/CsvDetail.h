@@ -8,6 +8,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <string_view>
@@ -31,10 +32,66 @@ inline void trim(const char*& b, const char*& e) {
 
 enum class NumberStatus { kOk, kNotANumber, kOutOfRange, kNonFinite };
 
+/// Clinger's fast path: a plain decimal `[-]digits[.digits][e[+-]digits]` with at most 19 significant digits,
+/// significand ≤ 2^53 and |power of ten| ≤ 22 is exactly w · 10^q or w / 10^-q, one correctly rounded IEEE
+/// operation on two exact doubles, so the result equals std::from_chars bit for bit. Returns false (caller falls
+/// back to from_chars) for anything else.
+inline bool parseDecimalFast(const char* p, const char* e, double& out) {
+  static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                                      1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  bool negative = false;
+  if (p < e && *p == '-') {
+    negative = true;
+    ++p;
+  }
+  std::uint64_t w = 0;
+  int significant = 0;
+  int fraction_digits = 0;
+  bool any_digit = false;
+  const auto digit = [&](unsigned d) -> bool {
+    if (w != 0 || d != 0) {
+      if (++significant > 19) return false;
+    }
+    w = w * 10 + d;
+    any_digit = true;
+    return true;
+  };
+  for (; p < e && static_cast<unsigned>(*p - '0') < 10; ++p) {
+    if (!digit(static_cast<unsigned>(*p - '0'))) return false;
+  }
+  if (p < e && *p == '.') {
+    ++p;
+    for (; p < e && static_cast<unsigned>(*p - '0') < 10; ++p) {
+      if (!digit(static_cast<unsigned>(*p - '0'))) return false;
+      ++fraction_digits;
+    }
+  }
+  if (!any_digit) return false;
+  int exponent = 0;
+  if (p < e && (*p == 'e' || *p == 'E')) {
+    ++p;
+    bool exp_negative = false;
+    if (p < e && (*p == '-' || *p == '+')) exp_negative = *p++ == '-';
+    if (p == e) return false;
+    for (; p < e && static_cast<unsigned>(*p - '0') < 10; ++p) {
+      exponent = exponent * 10 + (*p - '0');
+      if (exponent > 1000) return false;
+    }
+    if (exp_negative) exponent = -exponent;
+  }
+  if (p != e) return false;
+  const int q = exponent - fraction_digits;
+  if (w > (std::uint64_t{1} << 53) || q < -22 || q > 22) return false;
+  const double value = q < 0 ? static_cast<double>(w) / kPow10[-q] : static_cast<double>(w) * kPow10[q];
+  out = negative ? -value : value;
+  return true;
+}
+
 /// Parses the whole of [b, e) (already trimmed) as a double. A leading '+' is accepted.
 inline NumberStatus parseDouble(const char* b, const char* e, double& out) {
   if (b < e && *b == '+') ++b;
   if (b == e) return NumberStatus::kNotANumber;
+  if (parseDecimalFast(b, e, out)) return NumberStatus::kOk;
   const auto [p, ec] = std::from_chars(b, e, out, std::chars_format::general);
   if (ec == std::errc::result_out_of_range) return NumberStatus::kOutOfRange;
   if (ec != std::errc() || p != e) return NumberStatus::kNotANumber;

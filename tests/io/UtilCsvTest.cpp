@@ -7,6 +7,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <charconv>
+#include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -134,6 +137,38 @@ TEST(UtilCsv, NotesStreamsWhoseColumnsArePresentButEmpty) {
   const Flight f = readFlightCsv(path, {}, &report);
   EXPECT_TRUE(f.tof.empty());
   EXPECT_THAT(report.notes, ::testing::Contains(HasSubstr("stream tof: columns present but no samples")));
+}
+
+TEST(UtilCsv, ParsesNumbersBitIdenticallyToFromChars) {
+  // GIVEN many decimal spellings (fast path and fallback cases), seed 5
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> mag(-30.0, 30.0);
+  std::uniform_int_distribution<int> prec(1, 19);
+  std::vector<std::string> texts = {"0",     "-0",   "1e22",  "1e23",  "9007199254740993", "123456789012345678901234",
+                                    "0.000000000000000000001", "1.7976931348623157e308", "1.", ".5",
+                                    "-.25e+2", "00012.5000", "1E5", "2.2250738585072014e-308"};
+  for (int i = 0; i < 20000; ++i) {
+    const double x = (rng() % 2 ? 1 : -1) * std::pow(10.0, mag(rng)) * std::uniform_real_distribution<double>(1, 10)(rng);
+    char buf[64];
+    switch (i % 3) {
+      case 0: std::snprintf(buf, sizeof buf, "%.*g", prec(rng), x); break;
+      case 1: std::snprintf(buf, sizeof buf, "%.6f", std::fmod(x, 1e6)); break;
+      default: std::snprintf(buf, sizeof buf, "%.*e", prec(rng), x); break;
+    }
+    texts.emplace_back(buf);
+  }
+  std::string csv = "t_tof,tof\n";
+  for (std::size_t i = 0; i < texts.size(); ++i) csv += std::to_string(i) + "," + texts[i] + "\n";
+  // WHEN the reader parses them
+  const Flight f = parseFlightCsv(csv, "numbers.csv");
+  // THEN every value equals std::from_chars bit for bit
+  ASSERT_EQ(f.tof.size(), texts.size());
+  for (std::size_t i = 0; i < texts.size(); ++i) {
+    double expected = 0.0;
+    const std::string& t = texts[i];
+    std::from_chars(t.data(), t.data() + t.size(), expected);
+    EXPECT_TRUE(test::sameBits(f.tof[i].value, expected)) << t;
+  }
 }
 
 // ------------------------------------------------------------------------------------------------ malformed input
