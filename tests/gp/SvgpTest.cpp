@@ -1,0 +1,225 @@
+/** @file SvgpTest.cpp
+ *  @brief SVGP: ELBO gradients vs finite differences for every parameter (both evaluation paths), natural-gradient
+ *         optimum, deterministic training, fast single predictions, model-file round trip and errors.
+ */
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "uwb/gp/SvgpTrainer.h"
+
+namespace uwb::gp {
+namespace {
+
+struct Problem {
+  Svgp gp;
+  MatX X;
+  VecX y;
+  double num_data = 500;
+};
+
+/// A small random problem with kernel parts on their own columns (like the paper kernels) plus a product.
+Problem makeProblem(std::uint64_t seed, int N = 40, int M = 7) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-2, 2);
+  std::normal_distribution<double> n(0, 1);
+  PartSpec per{PartType::kPeriodic, {0}, 0.6, {0.9}, {2.5}, 0, 0, true};
+  PartSpec mat{PartType::kMatern52, {1, 2}, 0.8, {0.7, 1.3}};
+  PartSpec rbf{PartType::kRbf, {0, 2}, 0.5, {1.1}};
+  Kernel k({per, mat, rbf}, {{0}, {1, 2}});
+  Problem p;
+  p.X.resize(N, 3);
+  p.y.resize(N);
+  for (int i = 0; i < N; ++i) {
+    for (int d = 0; d < 3; ++d) p.X(i, d) = u(rng);
+    p.y[i] = std::sin(p.X(i, 0)) + 0.3 * p.X(i, 1) + 0.1 * n(rng);
+  }
+  MatX Z(M, 3);
+  for (int i = 0; i < M; ++i)
+    for (int d = 0; d < 3; ++d) Z(i, d) = u(rng);
+  p.gp = Svgp(k, Z);
+  VecX m(M);
+  MatX L = MatX::Zero(M, M);
+  for (int i = 0; i < M; ++i) {
+    m[i] = 0.5 * n(rng);
+    L(i, i) = 0.4 + 0.5 * std::abs(n(rng));
+    for (int j = 0; j < i; ++j) L(i, j) = 0.15 * n(rng);
+  }
+  p.gp.setVariational(m, L);
+  p.gp.setMean(0.1);
+  p.gp.setNoiseVariance(0.05);
+  return p;
+}
+
+double fd4(const std::function<double(double)>& f, double x) {
+  const double h = 1e-4 * std::max(std::abs(x), 0.1);
+  return (-f(x + 2 * h) + 8 * f(x + h) - 8 * f(x - h) + f(x - 2 * h)) / (12 * h);
+}
+
+void checkGradient(ElboMode mode) {
+  // GIVEN a random SVGP state and batch
+  const Problem p = makeProblem(7);
+  SvgpGradient g;
+  p.gp.elbo(p.X, p.y, p.num_data, &g, mode);
+  auto elboWith = [&](const std::function<void(Svgp&)>& edit) {
+    Svgp q = p.gp;
+    edit(q);
+    return q.elbo(p.X, p.y, p.num_data, nullptr, ElboMode::kExact).elbo;
+  };
+  const double tol = 1e-6;
+  auto near = [&](double a, double b, const std::string& what) { EXPECT_NEAR(a, b, tol * std::max(1.0, std::abs(b))) << what; };
+  // THEN every gradient matches 4th-order central differences
+  const VecX theta = p.gp.kernel().theta();
+  for (int i = 0; i < theta.size(); ++i) {
+    const double fd = fd4([&](double v) { return elboWith([&](Svgp& q) { VecX t = theta; t[i] = v; q.kernel().setTheta(t); }); }, theta[i]);
+    near(g.kernel[i], fd, p.gp.kernel().paramNames()[i]);
+  }
+  near(g.noise, fd4([&](double v) { return elboWith([&](Svgp& q) { q.setNoiseVariance(v); }); }, p.gp.noiseVariance()), "noise");
+  near(g.mean, fd4([&](double v) { return elboWith([&](Svgp& q) { q.setMean(v); }); }, p.gp.meanConstant()), "mean");
+  const MatX Z = p.gp.inducing();
+  for (Eigen::Index i = 0; i < Z.rows(); ++i)
+    for (Eigen::Index d = 0; d < Z.cols(); ++d)
+      near(g.Z(i, d), fd4([&](double v) { return elboWith([&](Svgp& q) { MatX Zq = Z; Zq(i, d) = v; q.setInducing(Zq); }); }, Z(i, d)),
+           "Z(" + std::to_string(i) + "," + std::to_string(d) + ")");
+  const VecX m = p.gp.variationalMean();
+  const MatX L = p.gp.variationalCholesky();
+  for (Eigen::Index i = 0; i < m.size(); ++i)
+    near(g.m[i], fd4([&](double v) { return elboWith([&](Svgp& q) { VecX mq = m; mq[i] = v; q.setVariational(mq, L); }); }, m[i]),
+         "m" + std::to_string(i));
+  for (Eigen::Index i = 0; i < L.rows(); ++i)
+    for (Eigen::Index j = 0; j <= i; ++j)
+      near(g.L(i, j), fd4([&](double v) { return elboWith([&](Svgp& q) { MatX Lq = L; Lq(i, j) = v; q.setVariational(m, Lq); }); }, L(i, j)),
+           "L(" + std::to_string(i) + "," + std::to_string(j) + ")");
+  EXPECT_EQ(g.L.triangularView<Eigen::StrictlyUpper>().toDenseMatrix().cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(Svgp, ElboGradientMatchesFiniteDifferencesExactPath) { checkGradient(ElboMode::kExact); }
+TEST(Svgp, ElboGradientMatchesFiniteDifferencesFastPath) { checkGradient(ElboMode::kFast); }
+
+TEST(Svgp, FastAndExactPathsAgree) {
+  const Problem p = makeProblem(9);
+  SvgpGradient a, b;
+  const double ea = p.gp.elbo(p.X, p.y, p.num_data, &a, ElboMode::kExact).elbo;
+  const double eb = p.gp.elbo(p.X, p.y, p.num_data, &b, ElboMode::kFast).elbo;
+  EXPECT_NEAR(ea, eb, 1e-12 * std::abs(ea));
+  EXPECT_LT(relativeError(b.kernel, a.kernel), 1e-10);
+  EXPECT_LT(relativeError(b.Z, a.Z), 1e-10);
+  EXPECT_LT(relativeError(b.L, a.L), 1e-10);
+}
+
+TEST(Svgp, FullBatchNaturalGradientStepOfOneReachesTheOptimalQ) {
+  // GIVEN a full batch (B = N_data)
+  Problem p = makeProblem(3, 60, 8);
+  SvgpGradient g;
+  p.gp.elbo(p.X, p.y, 60, &g);
+  // WHEN we take a natural-gradient step of size 1
+  naturalGradientStep(p.gp, g.AAt, g.Ar + g.AAt * p.gp.variationalMean(), 60, 60, 1.0);
+  // THEN q(v) is optimal: ∂ELBO/∂m = 0 and ∂ELBO/∂L = 0
+  p.gp.elbo(p.X, p.y, 60, &g);
+  EXPECT_LT(g.m.cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT(g.L.cwiseAbs().maxCoeff(), 1e-9);
+}
+
+TEST(Svgp, TrainingIsDeterministicForASeedAndImprovesTheElbo) {
+  // GIVEN data from a smooth function
+  Problem p = makeProblem(5, 600, 5);
+  SvgpTrainParams tp;
+  tp.epochs = 4;
+  tp.batch_size = 128;
+  tp.seed = 17;
+  Svgp a = initSvgp(p.gp.kernel(), p.X, p.y, 12, 17);
+  Svgp b = initSvgp(p.gp.kernel(), p.X, p.y, 12, 17);
+  const double before = a.elbo(p.X, p.y, 600).elbo;
+  // WHEN we train twice with the same seed
+  trainSvgp(a, p.X, p.y, tp);
+  trainSvgp(b, p.X, p.y, tp);
+  // THEN the results are bit-identical and the ELBO improved
+  EXPECT_EQ(a.toJson().dump(), b.toJson().dump());
+  EXPECT_GT(a.elbo(p.X, p.y, 600).elbo, before + 0.1);
+}
+
+TEST(Svgp, AdamOnlyTrainingAlsoWorks) {
+  Problem p = makeProblem(6, 400, 5);
+  SvgpTrainParams tp;
+  tp.epochs = 5;
+  tp.batch_size = 100;
+  tp.natgrad_step = 0.0;
+  tp.lr_variational = 0.05;
+  Svgp a = initSvgp(p.gp.kernel(), p.X, p.y, 10, 1, InputNormalization::kStandardize);
+  const double before = a.elbo(p.X, p.y, 400).elbo;
+  trainSvgp(a, p.X, p.y, tp);
+  EXPECT_GT(a.elbo(p.X, p.y, 400).elbo, before);
+}
+
+TEST(Svgp, SinglePredictionEqualsBatchPrediction) {
+  Problem p = makeProblem(8);
+  p.gp.setInputTransform(VecX::Constant(3, 0.1), VecX::Constant(3, 1.5));
+  const SvgpPredictor pred = p.gp.predictor();
+  const SvgpPrediction batch = pred.predict(p.X);
+  for (Eigen::Index i = 0; i < p.X.rows(); ++i) {
+    double mean, var;
+    pred.predictOne(p.X.row(i), mean, var);
+    EXPECT_NEAR(mean, batch.mean[i], 1e-13);
+    EXPECT_NEAR(var, batch.var_f[i], 1e-13);
+    EXPECT_NEAR(batch.var_y[i] - batch.var_f[i], p.gp.noiseVariance(), 1e-15);
+  }
+}
+
+TEST(SvgpModelFile, RoundTripGivesBitIdenticalPredictions) {
+  // GIVEN a trained-looking model with an input transform
+  Problem p = makeProblem(4);
+  p.gp.setInputTransform(VecX::Constant(3, -0.3), VecX::Constant(3, 0.7));
+  p.gp.kernel().setTrainable("p1.matern52.l[1]", false);
+  // WHEN we write and read it
+  const std::string text = p.gp.toJson().dump();
+  const Svgp back = Svgp::fromJson(nlohmann::json::parse(text));
+  // THEN predictions are bit-identical and the file is the same
+  const SvgpPrediction a = p.gp.predict(p.X), b = back.predict(p.X);
+  EXPECT_TRUE((a.mean.array() == b.mean.array()).all());
+  EXPECT_TRUE((a.var_y.array() == b.var_y.array()).all());
+  EXPECT_EQ(back.toJson().dump(), text);
+}
+
+TEST(SvgpModelFile, CorruptOrMismatchedFilesAreClearErrors) {
+  const Problem p = makeProblem(4);
+  const nlohmann::json good = p.gp.toJson();
+  auto expectError = [](const nlohmann::json& j, const std::string& fragment) {
+    try {
+      Svgp::fromJson(j);
+      ADD_FAILURE() << "no error for " << fragment;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  };
+  nlohmann::json j = good;
+  j["version"] = 99;
+  expectError(j, "version");
+  j = good;
+  j["format"] = "something-else";
+  expectError(j, "format");
+  j = good;
+  j["variational"]["m"].erase(0);
+  expectError(j, "M=");
+  j = good;
+  j.erase("kernel");
+  expectError(j, "kernel");
+  j = good;
+  j["inducing_points"][1].erase(0);
+  expectError(j, "ragged");
+  j = good;
+  j["input_transform"]["shift"] = {1.0};
+  j["input_transform"]["scale"] = {1.0};
+  expectError(j, "input_transform");
+  expectError(nlohmann::json::array(), "object");
+}
+
+TEST(KMeansPlusPlus, IsDeterministicAndRejectsTooFewPoints) {
+  const Problem p = makeProblem(2, 200, 5);
+  EXPECT_EQ(kmeansPlusPlus(p.X, 10, 3), kmeansPlusPlus(p.X, 10, 3));
+  EXPECT_THROW(kmeansPlusPlus(p.X.topRows(5), 10, 3), std::invalid_argument);
+  EXPECT_THROW(kmeansPlusPlus(MatX::Ones(50, 2), 3, 3), std::invalid_argument);  // one distinct point
+}
+
+}  // namespace
+}  // namespace uwb::gp
