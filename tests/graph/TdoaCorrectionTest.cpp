@@ -41,6 +41,7 @@ FilterScene randomFilterScene(unsigned seed) {
   s.var_m2 = 0.01 + 0.05 * std::abs(randomVector(rng, 1)[0]);
   s.m = VecN(randomVector(rng, kN, 0.05));  // a non-zero prior mean of the error state, for generality
   s.P = MatN(randomSpd(rng, kN, 0.01) * 0.1);
+  s.P = (0.5 * (s.P + s.P.transpose())).eval();  // the filter keeps P exactly symmetric
   const Vec3 p_tag = tagPosition(s.w_p_b, s.w_q_b, s.b_t_tag);
   s.z_m = (p_tag - s.anchor_b.m).norm() - (p_tag - s.anchor_a.m).norm() + randomVector(rng, 1, 0.2)[0];
   return s;

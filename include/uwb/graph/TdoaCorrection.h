@@ -7,9 +7,10 @@
  *  Fast path (header-only template on the state dimension N, e.g. N = 15): no heap allocation, no n×n inverse.
  *  The message on δx has rank one (W = aᵀ a / s), so the equality node is used in its Kalman-gain form
  *  (Table 4; G10 with a scalar Y) and the covariance in Joseph form, written in O(N²) for a rank-one update:
- *    u = V a ᵀ,  S = a u + s,  K = u / S,
+ *    u = V aᵀ,  S = a u + s,  K = u / S,
  *    m⁺ = m + K (y − a m),
- *    V⁺ = (I − K a) V (I − K a)ᵀ + K s Kᵀ = V − K uᵀ − u Kᵀ + S K Kᵀ      (G18, exactly symmetric).
+ *    V⁺ = (I − K a) V (I − K a)ᵀ + K s Kᵀ = V − K uᵀ − u Kᵀ + S K Kᵀ = V − w wᵀ,  w = u/√S   (G18).
+ *  The last form keeps a symmetric V exactly symmetric; zero entries of a (blocks C does not touch) are skipped.
  *
  *  Recipe for the filter (UTIL convention tdoa = |p − a_B| − |p − a_A|, right attitude error q ⊗ exp(δθ)):
  *  @code
@@ -85,13 +86,16 @@ InnovationStats innovationOf(const ScalarLinearMessage<N>& msg, const Eigen::Mat
 }
 
 /// (G18) Equality node combining the prior N(m, V) (moment form) with a rank-one message, Kalman-gain form
-/// (Table 4) and Joseph-form covariance, in place. Returns the innovation statistics, or nullopt (and leaves m, V
+/// (Table 4), Joseph-equivalent covariance update, in place. V must be symmetric (it then stays exactly symmetric). Returns the innovation statistics, or nullopt (and leaves m, V
 /// untouched) when S ≤ 0 or anything is not finite.
 template <int N>
 std::optional<InnovationStats> equalityRankOneInPlace(Eigen::Matrix<double, N, 1>& m, Eigen::Matrix<double, N, N>& V,
                                                       const ScalarLinearMessage<N>& msg) {
-  Eigen::Matrix<double, N, 1> u;
-  u.noalias() = V * msg.a.transpose();  // V aᵀ (V symmetric)
+  // u = V aᵀ, skipping the zero entries of a (a = B12 C touches only the position and attitude blocks).
+  Eigen::Matrix<double, N, 1> u = Eigen::Matrix<double, N, 1>::Zero(V.rows());
+  for (Eigen::Index c = 0; c < V.cols(); ++c) {
+    if (msg.a[c] != 0.0) u.noalias() += V.col(c) * msg.a[c];
+  }
   InnovationStats st;
   st.innovation_m = msg.y - msg.a.dot(m.transpose());
   st.innovation_var_m2 = msg.a.dot(u.transpose()) + msg.var;
@@ -100,18 +104,12 @@ std::optional<InnovationStats> equalityRankOneInPlace(Eigen::Matrix<double, N, 1
   }
   st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
   const double S = st.innovation_var_m2;
-  const Eigen::Matrix<double, N, 1> K = u / S;
-  m.noalias() += K * st.innovation_m;
-  // Joseph form for a rank-one gain, (I − K a) V (I − K a)ᵀ + K var Kᵀ = V − K uᵀ − u Kᵀ + S K Kᵀ, evaluated on the
-  // upper triangle in one pass and mirrored, so V stays exactly symmetric (STYLE §6).
-  const Eigen::Index n = V.rows();
-  for (Eigen::Index j = 0; j < n; ++j) {
-    const double Kj = K[j], uj = u[j], SKj = S * Kj;
-    for (Eigen::Index i = 0; i <= j; ++i) V(i, j) += K[i] * (SKj - uj) - u[i] * Kj;
-  }
-  for (Eigen::Index j = 0; j < n; ++j) {
-    for (Eigen::Index i = j + 1; i < n; ++i) V(i, j) = V(j, i);
-  }
+  m.noalias() += u * (st.innovation_m / S);  // m⁺ = m + K r, K = u / S
+  // Joseph form (I − K a) V (I − K a)ᵀ + K var Kᵀ = V − K uᵀ − u Kᵀ + S K Kᵀ, which for the optimal rank-one gain
+  // K = u/S equals V − u uᵀ/S = V − w wᵀ with w = u/√S. Evaluated as w wᵀ, element (i, j) and (j, i) are the same
+  // floating-point product, so a symmetric V stays exactly symmetric without a mirror pass.
+  const Eigen::Matrix<double, N, 1> w = u / std::sqrt(S);
+  V.noalias() -= w * w.transpose();
   return st;
 }
 
