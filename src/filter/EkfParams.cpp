@@ -39,6 +39,7 @@ void EkfParams::validate() const {
   if (robust_iterations < 1 || robust_iterations > 20)
     throw std::invalid_argument("EkfParams.robust_iterations must be in [1, 20]");
   requirePositive(max_lost_s, "max_lost_s");
+  requireNonNegative(pair_bias_tau_s, "pair_bias_tau_s");
   requirePositive(max_predict_dt_s, "max_predict_dt_s");
   requireNonNegative(cov_period_s, "cov_period_s");
   requirePositive(max_gap_s, "max_gap_s");

@@ -28,7 +28,7 @@ constexpr double kTakeoffLeak_s = 1.0;
 constexpr double kZuptPeriod_s = 0.01;
 constexpr double kZuptSigma_mps = 0.02;
 /// Multilateration window after take-off / at the start [s], and the minimum number of TDoAs (F16).
-constexpr double kMlatWindow_s = 0.4;
+constexpr double kMlatWindow_s = 0.6;
 constexpr std::size_t kMlatMinSamples = 40;
 constexpr double kMlatMaxWindow_s = 3.0;
 /// Stillness (motors off): acc std and gyro rms thresholds, EMA time constant (F18).
@@ -78,6 +78,11 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
   const std::vector<int> ids = anchors_.ids();
   for (int id : ids) centroid += anchors_.find(id)->m;
   centroid /= static_cast<double>(ids.size());
+  Vec3 box_min = Vec3::Constant(1e300), box_max = Vec3::Constant(-1e300);
+  for (int id : ids) {
+    box_min = box_min.cwiseMin(anchors_.find(id)->m);
+    box_max = box_max.cwiseMax(anchors_.find(id)->m);
+  }
 
   Ekf ekf(p);
   FlightPhase phase = FlightPhase::kAcquisition;
@@ -105,9 +110,15 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
   double acc_mean = kGravity_mps2, acc_var = 1.0, gyro_ms = 1.0;
   double z_takeoff = p.ground_z_m;
   double t_low_slow = std::numeric_limits<double>::quiet_NaN();
+  struct PairOffset {
+    double offset_m = 0.0;
+    double t_last_s = std::numeric_limits<double>::quiet_NaN();
+  };
+  std::vector<PairOffset> pair_offsets(p.pair_bias_tau_s > 0.0 ? 64 * 64 : 0);
   // multilateration buffer (F16)
   std::vector<MultilaterationSample> mlat;
   double t_mlat_start = std::numeric_limits<double>::quiet_NaN();
+  double t_mlat_try = 0.0;
   Vec3 mlat_ref_p = Vec3::Zero();
 
   auto emit = [&](double t, bool force = false) {
@@ -174,6 +185,7 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
     } else {
       phase = FlightPhase::kAcquisition;
       t_mlat_start = t;
+      t_mlat_try = t;
       mlat_ref_p = ekf.state().w_p_b;
       mlat.clear();
     }
@@ -185,6 +197,9 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
                                  Vec3(centroid.x(), centroid.y(), centroid.z())};
     const std::optional<MultilaterationResult> r = multilaterate(mlat, anchors_, p.b_t_tag, guesses);
     if (!r) return false;
+    // a start outside the anchors' box (grown by 1 m) is a failed solve (ground-phase TDoA can still be off)
+    if ((r->w_p0.array() < (box_min.array() - 1.0)).any() || (r->w_p0.array() > (box_max.array() + 1.0)).any())
+      return false;
     const Vec3 d_now = ekf.state().w_p_b - mlat_ref_p;
     const double sigma = std::clamp(std::sqrt(r->covariance.trace()), 0.2, p.init_pos_sigma_m);
     startFromPosition(r->w_p0 + d_now, sigma);
@@ -224,6 +239,7 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
     } else {
       phase = FlightPhase::kAcquisition;
       t_mlat_start = t;
+      t_mlat_try = t;
       mlat_ref_p = x0.w_p_b;
       if (imu_mode) ekf.setAccelModel(p.accel_model);
       if (!imu_mode) ekf.inflatePosition(0.0, 1.0);
@@ -327,9 +343,15 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
       s.w_q_b = ekf.state().w_q_b;
       mlat.push_back(s);
       ++sum.n_tdoa_ground;
-      if (t - t_mlat_start >= kMlatWindow_s && mlat.size() >= kMlatMinSamples) {
+      if (t - t_mlat_try >= kMlatWindow_s && mlat.size() >= kMlatMinSamples) {
         propagate(true);
-        if (!finishMultilateration(t) && t - t_mlat_start > kMlatMaxWindow_s) {
+        const bool ok = finishMultilateration(t);
+        if (!ok) {
+          // keep only the most recent half window and try again later (early samples are the worst)
+          std::erase_if(mlat, [&](const MultilaterationSample& m) { return m.z.t_s < t - 0.5 * kMlatWindow_s; });
+          t_mlat_try = t - 0.5 * kMlatWindow_s;
+        }
+        if (!ok && t - t_mlat_start > kMlatMaxWindow_s) {
           // give up: EKF acquisition from the centroid with a wide prior
           startFromPosition(Vec3(centroid.x(), centroid.y(), 1.0), p.init_pos_sigma_m);
           t_acq_end = t + 2.0 * p.acquisition_s;
@@ -344,7 +366,19 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
     if (phase == FlightPhase::kAcquisition && t >= t_acq_end) phase = FlightPhase::kTracking;
     propagate(!imu_mode);
     const bool acquiring = phase == FlightPhase::kAcquisition;
-    const TdoaUpdateResult r = updateTdoa(ekf, anchors_, z, acquiring ? acq_opt : track_opt, bias);
+    // (F19) optional per-pair offset learned from the innovations while tracking
+    TdoaObservation zc = z;
+    PairOffset* po = nullptr;
+    if (p.pair_bias_tau_s > 0.0 && z.id_a >= 0 && z.id_b >= 0 && z.id_a < 64 && z.id_b < 64) {
+      po = &pair_offsets[z.id_a * 64 + z.id_b];
+      zc.tdoa_m -= po->offset_m;
+    }
+    const TdoaUpdateResult r = updateTdoa(ekf, anchors_, zc, acquiring ? acq_opt : track_opt, bias);
+    if (po && !acquiring && r.outcome == UpdateOutcome::kApplied) {
+      const double dt_pair = std::isnan(po->t_last_s) ? 0.0 : std::min(t - po->t_last_s, 0.2);
+      po->offset_m = std::clamp(po->offset_m + (dt_pair / p.pair_bias_tau_s) * r.weight * r.innovation_m, -0.5, 0.5);
+      po->t_last_s = t;
+    }
     switch (r.outcome) {
       case UpdateOutcome::kApplied:
         ++sum.n_tdoa_used;

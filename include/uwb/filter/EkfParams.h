@@ -60,8 +60,9 @@ struct EkfParams {
   double anchor_sigma_m = 0.0;           ///< std of each surveyed anchor coordinate [m] (graph node anchors)
   double gate_sigma = 4.0;               ///< Mahalanobis gate on the normalised innovation (χ²₁ = gate²)
   RobustLoss robust_loss = RobustLoss::kHuber;
-  double robust_k = 1.5;                 ///< loss scale on the normalised innovation
+  double robust_k = 1.0;                 ///< loss scale on the normalised innovation
   int robust_iterations = 2;             ///< IRLS iterations per TDoA update (≥ 1)
+  double pair_bias_tau_s = 0.0;          ///< >0: per-pair TDoA offset learned from innovations, time constant [s] (F19)
   double max_lost_s = 1.0;               ///< all TDoA rejected this long → re-acquire (inflate P, open gate)
 
   // --- scheduling ---
