@@ -24,6 +24,10 @@ struct CommandSpec {
 bool registerCommand(CommandSpec spec);
 std::vector<CommandSpec>& commandRegistry();
 
+/// The command line the tool was started with, shell-quoted where needed (for reports).
+const std::string& commandLine();
+void setCommandLine(int argc, char** argv);
+
 /// Default real-data directory: $UWBTDOA_DATA, else the build-time default (../shared/data).
 std::string defaultDataDir();
 

@@ -21,6 +21,27 @@ bool registerCommand(CommandSpec spec) {
   return true;
 }
 
+namespace {
+std::string& commandLineStorage() {
+  static std::string line;
+  return line;
+}
+}  // namespace
+
+const std::string& commandLine() { return commandLineStorage(); }
+
+void setCommandLine(int argc, char** argv) {
+  std::string line;
+  for (int i = 0; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (i == 0) arg = "uwbtdoa";
+    const bool plain = !arg.empty() && arg.find_first_of(" \t'\"$;&|<>*?()") == std::string::npos;
+    if (!line.empty()) line += ' ';
+    line += plain ? arg : "'" + arg + "'";
+  }
+  commandLineStorage() = line;
+}
+
 std::string defaultDataDir() {
   if (const char* env = std::getenv("UWBTDOA_DATA"); env != nullptr && *env != '\0') return env;
   return UWB_DEFAULT_DATA_DIR;
@@ -29,6 +50,7 @@ std::string defaultDataDir() {
 }  // namespace uwb::app
 
 int main(int argc, char** argv) {
+  uwb::app::setCommandLine(argc, argv);
   CLI::App app{"uwbtdoa: UWB TDoA localization with Gaussian-process bias correction"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "uwbtdoa 0.1.0");

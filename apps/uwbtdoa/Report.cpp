@@ -1,0 +1,94 @@
+/** @file Report.cpp */
+#include "Report.h"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "Command.h"
+#include "uwb/core/Error.h"
+
+namespace uwb::app {
+
+void EvaluationCliOptions::addTo(CLI::App& sub) {
+  sub.add_option("--kernels", kernels, "Kernel presets, comma-separated (z1, z2, tdoa, pair-tdoa, pair-pos)")
+      ->delimiter(',')
+      ->capture_default_str();
+  sub.add_option("--inducing", inducing, "Numbers of inducing points, comma-separated")
+      ->delimiter(',')
+      ->capture_default_str();
+  sub.add_option("--repeats", repeats, "Trainings per configuration (seeds 1..N)")->capture_default_str();
+  sub.add_option("--epochs", epochs, "Training epochs (0: trainer default)")->capture_default_str();
+  sub.add_option("--batch", batch, "Minibatch size (0: trainer default)")->capture_default_str();
+  sub.add_option("--threads", threads, "Configurations run in parallel")->capture_default_str();
+  sub.add_flag("--no-plots", no_plots, "Write the data and report but do not render PNG figures");
+  sub.add_flag("--json", json, "Print one JSON object (results and paths) on stdout");
+}
+
+EvaluationParams EvaluationCliOptions::toParams() const {
+  EvaluationParams p;
+  p.kernels = kernels;
+  p.inducing = inducing;
+  p.repeats = repeats;
+  p.threads = threads;
+  if (epochs > 0) p.train.svgp.epochs = epochs;
+  if (batch > 0) p.train.svgp.batch_size = batch;
+  return p;
+}
+
+std::vector<std::string> renderFigures(const std::string& dir) {
+  const std::string python_dir = UWB_PYTHON_DIR;
+  const std::string cmd = fmt::format("PYTHONPATH='{}' /usr/bin/python3 -m uwbtdoa.plots report '{}'", python_dir, dir);
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (pipe == nullptr) throw FileError("cannot start python3 to render the figures: " + cmd);
+  std::string output;
+  std::array<char, 512> buffer{};
+  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) output += buffer.data();
+  const int status = pclose(pipe);
+  if (status != 0) {
+    throw FileError(fmt::format("rendering the figures failed (exit status {}): {}\n(use --no-plots to skip)",
+                                status, cmd));
+  }
+  std::vector<std::string> pngs;
+  std::istringstream lines(output);
+  for (std::string line; std::getline(lines, line);) {
+    if (!line.empty()) pngs.push_back(std::filesystem::path(line).filename().string());
+  }
+  return pngs;
+}
+
+void runAndReport(const std::vector<NamedFlight>& train, const std::vector<NamedFlight>& test,
+                  const AnchorSurvey& survey, const EvaluationCliOptions& options) {
+  const EvaluationParams params = options.toParams();
+  const EvaluationResult result =
+      runEvaluation(train, test, survey, params, [](const std::string& line) { std::cerr << line << std::endl; });
+  writeEvaluation(result, survey, options.out_dir, commandLine());
+  std::vector<std::string> figures;
+  if (!options.no_plots) {
+    figures = renderFigures(options.out_dir);
+    writeEvaluation(result, survey, options.out_dir, commandLine(), figures);  // report lists what was drawn
+  }
+  const std::string report = (std::filesystem::path(options.out_dir) / "REPORT.md").string();
+  if (options.json) {
+    const nlohmann::json j = {{"results", toJson(result.rows)},
+                              {"out_dir", options.out_dir},
+                              {"report", report},
+                              {"figures", figures},
+                              {"best_kernel", result.best_kernel},
+                              {"best_inducing", result.best_inducing},
+                              {"n_train_samples", result.n_train_samples},
+                              {"seconds", result.seconds}};
+    std::cout << j.dump(2) << std::endl;
+    return;
+  }
+  std::cout << toMarkdown(result.rows) << '\n';
+  std::cout << fmt::format("best: {} with M = {}; report: {} ({} figures); {:.0f} s\n", result.best_kernel,
+                           result.best_inducing, report, figures.size(), result.seconds);
+}
+
+}  // namespace uwb::app
