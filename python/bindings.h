@@ -140,5 +140,6 @@ void bindModel(py::module_& m);
 void bindGp(py::module_& m);
 void bindSim(py::module_& m);
 void bindGpTrain(py::module_& m);
+void bindEval(py::module_& m);
 
 }  // namespace uwb::python

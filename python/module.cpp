@@ -43,4 +43,5 @@ PYBIND11_MODULE(_uwbtdoa, m) {
   uwb::python::bindGp(m);
   uwb::python::bindGpTrain(m);
   uwb::python::bindSim(m);
+  uwb::python::bindEval(m);
 }

@@ -1,0 +1,438 @@
+/** @file bind_eval.cpp
+ *  @brief Python bindings of uwb/eval (and the filter's parameters): GP training data from flights (BiasDataset),
+ *  trained bias models (BiasModel), localization of a flight with or without a bias model, trajectory metrics.
+ *
+ *  Feature dicts (one row per measurement), as returned by make_tdoa_features / BiasDataset.arrays():
+ *    id_a, id_b (int32), yaw_a, yaw_b [rad], b_p_a, b_p_b (N, 3) [m, body frame], w_p_b (N, 3) [m, world].
+ */
+#include <functional>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "bindings.h"
+#include "uwb/eval/BiasDataset.h"
+#include "uwb/eval/BiasModel.h"
+#include "uwb/eval/Localization.h"
+#include "uwb/eval/TrajectoryMetrics.h"
+#include "uwb/filter/EkfParams.h"
+
+namespace uwb::python {
+namespace {
+
+// ---------------------------------------------------------------------------------------------- features
+std::vector<TdoaFeature> featuresFromDict(const py::dict& d) {
+  const Eigen::VectorXi ia = toIntVector(requireKey(d, "id_a", "features"), "features['id_a']");
+  const auto n = ia.size();
+  const Eigen::VectorXi ib = toIntVector(requireKey(d, "id_b", "features"), "features['id_b']");
+  const auto opt = [&](const char* key, Eigen::Index cols) -> RowMat {
+    if (!d.contains(key)) return RowMat::Zero(1, cols == 0 ? 1 : cols);
+    RowMat m = toMatrix(d[key], cols, (std::string("features['") + key + "']").c_str());
+    if (m.rows() != n && m.rows() != 1) {
+      throw std::invalid_argument(std::string("features['") + key + "']: " + std::to_string(m.rows()) +
+                                  " rows, expected " + std::to_string(n) + " (as id_a)");
+    }
+    return m;
+  };
+  if (ib.size() != n) throw std::invalid_argument("features['id_b']: length differs from id_a");
+  const RowMat ya = opt("yaw_a", 0), yb = opt("yaw_b", 0), pa = opt("b_p_a", 3), pb = opt("b_p_b", 3),
+               wp = opt("w_p_b", 3);
+  const auto r = [](const RowMat& m, Eigen::Index i) { return m.rows() == 1 ? 0 : i; };
+  std::vector<TdoaFeature> out(static_cast<std::size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    TdoaFeature& f = out[i];
+    f.id_a = ia(i), f.id_b = ib(i);
+    f.yaw_a_rad = ya(r(ya, i), 0), f.yaw_b_rad = yb(r(yb, i), 0);
+    f.b_p_a = row3(pa, i), f.b_p_b = row3(pb, i), f.w_p_b = row3(wp, i);
+  }
+  return out;
+}
+
+py::dict featuresToDict(const std::vector<const TdoaFeature*>& fs) {
+  const auto n = static_cast<Eigen::Index>(fs.size());
+  auto ia = newIntArray(n), ib = newIntArray(n);
+  auto ma = ia.mutable_unchecked<1>(), mb = ib.mutable_unchecked<1>();
+  RowMat yaw(n, 2), pa(n, 3), pb(n, 3), wp(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const TdoaFeature& f = *fs[i];
+    ma(i) = f.id_a, mb(i) = f.id_b;
+    yaw.row(i) << f.yaw_a_rad, f.yaw_b_rad;
+    pa.row(i) = f.b_p_a.transpose(), pb.row(i) = f.b_p_b.transpose(), wp.row(i) = f.w_p_b.transpose();
+  }
+  py::dict d;
+  d["id_a"] = ia, d["id_b"] = ib, d["yaw_a"] = toNumpy(yaw.col(0), true), d["yaw_b"] = toNumpy(yaw.col(1), true);
+  d["b_p_a"] = toNumpy(pa), d["b_p_b"] = toNumpy(pb), d["w_p_b"] = toNumpy(wp);
+  return d;
+}
+
+// ------------------------------------------------------------------------------------------- parameters
+template <class T>
+using Setters = std::map<std::string, std::function<void(T&, const py::handle&)>>;
+
+template <class T>
+void applyOverrides(T& obj, const Setters<T>& setters, const py::dict& overrides, const std::string& what) {
+  for (const auto& [key, value] : overrides) {
+    const std::string name = py::str(key);
+    const auto it = setters.find(name);
+    if (it == setters.end()) {
+      std::string known;
+      for (const auto& [n, _] : setters) known += (known.empty() ? "" : ", ") + n;
+      throw std::invalid_argument("unknown " + what + " parameter '" + name + "' (known: " + known + ")");
+    }
+    try {
+      it->second(obj, value);
+    } catch (const py::cast_error&) {
+      throw std::invalid_argument(what + " parameter '" + name + "': wrong type");
+    }
+  }
+}
+
+const Setters<EkfParams>& ekfSetters() {
+  static const Setters<EkfParams> s = [] {
+    Setters<EkfParams> out;
+    using P = EkfParams;
+    for (const auto& [n, f] : std::vector<std::pair<std::string, double P::*>>{
+             {"acc_noise_mps2_sqrthz", &P::acc_noise_mps2_sqrthz},
+             {"lateral_acc_noise_mps2_sqrthz", &P::lateral_acc_noise_mps2_sqrthz},
+             {"gyro_noise_radps_sqrthz", &P::gyro_noise_radps_sqrthz},
+             {"acc_bias_rw_mps3_sqrthz", &P::acc_bias_rw_mps3_sqrthz},
+             {"gyro_bias_rw_radps2_sqrthz", &P::gyro_bias_rw_radps2_sqrthz},
+             {"pos_noise_m_sqrts", &P::pos_noise_m_sqrts},
+             {"cv_acc_noise_mps2_sqrthz", &P::cv_acc_noise_mps2_sqrthz},
+             {"ca_jerk_noise_mps3_sqrthz", &P::ca_jerk_noise_mps3_sqrthz},
+             {"init_pos_sigma_m", &P::init_pos_sigma_m}, {"init_vel_sigma_mps", &P::init_vel_sigma_mps},
+             {"init_att_sigma_rad", &P::init_att_sigma_rad}, {"init_yaw_sigma_rad", &P::init_yaw_sigma_rad},
+             {"init_acc_bias_sigma_mps2", &P::init_acc_bias_sigma_mps2},
+             {"init_gyro_bias_sigma_radps", &P::init_gyro_bias_sigma_radps}, {"tdoa_sigma_m", &P::tdoa_sigma_m},
+             {"anchor_sigma_m", &P::anchor_sigma_m}, {"gate_sigma", &P::gate_sigma}, {"robust_k", &P::robust_k},
+             {"max_lost_s", &P::max_lost_s}, {"max_predict_dt_s", &P::max_predict_dt_s},
+             {"cov_period_s", &P::cov_period_s}, {"max_gap_s", &P::max_gap_s},
+             {"takeoff_climb_mps", &P::takeoff_climb_mps}, {"takeoff_acc_mps2", &P::takeoff_acc_mps2},
+             {"landing_height_m", &P::landing_height_m}, {"landing_hold_s", &P::landing_hold_s},
+             {"acquisition_s", &P::acquisition_s}, {"acquisition_tdoa_sigma_m", &P::acquisition_tdoa_sigma_m},
+             {"ground_z_m", &P::ground_z_m}}) {
+      out[n] = [f](P& p, const py::handle& v) { p.*f = py::cast<double>(v); };
+    }
+    out["robust_iterations"] = [](P& p, const py::handle& v) { p.robust_iterations = py::cast<int>(v); };
+    out["has_start_position"] = [](P& p, const py::handle& v) { p.has_start_position = py::cast<bool>(v); };
+    out["start_w_p_b"] = [](P& p, const py::handle& v) {
+      p.start_w_p_b = row3(toMatrix(v, 3, "start_w_p_b"), 0);
+      p.has_start_position = true;
+    };
+    out["b_t_tag"] = [](P& p, const py::handle& v) { p.b_t_tag = row3(toMatrix(v, 3, "b_t_tag"), 0); };
+    out["accel_model"] = [](P& p, const py::handle& v) { p.accel_model = parseAccelModel(py::cast<std::string>(v)); };
+    out["process_model"] = [](P& p, const py::handle& v) {
+      p.process_model = parseProcessModel(py::cast<std::string>(v));
+    };
+    out["robust_loss"] = [](P& p, const py::handle& v) { p.robust_loss = parseRobustLoss(py::cast<std::string>(v)); };
+    out["ground_phase"] = [](P& p, const py::handle& v) {
+      p.ground_phase = parseGroundPhase(py::cast<std::string>(v));
+    };
+    return out;
+  }();
+  return s;
+}
+
+EkfParams ekfParams(const std::string& preset, const py::dict& overrides) {
+  EkfParams p;
+  if (preset == "defaults") p = EkfParams::defaults();
+  else if (preset == "crazyflie") p = EkfParams::crazyflieLike();
+  else if (preset == "tdoa-only") p = EkfParams::tdoaOnly();
+  else throw std::invalid_argument("unknown filter preset '" + preset + "' (expected defaults, crazyflie, tdoa-only)");
+  applyOverrides(p, ekfSetters(), overrides, "filter");
+  p.validate();
+  return p;
+}
+
+BiasDatasetParams datasetParams(const py::kwargs& kw) {
+  BiasDatasetParams p;
+  for (const auto& [key, value] : kw) {
+    const std::string n = py::str(key);
+    if (n == "b_t_tag") p.b_t_tag = row3(toMatrix(value, 3, "b_t_tag"), 0);
+    else if (n == "min_z_m") p.min_z_m = py::cast<double>(value);
+    else if (n == "glitch_margin_s") p.glitch_margin_s = py::cast<double>(value);
+    else if (n == "max_abs_error_m") p.max_abs_error_m = py::cast<double>(value);
+    else if (n == "neighbour_pairs_only") p.neighbour_pairs_only = py::cast<bool>(value);
+    else
+      throw std::invalid_argument("unknown dataset parameter '" + n +
+                                  "' (known: b_t_tag, min_z_m, glitch_margin_s, max_abs_error_m, "
+                                  "neighbour_pairs_only)");
+  }
+  p.validate();
+  return p;
+}
+
+// ---------------------------------------------------------------------------------------------- results
+py::dict statsDict(const PositionErrorStats& s) {
+  py::dict d;
+  d["n"] = s.n, d["rmse_m"] = s.rmse_m, d["rmse_axis_m"] = toNumpy(s.rmse_axis_m, true), d["mean_m"] = s.mean_m;
+  d["p50_m"] = s.p50_m, d["p90_m"] = s.p90_m, d["p99_m"] = s.p99_m, d["max_m"] = s.max_m;
+  return d;
+}
+
+py::dict metricsDict(const TrajectoryMetrics& m) {
+  const auto n = static_cast<Eigen::Index>(m.samples.size());
+  RowMat t(n, 2), pt(n, 3), pe(n, 3), e(n, 3);
+  py::array_t<bool> airborne(static_cast<py::ssize_t>(n));
+  auto ma = airborne.mutable_unchecked<1>();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto& s = m.samples[i];
+    t.row(i) << s.t_s, s.error_norm_m;
+    pt.row(i) = s.w_p_true.transpose(), pe.row(i) = s.w_p_est.transpose(), e.row(i) = s.error_m.transpose();
+    ma(i) = s.airborne;
+  }
+  py::dict samples;
+  samples["t"] = toNumpy(t.col(0), true), samples["p_true"] = toNumpy(pt), samples["p_est"] = toNumpy(pe);
+  samples["error"] = toNumpy(e), samples["error_norm"] = toNumpy(t.col(1), true), samples["airborne"] = airborne;
+  py::dict d;
+  d["whole"] = statsDict(m.whole), d["airborne"] = statsDict(m.airborne), d["samples"] = samples;
+  d["n_truth_not_covered"] = m.n_truth_not_covered;
+  return d;
+}
+
+py::dict summaryDict(const LocalizerSummary& s) {
+  py::dict d;
+  d["n_tdoa_total"] = s.n_tdoa_total, d["n_tdoa_used"] = s.n_tdoa_used, d["n_tdoa_rejected"] = s.n_tdoa_rejected;
+  d["n_tdoa_downweighted"] = s.n_tdoa_downweighted, d["n_tdoa_ground"] = s.n_tdoa_ground;
+  d["n_tdoa_degenerate"] = s.n_tdoa_degenerate, d["n_tdoa_unknown_anchor"] = s.n_tdoa_unknown_anchor;
+  d["n_predictions"] = s.n_predictions, d["n_covariance_propagations"] = s.n_covariance_propagations;
+  d["n_reacquisitions"] = s.n_reacquisitions, d["takeoff_t_s"] = s.takeoff_t_s, d["landing_t_s"] = s.landing_t_s;
+  d["start_t_s"] = s.start_t_s, d["end_t_s"] = s.end_t_s, d["process_model"] = toString(s.process_model);
+  d["start_w_p_b"] = toNumpy(s.start_w_p_b, true), d["start_rms_residual_m"] = s.start_rms_residual_m;
+  return d;
+}
+
+py::dict trainReportDict(const BiasTrainReport& r) {
+  py::dict d;
+  d["n_train"] = r.n_train, d["n_holdout"] = r.n_holdout, d["bias_rmse_before_m"] = r.bias_rmse_before_m;
+  d["bias_rmse_after_m"] = r.bias_rmse_after_m, d["mean_predicted_std_m"] = r.mean_predicted_std_m;
+  d["train_seconds"] = r.train_seconds, d["num_models"] = r.num_models;
+  return d;
+}
+
+py::dict flightReportDict(const BiasFlightReport& r) {
+  py::dict d;
+  d["source"] = r.source, d["n_measurements"] = r.n_measurements, d["n_unknown_anchor"] = r.n_unknown_anchor;
+  d["n_no_ground_truth"] = r.n_no_ground_truth, d["n_pose_glitch"] = r.n_pose_glitch;
+  d["n_on_ground"] = r.n_on_ground, d["n_non_neighbour"] = r.n_non_neighbour, d["n_outlier"] = r.n_outlier;
+  d["n_used"] = r.n_used, d["n_pose_glitches_detected"] = r.n_pose_glitches_detected;
+  return d;
+}
+
+}  // namespace
+
+void bindEval(py::module_& m) {
+  // ------------------------------------------------------------------------------------- training data
+  py::class_<BiasDataset>(m, "BiasDataset",
+                          "GP training data from flights with ground truth: features from the interpolated\n"
+                          "ground-truth pose and the TDoA error ε (paper eq. 6), after explicit exclusion rules.")
+      .def("__len__", [](const BiasDataset& d) { return d.samples.size(); })
+      .def(
+          "arrays",
+          [](const BiasDataset& d) {
+            std::vector<const TdoaFeature*> fs;
+            fs.reserve(d.samples.size());
+            const auto n = static_cast<Eigen::Index>(d.samples.size());
+            RowMat x(n, 2);
+            auto flight = newIntArray(n);
+            auto mf = flight.mutable_unchecked<1>();
+            for (Eigen::Index i = 0; i < n; ++i) {
+              fs.push_back(&d.samples[i].feature);
+              x.row(i) << d.samples[i].t_s, d.samples[i].error_m;
+              mf(i) = d.samples[i].flight;
+            }
+            py::dict out = featuresToDict(fs);
+            out["t"] = toNumpy(x.col(0), true), out["error"] = toNumpy(x.col(1), true), out["flight"] = flight;
+            return out;
+          },
+          "{t, flight (index), error [m] (ε, the GP target), id_a, id_b, yaw_a, yaw_b, b_p_a, b_p_b, w_p_b}")
+      .def_property_readonly("flights",
+                             [](const BiasDataset& d) {
+                               py::list l;
+                               for (const auto& r : d.flights) l.append(flightReportDict(r));
+                               return l;
+                             },
+                             "per-flight exclusion counts")
+      .def("report_text", &BiasDataset::reportText);
+
+  m.def(
+      "build_bias_dataset",
+      [](const std::vector<const Flight*>& flights, const AnchorSurvey& survey, const py::kwargs& kw) {
+        const BiasDatasetParams params = datasetParams(kw);
+        std::vector<Flight> copies;
+        copies.reserve(flights.size());
+        for (const Flight* f : flights) copies.push_back(*f);
+        py::gil_scoped_release release;
+        return buildBiasDataset(copies, survey, params);
+      },
+      py::arg("flights"), py::arg("survey"),
+      "Training data from flights with ground-truth pose and orientation. Keyword arguments override\n"
+      "BiasDatasetParams (min_z_m, glitch_margin_s, max_abs_error_m, neighbour_pairs_only, b_t_tag).");
+
+  m.def("bias_preset_names", &BiasPreset::names, "Bias-model presets: z1, z2, tdoa (paper) and extras.");
+  m.def(
+      "feature_matrix",
+      [](const std::string& feature_map, const py::dict& features) {
+        return toNumpy(featureMatrix(featureMapFromString(feature_map), featuresFromDict(features)));
+      },
+      py::arg("feature_map"), py::arg("features"),
+      "GP input rows (N, D) of a feature dict for a feature map ('yaw_angles' → [yaw_a, yaw_b], 'body_positions' →\n"
+      "[b_p_a, b_p_b], 'world_position' → [w_p_b]).");
+
+  // ---------------------------------------------------------------------------------------- bias model
+  py::class_<BiasModel>(m, "BiasModel",
+                        "A trained TDoA bias model (SVGP(s) + feature mapping); the filter's bias predictor.")
+      .def(py::init([](const gp::Svgp& svgp, const std::string& feature_map, const std::string& preset) {
+             return BiasModel(preset, featureMapFromString(feature_map), {BiasModel::Entry{-1, -1, svgp}});
+           }),
+           py::arg("svgp"), py::arg("feature_map"), py::arg("preset") = "custom",
+           "Wraps one global SVGP trained in Python (inputs given by feature_map) as a bias model.")
+      .def_property_readonly("preset", &BiasModel::preset)
+      .def_property_readonly("feature_map", [](const BiasModel& b) { return toString(b.features()); })
+      .def_property_readonly("entries",
+                             [](const BiasModel& b) {
+                               py::list l;
+                               for (const auto& e : b.entries()) {
+                                 py::dict d;
+                                 d["id_a"] = e.id_a, d["id_b"] = e.id_b, d["gp"] = e.gp;
+                                 l.append(d);
+                               }
+                               return l;
+                             },
+                             "[{id_a, id_b (-1: all pairs), gp: Svgp}]")
+      .def(
+          "predict",
+          [](const BiasModel& b, const py::dict& features) {
+            const std::vector<TdoaFeature> fs = featuresFromDict(features);
+            Eigen::VectorXd mean(static_cast<Eigen::Index>(fs.size())), var(mean.size());
+            {
+              py::gil_scoped_release release;
+              for (std::size_t i = 0; i < fs.size(); ++i) {
+                const BiasPrediction p = b.predict(fs[i]);
+                mean(i) = p.mean_m, var(i) = p.variance_m2;
+              }
+            }
+            py::dict d;
+            d["mean"] = toNumpy(mean, true), d["var"] = toNumpy(var, true);
+            return d;
+          },
+          py::arg("features"),
+          "Predicted bias of every row of a feature dict: {mean [m], var [m²] (latent)}; 0, 0 for uncovered pairs.")
+      .def_property("metadata_json", [](const BiasModel& b) { return b.metadata_json; },
+                    [](BiasModel& b, const std::string& s) { b.metadata_json = s; })
+      .def("save", &BiasModel::save, py::arg("path"), "Writes the model file (the CLI's --bias-model format).")
+      .def_static("load", &BiasModel::load, py::arg("path"), "Reads a model file written by save() or the CLI.")
+      .def("to_json", [](const BiasModel& b) { return b.toJson().dump(); })
+      .def("__repr__", [](const BiasModel& b) {
+        return "<BiasModel preset=" + b.preset() + " features=" + toString(b.features()) + " models=" +
+               std::to_string(b.entries().size()) + ">";
+      });
+
+  m.def(
+      "train_bias_model",
+      [](const BiasDataset& data, const std::string& preset, int num_inducing, double holdout_fraction,
+         double holdout_block_s, const py::object& progress, const py::kwargs& kw) {
+        BiasTrainParams p;
+        p.preset = preset;
+        p.num_inducing = num_inducing;
+        p.holdout_fraction = holdout_fraction;
+        p.holdout_block_s = holdout_block_s;
+        // SVGP training parameters (same names as train_svgp)
+        for (const auto& [key, value] : kw) {
+          const std::string n = py::str(key);
+          if (n == "epochs") p.svgp.epochs = py::cast<int>(value);
+          else if (n == "batch_size") p.svgp.batch_size = py::cast<int>(value);
+          else if (n == "seed") p.svgp.seed = py::cast<std::uint64_t>(value);
+          else if (n == "lr") p.svgp.lr = py::cast<double>(value);
+          else if (n == "lr_inducing") p.svgp.lr_inducing = py::cast<double>(value);
+          else if (n == "natgrad_step") p.svgp.natgrad_step = py::cast<double>(value);
+          else if (n == "train_inducing") p.svgp.train_inducing = py::cast<bool>(value);
+          else if (n == "min_samples_per_inducing") p.min_samples_per_inducing = py::cast<int>(value);
+          else
+            throw std::invalid_argument("unknown training parameter '" + n +
+                                        "' (known: epochs, batch_size, seed, lr, lr_inducing, natgrad_step, "
+                                        "train_inducing, min_samples_per_inducing)");
+        }
+        p.validate();
+        BiasTrainProgress cb;
+        if (!progress.is_none()) {
+          cb = [&progress](int model, int models, const gp::EpochReport& r) {
+            py::gil_scoped_acquire acquire;
+            py::dict d;
+            d["model"] = model, d["models"] = models, d["epoch"] = r.epoch, d["epochs"] = r.epochs;
+            d["elbo"] = r.elbo, d["val_rmse"] = r.val_rmse, d["elapsed_s"] = r.elapsed_s;
+            progress(d);
+          };
+        }
+        BiasTrainReport report;
+        BiasModel model;
+        {
+          py::gil_scoped_release release;
+          model = trainBiasModel(data, p, &report, cb);
+        }
+        return py::make_tuple(std::move(model), trainReportDict(report));
+      },
+      py::arg("dataset"), py::arg("preset") = "z1", py::arg("num_inducing") = 30, py::arg("holdout_fraction") = 0.2,
+      py::arg("holdout_block_s") = 5.0, py::arg("progress") = py::none(),
+      "Trains the preset's GP(s) on the dataset (time blocks held out). Keyword arguments: SVGP training\n"
+      "parameters (epochs, batch_size, seed, lr, ...). Returns (BiasModel, report {n_train, n_holdout,\n"
+      "bias_rmse_before_m, bias_rmse_after_m, mean_predicted_std_m, train_seconds, num_models}).");
+
+  // -------------------------------------------------------------------------------------- localization
+  m.def(
+      "localize_flight",
+      [](const Flight& flight, const AnchorSurvey& survey, const BiasModel* bias_model, const std::string& preset,
+         const py::dict& params, double output_period_s, bool tdoa_only, double airborne_min_z_m) {
+        LocalizationOptions options;
+        options.params = ekfParams(preset, params);
+        options.output_period_s = output_period_s;
+        options.tdoa_only = tdoa_only;
+        options.metrics.airborne_min_z_m = airborne_min_z_m;
+        LocalizationRun run;
+        {
+          py::gil_scoped_release release;
+          run = localizeFlight(flight, survey, options, bias_model ? bias_model->predictor() : BiasPredictor{});
+        }
+        py::dict d;
+        d["trajectory"] = trajectoryToDict(run.trajectory);
+        d["summary"] = summaryDict(run.summary);
+        d["metrics"] = run.metrics ? py::object(metricsDict(*run.metrics)) : py::object(py::none());
+        d["duration_s"] = run.duration_s, d["n_truth_glitches"] = run.n_truth_glitches;
+        return d;
+      },
+      py::arg("flight"), py::arg("survey"), py::arg("bias_model") = nullptr, py::arg("preset") = "defaults",
+      py::arg("params") = py::dict(), py::arg("output_period_s") = 0.01, py::arg("tdoa_only") = false,
+      py::arg("airborne_min_z_m") = 0.3,
+      "Runs the localization filter on a flight, with the GP correction when bias_model is given (paper III-B:\n"
+      "z − mean, variance added). preset: 'defaults' | 'crazyflie' | 'tdoa-only'; params: EkfParams overrides\n"
+      "(field names of uwb/filter/EkfParams.h, enums as strings). Returns {trajectory {t, p, q, sigma_p, v},\n"
+      "summary {...}, metrics (None without ground truth) {whole, airborne: {n, rmse_m, rmse_axis_m, mean_m,\n"
+      "p50_m, p90_m, p99_m, max_m}, samples {t, p_true, p_est, error, error_norm, airborne}}, duration_s}.");
+  m.def("filter_param_names",
+        [] {
+          std::vector<std::string> names;
+          for (const auto& [n, _] : ekfSetters()) names.push_back(n);
+          return names;
+        },
+        "Names accepted by localize_flight(params=...).");
+  m.def(
+      "compute_trajectory_metrics",
+      [](const py::dict& trajectory, const py::object& truth, double airborne_min_z_m, double max_interp_gap_s) {
+        TrajectoryMetricsParams p;
+        p.airborne_min_z_m = airborne_min_z_m;
+        p.max_interp_gap_s = max_interp_gap_s;
+        p.validate();
+        std::vector<PoseSample> gt;
+        if (py::isinstance<Flight>(truth)) {
+          gt = PoseTrack(py::cast<const Flight&>(truth)).samples();
+        } else {
+          const Trajectory t = trajectoryFromDict(py::cast<py::dict>(truth));
+          for (const auto& s : t) gt.push_back({s.t_s, s.w_p_b, s.w_q_b});
+        }
+        return metricsDict(computeTrajectoryMetrics(trajectoryFromDict(trajectory), gt, p));
+      },
+      py::arg("trajectory"), py::arg("truth"), py::arg("airborne_min_z_m") = 0.3, py::arg("max_interp_gap_s") = 0.1,
+      "Position error of an estimated trajectory {t, p, ...} against ground truth (a Flight: its glitch-free pose\n"
+      "track; or a dict {t, p[, q]}): {whole, airborne, samples, n_truth_not_covered} as in localize_flight.");
+}
+
+}  // namespace uwb::python

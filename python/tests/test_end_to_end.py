@@ -1,0 +1,94 @@
+"""End to end from Python on short simulated flights: simulate → training data → train a small GP →
+localize without and with the correction → metrics; plus the eval bindings' errors and round trips."""
+import numpy as np
+import pytest
+
+import uwbtdoa as u
+
+
+@pytest.fixture(scope="module")
+def flights():
+    train = u.simulate_flight("zigzag", 50.0, seed=1)
+    test = u.simulate_flight("circle", 35.0, seed=2, anchors=train["survey"])
+    return train, test
+
+
+@pytest.fixture(scope="module")
+def trained(flights):
+    train, _ = flights
+    data = u.build_bias_dataset([train["flight"]], train["survey"])
+    model, report = u.train_bias_model(data, "z1", 15, epochs=5, seed=1)
+    return data, model, report
+
+
+def test_training_data_match_the_simulated_error(flights, trained):
+    train, _ = flights
+    data, _, _ = trained
+    a = data.arrays()
+    assert len(data) == a["error"].size > 1000
+    assert data.flights[0]["n_used"] == len(data)
+    # ε of the dataset is the simulator's error of the same measurements (up to the 1 mm pose quantization)
+    tdoa = train["flight"].tdoa
+    idx = np.searchsorted(tdoa["t"], a["t"])
+    np.testing.assert_allclose(a["error"], train["tdoa_truth"]["error"][idx], atol=0.01)
+    X = u.feature_matrix("yaw_angles", a)
+    assert X.shape == (len(data), 2)
+    np.testing.assert_array_equal(X[:, 0], a["yaw_a"])
+
+
+def test_train_localize_and_compare(flights, trained, tmp_path):
+    _, test = flights
+    _, model, report = trained
+    assert report["n_train"] > 0 and report["num_models"] == 1
+    # WHEN the test flight is localized without and with the correction
+    plain = u.localize_flight(test["flight"], test["survey"])
+    corrected = u.localize_flight(test["flight"], test["survey"], bias_model=model)
+    # THEN both give a full trajectory with per-axis position std and metrics against the ground truth
+    for run in (plain, corrected):
+        traj = run["trajectory"]
+        assert traj["p"].shape[0] == traj["t"].size > 1000 and traj["sigma_p"].shape == traj["p"].shape
+        assert np.all(traj["sigma_p"] > 0)
+        air = run["metrics"]["airborne"]
+        assert 0 < air["rmse_m"] < 1.5 and air["n"] > 100
+        s = run["metrics"]["samples"]
+        np.testing.assert_allclose(np.sqrt(np.mean(s["error_norm"][s["airborne"]] ** 2)), air["rmse_m"], rtol=1e-9)
+    # the correction changes the estimate
+    assert not np.allclose(plain["trajectory"]["p"], corrected["trajectory"]["p"])
+    # metrics recomputed from the arrays agree with the filter run's
+    m = u.compute_trajectory_metrics(plain["trajectory"], test["flight"])
+    assert m["airborne"]["rmse_m"] == pytest.approx(plain["metrics"]["airborne"]["rmse_m"], rel=1e-9)
+    # the model file round trips and predicts the same
+    path = tmp_path / "bias.json"
+    model.save(str(path))
+    back = u.BiasModel.load(str(path))
+    feats = u.make_tdoa_features([0, 1], [1, 2], [[0, 0, 1.5]], [0, 0, 0, 1], test["survey"].position(0),
+                                 test["survey"].position(1))
+    np.testing.assert_allclose(back.predict(feats)["mean"], model.predict(feats)["mean"], rtol=1e-12)
+
+
+def test_a_gp_trained_in_python_drives_the_filter(flights, trained):
+    _, test = flights
+    data, _, _ = trained
+    a = data.arrays()
+    X = u.feature_matrix("yaw_angles", a)
+    gp = u.init_svgp(u.Kernel.preset("z1"), X, a["error"], 10)
+    u.train_svgp(gp, X, a["error"], epochs=2)
+    model = u.BiasModel(gp, "yaw_angles")
+    np.testing.assert_allclose(model.predict(a)["mean"][:50], gp.predict(X[:50])["mean"], rtol=1e-9, atol=1e-12)
+    run = u.localize_flight(test["flight"], test["survey"], bias_model=model, params={"tdoa_sigma_m": 0.3})
+    assert run["metrics"]["airborne"]["n"] > 100
+
+
+def test_eval_errors_are_value_and_os_errors(flights, trained, tmp_path):
+    _, test = flights
+    data, _, _ = trained
+    with pytest.raises(ValueError, match="unknown filter parameter 'tdoa_sigma'"):
+        u.localize_flight(test["flight"], test["survey"], params={"tdoa_sigma": 0.3})
+    with pytest.raises(ValueError, match="unknown filter preset"):
+        u.localize_flight(test["flight"], test["survey"], preset="fast")
+    with pytest.raises(ValueError):
+        u.train_bias_model(data, "no-such-kernel", 10)
+    with pytest.raises(OSError):
+        u.BiasModel.load(str(tmp_path / "absent.json"))
+    with pytest.raises(ValueError, match="unknown feature map"):
+        u.feature_matrix("angles", data.arrays())
