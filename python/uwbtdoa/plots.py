@@ -171,11 +171,14 @@ def fig6_error_distribution(err_uncorrected, err_corrected, path: str | None = N
     upper = float(np.percentile(np.concatenate([eu, ec]), 99.5))
     edges = np.linspace(0.0, upper * 1.02 if upper > 0 else 1.0, bins + 1)
     styles = [("uncorrected", eu, "tab:blue"), ("corrected", ec, "tab:orange")]
+    bin_width = edges[1] - edges[0]
     for name, e, color in styles:
         med, rmse = float(np.median(e)), _rmse(e)
-        ax_h.hist(np.clip(e, 0, edges[-1]), bins=edges, density=True, histtype="stepfilled", alpha=0.35,
-                  color=color, label=f"{name}: median {med:.3f} m, RMSE {rmse:.3f} m")
-        ax_h.hist(np.clip(e, 0, edges[-1]), bins=edges, density=True, histtype="step", color=color, linewidth=1.2)
+        beyond = int(np.sum(e > edges[-1]))  # the axis ends at the 99.5th percentile; those are counted, not drawn
+        label = f"{name}: median {med:.3f} m, RMSE {rmse:.3f} m" + (f" ({beyond} beyond axis)" if beyond else "")
+        w = np.full(e.size, 1.0 / (e.size * bin_width))  # density over ALL samples, not only those drawn
+        ax_h.hist(e, bins=edges, weights=w, histtype="stepfilled", alpha=0.35, color=color, label=label)
+        ax_h.hist(e, bins=edges, weights=w, histtype="step", color=color, linewidth=1.2)
         ax_h.axvline(med, color=color, linestyle="--", linewidth=1.4)
         ax_h.axvline(rmse, color=color, linestyle=":", linewidth=1.6)
         xs = np.sort(e)
@@ -183,6 +186,7 @@ def fig6_error_distribution(err_uncorrected, err_corrected, path: str | None = N
         ax_c.plot(xs, cdf, color=color, linewidth=1.8, label=f"{name} (n={e.size})")
         ax_c.plot([med], [0.5], "o", color=color)
         ax_c.axvline(rmse, color=color, linestyle=":", linewidth=1.4)
+    ax_h.set_ylim(0.0, ax_h.get_ylim()[1] * 1.3)  # head room for the legend
     ax_h.set_xlabel("localization error |p_est − p_gt| [m]")
     ax_h.set_ylabel("density [1/m]")
     ax_h.set_title("error density (dashed: median, dotted: RMSE)")
@@ -208,7 +212,8 @@ def fig7_bias_vs_angles(alpha_i, alpha_j, error, grid_alpha_i, grid_alpha_j, gri
     ``alpha_i``, ``alpha_j``, ``error``: per-sample yaw angles of anchors A and B in the body frame [rad] and
     the measured TDoA error [m]. ``grid_alpha_i`` (n_i), ``grid_alpha_j`` (n_j): grid axes [rad];
     ``grid_mean``: (n_j, n_i) GP mean [m] (row = alpha_j). ``inducing_alpha``: (M, 2) inducing points
-    (alpha_i, alpha_j) [rad], drawn in red. Both panels share one colour scale; angles are shown in degrees.
+    (alpha_i, alpha_j) [rad], drawn in red; the sample locations are shaded light grey on the right. Both panels
+    share one colour scale; angles are shown in degrees.
     """
     ai, aj, err = (np.asarray(a, dtype=float).ravel() for a in (alpha_i, alpha_j, error))
     if not (ai.size == aj.size == err.size):
@@ -230,9 +235,13 @@ def fig7_bias_vs_angles(alpha_i, alpha_j, error, grid_alpha_i, grid_alpha_j, gri
                  linewidths=0, rasterized=True)
     mesh = ax_r.pcolormesh(gi * deg, gj * deg, np.ma.masked_invalid(gm), cmap="viridis", vmin=-lim, vmax=lim,
                            shading="auto")
+    if ai.size:  # where the training samples lie: the GP mean elsewhere is extrapolation
+        ax_r.scatter(ai * deg, aj * deg, s=1.5, c="k", alpha=0.25, linewidths=0, rasterized=True, zorder=2)
+        ax_r.plot([], [], "o", color="k", alpha=0.5, markersize=4, label="sample locations")  # legend entry
     if z.shape[0]:
         ax_r.scatter(z[:, 0] * deg, z[:, 1] * deg, s=28, c="red", edgecolors="white", linewidths=0.6,
                      label=f"inducing points (M={z.shape[0]})", zorder=3)
+    if ai.size or z.shape[0]:
         ax_r.legend(loc="upper right", fontsize=8.5, framealpha=0.85)
     a_name, b_name = ("A", "B") if pair is None else (str(pair[0]), str(pair[1]))
     for ax in (ax_l, ax_r):
