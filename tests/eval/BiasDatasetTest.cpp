@@ -1,0 +1,192 @@
+/** @file BiasDatasetTest.cpp
+ *  @brief Bias training data (paper eq. 6) and the bias model: ε with lever arm, exclusion rules and counts,
+ *         clear errors, model files (bit-identical round trip, corrupt/mismatched files), and a real-data check.
+ */
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "support/TestSupport.h"
+#include "uwb/core/Error.h"
+#include "uwb/eval/BiasDataset.h"
+#include "uwb/eval/BiasModel.h"
+#include "uwb/io/UtilCsv.h"
+#include "uwb/model/TdoaModel.h"
+
+namespace uwb {
+namespace {
+
+AnchorSurvey ringSurvey() {
+  AnchorSurvey s;
+  for (int i = 0; i < 8; ++i) {
+    const double a = 2 * kPi * i / 8;
+    s.anchors.push_back({i, Vec3(4 * std::cos(a), 4 * std::sin(a), i % 2 ? 0.2 : 2.5), Quat::Identity()});
+  }
+  s.source = "ring";
+  return s;
+}
+
+/// A circle flight at 200 Hz pose; TDoA on neighbour pairs with a known bias 0.1·sin(yaw_a) + a ground phase.
+Flight circleFlight(double duration_s = 20.0) {
+  Flight f;
+  f.source = "synthetic-circle";
+  f.pose_has_orientation = true;
+  const AnchorSurvey s = ringSurvey();
+  for (int k = 0; k <= static_cast<int>(duration_s * 200); ++k) {
+    const double t = k / 200.0;
+    PoseSample p;
+    p.t_s = t;
+    const double z = t < 2.0 ? 0.05 : 1.5;  // 2 s on the ground
+    p.w_p_b = Vec3(1.5 * std::cos(0.5 * t), 1.5 * std::sin(0.5 * t), z);
+    p.w_q_b = Quat(Eigen::AngleAxisd(0.1 * std::sin(t), Vec3::UnitZ()));
+    f.pose.push_back(p);
+  }
+  const PoseTrack track(f.pose, true);
+  for (int k = 0; k < static_cast<int>(duration_s * 100); ++k) {
+    const double t = 0.0025 + k / 100.0;
+    const int a = k % 8, b = (a + 1) % 8;
+    const auto gt = track.interpolate(t);
+    if (!gt) continue;
+    const TdoaFeature feat = makeTdoaFeature(a, b, gt->w_p_b, gt->w_q_b, s.position(a), s.position(b));
+    double bias = 0.1 * std::sin(feat.yaw_a_rad);
+    if (gt->w_p_b.z() < 0.3) bias = 2.0;                     // grossly wrong on the ground
+    if (k % 97 == 5 && gt->w_p_b.z() > 0.3) bias = 3.0;      // gross outliers
+    const double tdoa = predictTdoa(gt->w_p_b, gt->w_q_b, kUtilTagOffset_b, s.position(a), s.position(b)) + bias;
+    f.tdoa.push_back({t, a, b, tdoa});
+  }
+  return f;
+}
+
+TEST(BiasDataset, ErrorIsMeasurementMinusModelWithLeverArmAndRulesAreCounted) {
+  // GIVEN a synthetic flight with a known bias, a ground phase and outliers
+  const Flight f = circleFlight();
+  const AnchorSurvey s = ringSurvey();
+  // WHEN we build the dataset with the default rules
+  const BiasDataset ds = buildBiasDataset({f}, s);
+  // THEN ε equals the injected bias (paper eq. 6, UTIL sign convention, with lever arm)
+  ASSERT_FALSE(ds.samples.empty());
+  for (const auto& smp : ds.samples) EXPECT_NEAR(smp.error_m, 0.1 * std::sin(smp.feature.yaw_a_rad), 1e-6);
+  // AND every measurement is counted under exactly one rule
+  const BiasFlightReport& r = ds.flights.at(0);
+  EXPECT_EQ(r.n_measurements, f.tdoa.size());
+  EXPECT_EQ(r.n_unknown_anchor + r.n_no_ground_truth + r.n_pose_glitch + r.n_on_ground + r.n_non_neighbour + r.n_outlier + r.n_used,
+            r.n_measurements);
+  EXPECT_NEAR(static_cast<double>(r.n_on_ground), 200.0, 2.0);  // 2 s at 100 Hz
+  EXPECT_GT(r.n_outlier, 10u);
+  EXPECT_EQ(r.n_used, ds.samples.size());
+  EXPECT_NE(ds.reportText().find("on ground"), std::string::npos);
+}
+
+TEST(BiasDataset, RulesCanBeChanged) {
+  const Flight f = circleFlight();
+  BiasDatasetParams p;
+  p.max_abs_error_m = 0.0;  // outlier rule off
+  p.min_z_m = -1.0;         // ground rule off
+  const BiasDataset ds = buildBiasDataset({f}, ringSurvey(), p);
+  EXPECT_EQ(ds.flights[0].n_outlier, 0u);
+  EXPECT_EQ(ds.flights[0].n_on_ground, 0u);
+  EXPECT_EQ(ds.flights[0].n_used + ds.flights[0].n_no_ground_truth, f.tdoa.size());
+}
+
+TEST(BiasDataset, FlightWithoutGroundTruthIsAClearError) {
+  Flight f = circleFlight(5);
+  f.pose.clear();
+  EXPECT_THROW(buildBiasDataset({f}, ringSurvey()), InputError);
+  Flight g = circleFlight(5);
+  g.pose_has_orientation = false;
+  try {
+    buildBiasDataset({g}, ringSurvey());
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("orientation"), std::string::npos) << e.what();
+  }
+}
+
+TEST(BiasModel, TooFewSamplesForTheInducingPointsIsAClearError) {
+  const BiasDataset ds = buildBiasDataset({circleFlight(5)}, ringSurvey());
+  BiasTrainParams p;
+  p.num_inducing = 5000;
+  try {
+    trainBiasModel(ds, p);
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("too few"), std::string::npos) << e.what();
+  }
+}
+
+TEST(BiasModel, LearnsTheSyntheticBiasAndRoundTripsBitIdentically) {
+  // GIVEN a synthetic dataset with bias 0.1 sin(yaw_a)
+  const BiasDataset ds = buildBiasDataset({circleFlight(30)}, ringSurvey());
+  BiasTrainParams p;
+  p.preset = "z1";
+  p.num_inducing = 15;
+  p.svgp.epochs = 15;
+  p.svgp.batch_size = 256;
+  BiasTrainReport rep;
+  // WHEN we train
+  const BiasModel model = trainBiasModel(ds, p, &rep);
+  // THEN the held-out bias RMSE drops substantially
+  EXPECT_LT(rep.bias_rmse_after_m, 0.5 * rep.bias_rmse_before_m);
+  EXPECT_GT(rep.n_holdout, 0u);
+  // AND a saved model loads back with bit-identical predictions
+  const std::string path = ::testing::TempDir() + "/bias_model_test.json";
+  model.save(path);
+  const BiasModel back = BiasModel::load(path);
+  const BiasPredictor pred = back.predictor();
+  for (std::size_t i = 0; i < ds.samples.size(); i += 37) {
+    const BiasPrediction a = model.predict(ds.samples[i].feature), b = pred(ds.samples[i].feature);
+    EXPECT_EQ(a.mean_m, b.mean_m);
+    EXPECT_EQ(a.variance_m2, b.variance_m2);
+    EXPECT_GE(a.variance_m2, 0.0);
+  }
+  std::remove(path.c_str());
+}
+
+TEST(BiasModel, CorruptOrMismatchedModelFilesAreClearErrors) {
+  const BiasDataset ds = buildBiasDataset({circleFlight(10)}, ringSurvey());
+  BiasTrainParams p;
+  p.num_inducing = 5;
+  p.svgp.epochs = 1;
+  const BiasModel model = trainBiasModel(ds, p);
+  const std::string path = ::testing::TempDir() + "/bias_model_bad.json";
+  auto write = [&](const std::string& text) {
+    std::ofstream(path) << text;
+  };
+  // truncated file
+  const std::string good = model.toJson().dump();
+  write(good.substr(0, good.size() / 2));
+  EXPECT_THROW(BiasModel::load(path), InputError);
+  // wrong feature map for the GP input dimension
+  nlohmann::json j = nlohmann::json::parse(good);
+  j["features"] = "body_positions";
+  j.erase("feature_columns");
+  write(j.dump());
+  try {
+    BiasModel::load(path);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("dimension"), std::string::npos) << e.what();
+  }
+  // an SVGP file is not a bias model
+  write(model.entries()[0].gp.toJson().dump());
+  EXPECT_THROW(BiasModel::load(path), InputError);
+  EXPECT_THROW(BiasModel::load(path + ".missing"), FileError);
+  std::remove(path.c_str());
+}
+
+TEST(BiasDataset, RealFlightPoseGlitchesAndGroundPhaseAreExcluded) {
+  const auto path = test::pilotFlight("0425-traj9");
+  UWB_REQUIRE_REAL_DATA(path);
+  const AnchorSurvey s = readAnchorSurvey(test::pilotSurvey("0425").string());
+  const BiasDataset ds = buildBiasDataset({readFlightCsv(path->string())}, s);
+  const auto& r = ds.flights[0];
+  EXPECT_GT(r.n_pose_glitches_detected, 0u);  // SOURCE.md: glitches at t ≈ 14.1 s
+  EXPECT_GT(r.n_pose_glitch, 0u);
+  EXPECT_GT(r.n_on_ground, 0u);
+  EXPECT_GT(r.n_used, r.n_measurements / 2);
+}
+
+}  // namespace
+}  // namespace uwb
