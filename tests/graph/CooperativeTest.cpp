@@ -85,6 +85,8 @@ TEST(Cooperative, TwoUncertainAgentsMeasuringEachOtherBothImprove) {
     SCOPED_TRACE("agent " + std::to_string(a));
     const double rms_prior = std::sqrt(err_prior[a] / kTrials), rms_post = std::sqrt(err_post[a] / kTrials);
     EXPECT_LT(rms_post, 0.7 * rms_prior) << rms_post << " vs " << rms_prior;
+    RecordProperty("rms_prior_m_agent" + std::to_string(a), std::to_string(rms_prior));
+    RecordProperty("rms_post_m_agent" + std::to_string(a), std::to_string(rms_post));
   }
 }
 
