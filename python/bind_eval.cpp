@@ -12,6 +12,7 @@
 #include "bindings.h"
 #include "uwb/eval/BiasDataset.h"
 #include "uwb/eval/BiasModel.h"
+#include "uwb/eval/Evaluation.h"
 #include "uwb/eval/Localization.h"
 #include "uwb/eval/TrajectoryMetrics.h"
 #include "uwb/filter/EkfParams.h"
@@ -218,6 +219,26 @@ py::dict flightReportDict(const BiasFlightReport& r) {
   return d;
 }
 
+std::vector<NamedFlight> namedFlights(const py::handle& flights, const char* what) {
+  std::vector<NamedFlight> out;
+  if (py::isinstance<py::dict>(flights)) {
+    for (const auto& [name, f] : py::cast<py::dict>(flights)) out.push_back({py::str(name), py::cast<Flight>(f)});
+  } else {
+    for (const auto& f : flights) {
+      Flight flight = py::cast<Flight>(f);
+      std::string name = flight.source;
+      const auto slash = name.find_last_of('/');
+      if (slash != std::string::npos) name = name.substr(slash + 1);
+      if (name.size() > 4 && name.substr(name.size() - 4) == ".csv") name.resize(name.size() - 4);
+      out.push_back({name, std::move(flight)});
+    }
+  }
+  if (out.empty()) throw std::invalid_argument(std::string(what) + ": no flight given");
+  return out;
+}
+
+py::object jsonToPython(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+
 }  // namespace
 
 void bindEval(py::module_& m) {
@@ -407,6 +428,73 @@ void bindEval(py::module_& m) {
       "(field names of uwb/filter/EkfParams.h, enums as strings). Returns {trajectory {t, p, q, sigma_p, v},\n"
       "summary {...}, metrics (None without ground truth) {whole, airborne: {n, rmse_m, rmse_axis_m, mean_m,\n"
       "p50_m, p90_m, p99_m, max_m}, samples {t, p_true, p_est, error, error_norm, airborne}}, duration_s}.");
+  m.def(
+      "run_evaluation",
+      [](const py::handle& train, const py::handle& test, const AnchorSurvey& survey,
+         const std::vector<std::string>& kernels, const std::vector<int>& inducing, int repeats, int epochs,
+         int threads, const py::object& out, const std::string& command, bool render, const py::object& progress) {
+        EvaluationParams params;
+        params.kernels = kernels;
+        params.inducing = inducing;
+        params.repeats = repeats;
+        if (epochs > 0) params.train.svgp.epochs = epochs;
+        params.threads = threads;
+        params.validate();
+        const std::vector<NamedFlight> tr = namedFlights(train, "train"), te = namedFlights(test, "test");
+        EvaluationProgress cb;
+        if (!progress.is_none()) {
+          cb = [&progress](const std::string& line) {
+            py::gil_scoped_acquire acquire;
+            progress(line);
+          };
+        }
+        EvaluationResult result;
+        {
+          py::gil_scoped_release release;
+          result = runEvaluation(tr, te, survey, params, cb);
+        }
+        py::dict d;
+        d["rows"] = jsonToPython(toJson(result.rows));
+        py::list runs;
+        for (const auto& r : result.runs) {
+          py::dict x;
+          x["kernel"] = r.kernel, x["inducing"] = r.inducing, x["repeat"] = r.repeat, x["flight"] = r.flight;
+          x["rmse_uncorrected_m"] = r.rmse_uncorrected_m, x["rmse_corrected_m"] = r.rmse_corrected_m;
+          x["bias_rmse_before_m"] = r.bias_rmse_before_m, x["bias_rmse_after_m"] = r.bias_rmse_after_m;
+          x["train_seconds"] = r.train_seconds;
+          runs.append(x);
+        }
+        d["runs"] = runs;
+        d["best_kernel"] = result.best_kernel, d["best_inducing"] = result.best_inducing;
+        d["n_train_samples"] = result.n_train_samples, d["seconds"] = result.seconds;
+        d["dataset_report"] = result.dataset_report;
+        d["markdown"] = toMarkdown(result.rows);
+        if (!out.is_none()) {
+          const std::string dir = py::str(out);
+          writeEvaluation(result, survey, dir, command);
+          if (render) {
+            // Same figures as the CLI's report (one implementation: uwbtdoa.plots), then the report names them.
+            const py::list written = py::module_::import("uwbtdoa.plots").attr("render_report")(dir);
+            std::vector<std::string> names;
+            for (const auto& p : written) {
+              const std::string path = py::str(p);
+              names.push_back(path.substr(path.find_last_of('/') + 1));
+            }
+            writeEvaluation(result, survey, dir, command, names);
+            d["figures"] = names;
+          }
+        }
+        return d;
+      },
+      py::arg("train"), py::arg("test"), py::arg("survey"),
+      py::arg("kernels") = std::vector<std::string>{"z1", "z2", "tdoa"},
+      py::arg("inducing") = std::vector<int>{10, 30, 50, 100, 170}, py::arg("repeats") = 3, py::arg("epochs") = 0,
+      py::arg("threads") = 2, py::arg("out") = py::none(), py::arg("command") = "", py::arg("render") = true,
+      py::arg("progress") = py::none(),
+      "The paper's evaluation (uwbtdoa evaluate): train every (kernel, M, repeat), localize every test flight\n"
+      "without and with correction. train/test: {name: Flight} or a list of Flights (named after their file).\n"
+      "Returns {rows (results.json objects), runs, best_kernel, best_inducing, n_train_samples, seconds,\n"
+      "dataset_report, markdown}. With out=DIR, writes the CLI's report files there and renders the figures.");
   m.def("filter_param_names",
         [] {
           std::vector<std::string> names;

@@ -92,3 +92,17 @@ def test_eval_errors_are_value_and_os_errors(flights, trained, tmp_path):
         u.BiasModel.load(str(tmp_path / "absent.json"))
     with pytest.raises(ValueError, match="unknown feature map"):
         u.feature_matrix("angles", data.arrays())
+
+
+def test_run_evaluation_writes_the_report_and_renders_its_figures(flights, tmp_path):
+    train, test = flights
+    lines = []
+    r = u.run_evaluation({"zigzag": train["flight"]}, {"circle": test["flight"]}, train["survey"], kernels=["z1"],
+                         inducing=[8, 12], repeats=1, epochs=2, out=str(tmp_path), command="pytest", progress=lines.append)
+    assert [row["inducing"] for row in r["rows"]] == [8, 12]
+    assert {"kernel", "improvement_pct", "improvement_pct_min", "improvement_pct_max"} <= set(r["rows"][0])
+    assert any("training data" in line for line in lines)
+    for name in ("results.json", "REPORT.md", "figdata/errors.csv", "fig5_improvement.png",
+                 "fig6_error_distribution.png", "trajectory_circle.png"):
+        assert (tmp_path / name).is_file(), name
+    assert "fig5_improvement.png" in (tmp_path / "REPORT.md").read_text()
