@@ -291,18 +291,16 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
       }
       if (t - t_pred >= p.max_predict_dt_s) {
         predictTo(t);
-        if (phase == FlightPhase::kGround || phase == FlightPhase::kLanded) {
-          if (t - t_last_zupt >= kZuptPeriod_s) {
-            propagate(true);
-            ekf.zeroVelocityUpdate(kZuptSigma_mps);  // (F14)
-            t_last_zupt = t;
-          }
-        } else {
-          propagate(false);
-        }
+        propagate(false);
+      }
+      if ((phase == FlightPhase::kGround || phase == FlightPhase::kLanded) && t - t_last_zupt >= kZuptPeriod_s) {
+        predictTo(t);
+        propagate(true);
+        ekf.zeroVelocityUpdate(kZuptSigma_mps);  // (F14)
+        t_last_zupt = t;
       }
       // landing (F18): nearly still, or low and slow for landing_hold_s
-      if (phase == FlightPhase::kTracking) {
+      if (phase == FlightPhase::kTracking && !std::isnan(sum.takeoff_t_s)) {
         const NavState& x = ekf.state();
         const bool low_slow = x.w_p_b.z() - z_takeoff < p.landing_height_m && x.w_v_b.norm() < 0.25;
         if (still || low_slow) {

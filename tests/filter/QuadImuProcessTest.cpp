@@ -1,0 +1,134 @@
+/** @file QuadImuProcessTest.cpp
+ *  @brief The process model's analytic Jacobians F and G against central differences (docs/math/filter.md F4–F5).
+ */
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "support/TestSupport.h"
+#include "uwb/filter/Ekf.h"
+#include "uwb/filter/QuadImuProcess.h"
+
+namespace uwb {
+namespace {
+
+NavState randomState(std::mt19937& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  NavState x;
+  x.w_p_b = Vec3(n(rng), n(rng), 1.0 + n(rng));
+  x.w_v_b = Vec3(n(rng), n(rng), 0.3 * n(rng));
+  x.w_q_b = Quat(Eigen::AngleAxisd(0.3 * n(rng), Vec3(n(rng), n(rng), n(rng)).normalized())).normalized();
+  x.b_acc_bias = 0.2 * Vec3(n(rng), n(rng), n(rng));
+  x.b_gyro_bias = 0.02 * Vec3(n(rng), n(rng), n(rng));
+  return x;
+}
+
+ImuReading randomImu(std::mt19937& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  ImuReading imu;
+  imu.b_acc_mps2 = Vec3(n(rng), n(rng), kGravity_mps2 + n(rng));
+  imu.b_gyro_radps = Vec3(n(rng), n(rng), n(rng));
+  return imu;
+}
+
+class QuadImuProcessJacobian : public ::testing::TestWithParam<std::tuple<AccelModel, int>> {};
+
+TEST_P(QuadImuProcessJacobian, FMatchesCentralDifferences) {
+  // GIVEN a random state, IMU reading and step
+  const auto [model, seed] = GetParam();
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  std::mt19937 rng(seed);
+  const NavState x = randomState(rng);
+  const ImuReading imu = randomImu(rng);
+  const double dt = 0.01;
+  // WHEN we differentiate x' ⊟ f(x) with respect to the error state
+  const ProcessStep ref = quadImuProcess(x, imu, dt, model);
+  const auto f = [&](const VecX& dx) -> VecX {
+    const ErrVec d = dx;
+    return boxMinus(quadImuProcess(boxPlus(x, d), imu, dt, model).next, ref.next);
+  };
+  const MatX F_num = test::numericalJacobian(f, VecX::Zero(kDim), 1e-6);
+  // THEN the analytic F agrees
+  const ErrMat F = ref.F();
+  EXPECT_LT((F - F_num).cwiseAbs().maxCoeff(), 1e-6) << "F\n" << F << "\nnumerical\n" << F_num;
+}
+
+TEST_P(QuadImuProcessJacobian, GMatchesCentralDifferences) {
+  // GIVEN a random state, reading and step
+  const auto [model, seed] = GetParam();
+  std::mt19937 rng(seed + 100);
+  const NavState x = randomState(rng);
+  const ImuReading imu = randomImu(rng);
+  const double dt = 0.01;
+  const ProcessStep ref = quadImuProcess(x, imu, dt, model);
+  // WHEN we perturb the reading noise n_a, n_g and the bias increments
+  const auto f = [&](const VecX& n) -> VecX {
+    ImuReading m = imu;
+    m.b_acc_mps2 += n.segment<3>(kNoiseAcc);
+    m.b_gyro_radps += n.segment<3>(kNoiseGyro);
+    NavState next = quadImuProcess(x, m, dt, model).next;
+    next.b_acc_bias += n.segment<3>(kNoiseAccBias);
+    next.b_gyro_bias += n.segment<3>(kNoiseGyroBias);
+    return boxMinus(next, ref.next);
+  };
+  const MatX G_num = test::numericalJacobian(f, VecX::Zero(kNoiseDim), 1e-6);
+  // THEN the analytic G agrees
+  EXPECT_LT((ref.G() - G_num).cwiseAbs().maxCoeff(), 1e-6) << ref.G() << "\nvs\n" << G_num;
+}
+
+INSTANTIATE_TEST_SUITE_P(BothAccelModels, QuadImuProcessJacobian,
+                         ::testing::Combine(::testing::Values(AccelModel::kFull, AccelModel::kThrustOnly),
+                                            ::testing::Values(1, 2, 3)));
+
+TEST(QuadImuProcess, HoverAtRestStaysPut) {
+  // GIVEN a level body at rest reading exactly gravity
+  NavState x;
+  x.w_p_b = Vec3(1, 2, 1.5);
+  ImuReading imu;
+  // WHEN predicting one second in 1 ms steps
+  for (int i = 0; i < 1000; ++i) x = quadImuProcess(x, imu, 0.001, AccelModel::kThrustOnly).next;
+  // THEN nothing moves
+  EXPECT_LT((x.w_p_b - Vec3(1, 2, 1.5)).norm(), 1e-9);
+  EXPECT_LT(x.w_v_b.norm(), 1e-9);
+}
+
+TEST(QuadImuProcess, ZeroDtIsIdentity) {
+  std::mt19937 rng(5);
+  const NavState x = randomState(rng);
+  const ProcessStep s = quadImuProcess(x, randomImu(rng), 0.0, AccelModel::kFull);
+  EXPECT_LT(boxMinus(s.next, x).norm(), 1e-12);
+  EXPECT_TRUE(s.F().isIdentity(1e-12));
+}
+
+TEST(AccumulatedTransition, BlockProductEqualsDenseProduct) {
+  // GIVEN several random IMU steps
+  std::mt19937 rng(11);
+  NavState x = randomState(rng);
+  AccumulatedTransition phi;
+  ErrMat dense = ErrMat::Identity();
+  for (int k = 0; k < 7; ++k) {
+    const ProcessStep s = quadImuProcess(x, randomImu(rng), 0.003, AccelModel::kFull);
+    // WHEN accumulating in block form and densely
+    phi.accumulate(s.J);
+    dense = s.F() * dense;
+    x = s.next;
+  }
+  // THEN both agree, and Φ M equals the block left-multiplication
+  EXPECT_LT((phi.dense() - dense).cwiseAbs().maxCoeff(), 1e-12);
+  const ErrMat M = ErrMat::Random();
+  EXPECT_LT((phi.leftMultiply(M) - dense * M).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+TEST(So3, ExpLogRoundTripAndRightJacobian) {
+  const Vec3 phi(0.3, -0.2, 0.5);
+  EXPECT_LT((logQuat(expQuat(phi)) - phi).norm(), 1e-12);
+  // Exp(φ + δ) ≈ Exp(φ) Exp(J_r δ)
+  const auto f = [&](const VecX& d) -> VecX {
+    return logQuat(expQuat(phi).conjugate() * expQuat(phi + Vec3(d)));
+  };
+  const MatX J_num = test::numericalJacobian(f, VecX::Zero(3), 1e-6);
+  EXPECT_LT((rightJacobianSo3(phi) - J_num).cwiseAbs().maxCoeff(), 1e-7);
+}
+
+}  // namespace
+}  // namespace uwb
