@@ -6,7 +6,7 @@
  *
  *  Fast path (header-only template on the state dimension N, e.g. N = 15): no heap allocation, no n×n inverse.
  *  The message on δx has rank one (W = aᵀ a / s), so the equality node is used in its Kalman-gain form
- *  (Table 4; G10 with a scalar Y) and the covariance in Joseph form, written in O(N²) for a rank-one update:
+ *  (Table 4; G10 with a scalar Y); the Joseph-form covariance reduces, for the optimal rank-one gain, to O(N²):
  *    u = V aᵀ,  S = a u + s,  K = u / S,
  *    m⁺ = m + K (y − a m),
  *    V⁺ = (I − K a) V (I − K a)ᵀ + K s Kᵀ = V − K uᵀ − u Kᵀ + S K Kᵀ = V − w wᵀ,  w = u/√S   (G18).
