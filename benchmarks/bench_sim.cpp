@@ -48,7 +48,7 @@ void BM_BiasSample(benchmark::State& state) {
   const uwb::Quat q(Eigen::AngleAxisd(0.3, uwb::Vec3::UnitZ()));
   uwb::Vec3 p(0.2, 0.1, 1.5);
   for (auto _ : state) {
-    benchmark::DoNotOptimize(model.sample(2, 3, p, q, 1.5, rng));
+    benchmark::DoNotOptimize(model.sample(1.0, 2, 3, p, q, 1.5, rng));
     p.x() += 1e-4;
   }
 }

@@ -45,6 +45,17 @@ std::vector<double> drawPattern(int degree, double rms_m, std::mt19937_64& rng) 
   return k;
 }
 
+/// splitmix64: a stateless 64-bit mix, so bursts are a pure function of (anchor key, time bin).
+std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+/// Uniform in (0, 1) from 53 bits of a hash.
+double unitFromHash(std::uint64_t h) { return (static_cast<double>(h >> 11) + 0.5) * 0x1.0p-53; }
+
 double evalPattern(const std::vector<double>& k, const std::array<double, 16>& Y) {
   double v = 0.0;
   for (std::size_t i = 1; i < 16; ++i) v += k[i] * Y[i];
@@ -74,6 +85,10 @@ void BiasParams::validate() const {
   require(finiteNonNegative(outlier_scale_m), "outlier_scale_m must be >= 0");
   require(std::isfinite(outlier_dof) && outlier_dof > 0.0, "outlier_dof must be positive");
   require(std::isfinite(outlier_max_m) && outlier_max_m > 0.0, "outlier_max_m must be positive");
+  require(std::isfinite(burst_probability) && burst_probability >= 0.0 && burst_probability <= 0.5,
+          "burst_probability must be in [0, 0.5]");
+  require(std::isfinite(burst_length_s) && burst_length_s > 0.0, "burst_length_s must be positive");
+  require(finiteNonNegative(burst_scale_m), "burst_scale_m must be >= 0");
   require(std::isfinite(ground_low_anchor_z_m), "ground_low_anchor_z_m must be finite");
   require(std::isfinite(ground_low_min_m) && std::isfinite(ground_low_max_m) && ground_low_min_m <= ground_low_max_m,
           "ground_low_min_m <= ground_low_max_m required");
@@ -133,6 +148,8 @@ BiasModel::BiasModel(const BiasParams& params, const AnchorSurvey& survey, std::
     t.ground_m = anchor.w_p.z() < params_.ground_low_anchor_z_m
                      ? params_.ground_low_min_m + (params_.ground_low_max_m - params_.ground_low_min_m) * g
                      : params_.ground_high_abs_m * (2.0 * g - 1.0);
+    t.burst_key = rng();
+    t.burst_phase = uniform(rng);
     anchors_.push_back(std::move(t));
   }
 }
@@ -168,6 +185,19 @@ double BiasModel::multipathBias(int anchor_id, const Vec3& w_p_tag) const {
   return params_.multipath_std_m * std::sqrt(2.0 / static_cast<double>(t.mp_freq.size())) * sum;
 }
 
+double BiasModel::burstBias(int anchor_id, double t_s) const {
+  const AnchorTerms& t = terms(anchor_id);
+  if (params_.burst_probability == 0.0 || params_.burst_scale_m == 0.0) return 0.0;
+  // (S16b) time bin k = ⌊t / L + φ_i⌋; a burst with probability p_b; excess s_b |t₂| with the closed-form
+  // Student-t (ν = 2) quantile t₂ = (2u − 1) / √(2u(1 − u)).
+  const auto bin = static_cast<std::int64_t>(std::floor(t_s / params_.burst_length_s + t.burst_phase));
+  const std::uint64_t h1 = splitmix64(t.burst_key ^ static_cast<std::uint64_t>(bin));
+  if (unitFromHash(h1) >= params_.burst_probability) return 0.0;
+  const double u = unitFromHash(splitmix64(h1));
+  const double t2 = (2.0 * u - 1.0) / std::sqrt(2.0 * u * (1.0 - u));
+  return std::min(params_.burst_scale_m * std::abs(t2), params_.outlier_max_m);
+}
+
 double BiasModel::groundBias(int anchor_id) const { return terms(anchor_id).ground_m; }
 
 double BiasModel::groundWeight(double height_m) const {
@@ -175,7 +205,7 @@ double BiasModel::groundWeight(double height_m) const {
   return 1.0 - smoothstep3(height_m / params_.ground_blend_height_m);
 }
 
-TdoaErrorParts BiasModel::sample(int id_a, int id_b, const Vec3& w_p_tag, const Quat& w_q_b, double height_m,
+TdoaErrorParts BiasModel::sample(double t_s, int id_a, int id_b, const Vec3& w_p_tag, const Quat& w_q_b, double height_m,
                                  std::mt19937_64& rng) const {
   TdoaErrorParts e;
   if (!params_.enabled) return e;
@@ -202,6 +232,7 @@ TdoaErrorParts BiasModel::sample(int id_a, int id_b, const Vec3& w_p_tag, const 
     const double magnitude = std::min(params_.outlier_scale_m * std::abs(t_draw), params_.outlier_max_m);
     e.outlier_m = u_sign < 0.5 ? magnitude : -magnitude;
   }
+  e.outlier_m += burstBias(id_b, t_s) - burstBias(id_a, t_s);  // (S16b) a delayed path lengthens that range
   if (params_.ground_effect) {
     const double w = groundWeight(height_m);
     if (w > 0.0) e.ground_m = w * (b.ground_m - a.ground_m + params_.ground_noise_std_m * n_ground);

@@ -132,7 +132,7 @@ SimResult simulateFlight(const Scenario& scenario, const SimParams& params, std:
       const Vec3 w_p_tag = tagPosition(s.w_p, s.w_q_b, params.b_t_tag);
       TdoaTruth truth;
       truth.tdoa_true_m = range(w_p_tag, anchor_b.w_p) - range(w_p_tag, anchor_a.w_p);  // (S20)
-      truth.error = bias.sample(anchor_a.id, anchor_b.id, w_p_tag, s.w_q_b, s.w_p.z() - ground_z, rng.tdoa_error);
+      truth.error = bias.sample(t, anchor_a.id, anchor_b.id, w_p_tag, s.w_q_b, s.w_p.z() - ground_z, rng.tdoa_error);
       truth.on_ground = s.on_ground;
       truth.airborne = s.w_p.z() >= 0.3;
       flight.tdoa.push_back({t, anchor_a.id, anchor_b.id, truth.tdoa_true_m + truth.error.total()});

@@ -57,6 +57,7 @@ TEST(BiasModel, PatternDependsOnlyOnTheBodyFrameDirection) {
   p.multipath_std_m = 0.0;
   p.noise_std_m = 0.0;
   p.outlier_probability = 0.0;
+  p.burst_probability = 0.0;
   p.ground_effect = false;
   std::mt19937_64 rng(5);
   const AnchorSurvey survey = paperAnchors();
@@ -80,7 +81,7 @@ TEST(BiasModel, PatternDependsOnlyOnTheBodyFrameDirection) {
   EXPECT_GT(std::abs(model.patternBias(4, v1) - model.patternBias(4, v2)), 1e-4);
   // AND the TDoA error is β_B − β_A (S17)
   std::mt19937_64 noise(1);
-  const TdoaErrorParts e = model.sample(3, 4, p1, q1, 1.4, noise);
+  const TdoaErrorParts e = model.sample(1.0, 3, 4, p1, q1, 1.4, noise);
   EXPECT_NEAR(e.total(), model.patternBias(4, v1) - model.patternBias(3, u1), 1e-6);  // tag lever arm excluded
 }
 

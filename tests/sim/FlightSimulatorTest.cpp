@@ -120,10 +120,12 @@ TEST(FlightSimulator, MeasurementIsTruthPlusTheRecordedErrorParts) {
   }
 }
 
-TEST(FlightSimulator, OutliersAreRareHeavyTailedAndOfBothSigns) {
-  // GIVEN a ten-minute flight
-  const SimResult r = defaultFlight(TrajectoryShape::kZigzag, 600.0, 8);
-  const BiasParams bp;
+TEST(FlightSimulator, OutlierSpikesAreRareHeavyTailedAndOfBothSigns) {
+  // GIVEN a ten-minute flight with spikes only (bursts off)
+  SimParams params;
+  params.bias.burst_probability = 0.0;
+  const SimResult r = simulateFlight(makeScenario(paperAnchors(), TrajectoryShape::kZigzag, 600.0), params, 8);
+  const BiasParams& bp = params.bias;
   std::size_t n = 0, positive = 0, beyond_1m = 0;
   for (const TdoaTruth& t : r.tdoa_truth) {
     if (t.error.outlier_m == 0.0) continue;
@@ -133,10 +135,35 @@ TEST(FlightSimulator, OutliersAreRareHeavyTailedAndOfBothSigns) {
     EXPECT_LE(std::abs(t.error.outlier_m), bp.outlier_max_m);
   }
   const double fraction = static_cast<double>(n) / static_cast<double>(r.tdoa_truth.size());
-  // THEN about outlier_probability of the measurements are outliers, half of each sign, some beyond 1 m
+  // THEN about outlier_probability of the measurements are spikes, half of each sign, some beyond 1 m
   EXPECT_NEAR(fraction, bp.outlier_probability, 0.15 * bp.outlier_probability);
-  EXPECT_NEAR(static_cast<double>(positive) / static_cast<double>(n), 0.5, 0.05);
+  EXPECT_NEAR(static_cast<double>(positive) / static_cast<double>(n), 0.5, 0.06);
   EXPECT_GT(beyond_1m, n / 20);
+}
+
+TEST(FlightSimulator, NlosBurstsLastOneBinAndHitTheConfiguredFraction) {
+  // GIVEN the bias model of a flight
+  const BiasParams bp;
+  std::mt19937_64 rng(12);
+  const BiasModel model(bp, paperAnchors(), rng);
+  // WHEN we sample anchor 2's burst excess over many time bins
+  std::size_t bins_in_burst = 0;
+  const std::size_t n_bins = 20000;
+  for (std::size_t k = 0; k < n_bins; ++k) {
+    const double t = (static_cast<double>(k) + 0.5) * bp.burst_length_s;
+    const double b = model.burstBias(2, t);
+    // THEN it is a non-negative range excess, constant for a while (bursts, not spikes)
+    EXPECT_GE(b, 0.0);
+    EXPECT_LE(b, bp.outlier_max_m);
+    if (b > 0.0) {
+      ++bins_in_burst;
+      const double nearby = model.burstBias(2, t + 0.02);
+      const double other_side = model.burstBias(2, t - 0.02);
+      EXPECT_TRUE(nearby == b || other_side == b);
+    }
+  }
+  // AND the anchor is in a burst in about burst_probability of the bins
+  EXPECT_NEAR(static_cast<double>(bins_in_burst) / n_bins, bp.burst_probability, 0.2 * bp.burst_probability);
 }
 
 TEST(FlightSimulator, GroundPhaseOffsetsAreSteadyPerPairAndUpToFourMetres) {
@@ -178,14 +205,15 @@ TEST_P(AirborneResiduals, ResembleTheRealFlights) {
   const ResidualStats s = residualStats(r.flight, r.survey, Phase::kAirborne);
   // THEN they fall in the documented ranges of the util-pilot flights (docs/math/simulation.md, Calibration)
   EXPECT_LT(std::abs(s.median_m), 0.03);
-  EXPECT_GT(s.mean_abs_dev_m, 0.11);
-  EXPECT_LT(s.mean_abs_dev_m, 0.24);
-  for (const auto& [pair, ps] : s.pairs) EXPECT_LT(std::abs(ps.median_m), 0.16) << pair.first << "-" << pair.second;
+  EXPECT_GT(s.mean_abs_dev_m, 0.13);
+  EXPECT_LT(s.mean_abs_dev_m, 0.27);
+  for (const auto& [pair, ps] : s.pairs) EXPECT_LT(std::abs(ps.median_m), 0.25) << pair.first << "-" << pair.second;
   ASSERT_EQ(s.autocorrelation.size(), 4u);
   EXPECT_GT(s.autocorrelation[0].second, 0.45);  // 0.1 s
   EXPECT_LT(s.autocorrelation[0].second, 0.8);
   EXPECT_LT(s.autocorrelation[2].second, 0.4);   // 1 s
-  EXPECT_LT(s.outlier_fraction, 0.005);
+  EXPECT_GT(s.outlier_fraction, 0.001);  // real: 0.26–2.8 % beyond 1 m
+  EXPECT_LT(s.outlier_fraction, 0.03);
 }
 
 INSTANTIATE_TEST_SUITE_P(ShapesAndSeeds, AirborneResiduals,
@@ -210,8 +238,9 @@ TEST(FlightSimulator, MostOfTheBiasVarianceIsAFunctionOfBodyFrameDirections) {
   }
   // THEN the learnable part (body-frame directions) is substantial, and so is the part that is not
   const double share = pattern / total;
-  EXPECT_GT(share, 0.2);
-  EXPECT_LT(share, 0.7);
+  // (SOURCE.md: body-frame models explain about 25 % of the real error variance across flights)
+  EXPECT_GT(share, 0.12) << share;
+  EXPECT_LT(share, 0.6) << share;
   EXPECT_GT(rest / total, 0.25);
 }
 

@@ -8,7 +8,8 @@
  *  fine-scale multipath field m_i over the tag position (random Fourier features; repeatable in space but not a
  *  function of the body-frame direction, so the paper's GP cannot learn it). TDoA error:
  *    e = β_B − β_A + ν + o + g_B − g_A                                                   (S17)
- *  with white noise ν, rare heavy-tailed outliers o and the ground-phase offsets g. docs/math/simulation.md.
+ *  with white noise ν, rare heavy-tailed outliers o (single spikes and per-anchor NLOS bursts) and the ground-phase
+ *  offsets g. docs/math/simulation.md.
  */
 #pragma once
 
@@ -28,9 +29,9 @@ namespace uwb::sim {
 struct BiasParams {
   bool enabled = true;                    ///< false: noise-free TDoA (every term below off)
   // learnable part: depends on the body-frame anchor direction only (the paper's GP inputs)
-  double antenna_rms_m = 0.06;            ///< RMS over the sphere of the common tag pattern h_tag (S13)
+  double antenna_rms_m = 0.07;            ///< RMS over the sphere of the common tag pattern h_tag (S13)
   int antenna_degree = 3;                 ///< highest spherical-harmonic degree, 1..3
-  double anchor_pattern_rms_m = 0.025;     ///< RMS of each anchor's own pattern h_i (S13)
+  double anchor_pattern_rms_m = 0.03;     ///< RMS of each anchor's own pattern h_i (S13)
   double anchor_offset_std_m = 0.02;      ///< per-anchor constant offset c_i ~ N(0, σ²)
   double nlos_bias_m = 0.05;              ///< body occlusion bias at full shadow (S14)
   double nlos_elevation_rad = -0.09;      ///< shadow starts below this body-frame elevation (≈ −5°)
@@ -38,14 +39,19 @@ struct BiasParams {
   double nlos_azimuth_gain = 0.5;         ///< relative extra shadow toward nlos_azimuth_rad (battery)
   double nlos_azimuth_rad = kPi;          ///< body-frame azimuth of the battery bulge (behind)
   // not learnable from body-frame directions
-  double multipath_std_m = 0.09;          ///< std of each anchor's spatial multipath field m_i (S15)
+  double multipath_std_m = 0.11;          ///< std of each anchor's spatial multipath field m_i (S15)
   double multipath_length_m = 0.3;       ///< its correlation length
   int multipath_features = 32;            ///< random Fourier features per anchor
-  double noise_std_m = 0.08;              ///< white TDoA noise ν
-  double outlier_probability = 0.01;     ///< probability of an outlier per measurement
-  double outlier_scale_m = 0.4;           ///< outlier = ± scale · |t_ν| (sign: which anchor is delayed) (S16)
+  double noise_std_m = 0.09;              ///< white TDoA noise ν
+  double outlier_probability = 0.005;     ///< probability of an independent outlier spike per measurement
+  double outlier_scale_m = 0.5;           ///< outlier = ± scale · |t_ν| (sign: which anchor is delayed) (S16)
   double outlier_dof = 2.0;               ///< Student-t degrees of freedom ν
-  double outlier_max_m = 3.0;            ///< outliers are clipped to this magnitude
+  double outlier_max_m = 4.0;            ///< outliers (spikes and bursts) are clipped to this magnitude
+  // NLOS bursts (S16b): an anchor's first path is blocked for a while, so its range is too long for a stretch of
+  // consecutive measurements (real outliers come in bursts; independent spikes would destroy the autocorrelation)
+  double burst_probability = 0.015;        ///< probability that an anchor is in a burst in a given time bin
+  double burst_length_s = 0.4;            ///< time bin (burst) length [s]
+  double burst_scale_m = 0.4;             ///< burst range excess = scale · |t₂| (Student-t, ν = 2), clipped
   // ground phase (SOURCE.md Caveats: each pair off by a steady amount up to ±3.9 m while on the ground)
   bool ground_effect = true;
   double ground_low_anchor_z_m = 1.0;     ///< anchors below this height count as "low"
@@ -64,7 +70,7 @@ struct TdoaErrorParts {
   double pattern_m = 0.0;    ///< (c + h_tag + h_i + n)_B − (…)_A: a function of the body-frame directions
   double multipath_m = 0.0;  ///< m_B − m_A
   double noise_m = 0.0;      ///< ν
-  double outlier_m = 0.0;    ///< o (0 unless an outlier)
+  double outlier_m = 0.0;    ///< o: spike + (burst_B − burst_A); 0 unless an outlier
   double ground_m = 0.0;     ///< ground-phase offset (0 when airborne)
   double total() const { return pattern_m + multipath_m + noise_m + outlier_m + ground_m; }
 };
@@ -82,11 +88,14 @@ class BiasModel {
   double multipathBias(int anchor_id, const Vec3& w_p_tag) const;
   /// Ground range bias g_i (before the height blend).
   double groundBias(int anchor_id) const;
+  /// NLOS burst range excess of anchor id at time t_s (≥ 0; 0 outside a burst) (S16b). Deterministic in t.
+  double burstBias(int anchor_id, double t_s) const;
   /// Height blend weight w(h) ∈ [0, 1] of the ground offset, h = height above the ground (S18).
   double groundWeight(double height_m) const;
 
-  /// The full error of one TDoA measurement between anchors a and b (S17). Draws noise/outliers from rng.
-  TdoaErrorParts sample(int id_a, int id_b, const Vec3& w_p_tag, const Quat& w_q_b, double height_m,
+  /// The full error of one TDoA measurement at time t_s between anchors a and b (S17). Draws noise and spikes
+  /// from rng; bursts are a deterministic function of (anchor, t_s).
+  TdoaErrorParts sample(double t_s, int id_a, int id_b, const Vec3& w_p_tag, const Quat& w_q_b, double height_m,
                         std::mt19937_64& rng) const;
 
   const BiasParams& params() const { return params_; }
@@ -100,6 +109,8 @@ class BiasModel {
     std::vector<Vec3> mp_freq;           ///< multipath wave vectors [rad/m]
     std::vector<double> mp_phase;
     double ground_m = 0.0;
+    std::uint64_t burst_key = 0;  ///< hash key of this anchor's burst sequence
+    double burst_phase = 0.0;     ///< offset of its time bins, in bins
   };
   const AnchorTerms& terms(int id) const;
 
