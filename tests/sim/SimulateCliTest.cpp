@@ -1,0 +1,92 @@
+/** @file SimulateCliTest.cpp
+ *  @brief `uwbtdoa simulate` end to end: one JSON object on stdout, files written, errors exit non-zero.
+ */
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "support/TestSupport.h"
+#include "uwb/io/UtilCsv.h"
+
+namespace {
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out;
+};
+
+RunResult run(const std::string& args) {
+  RunResult r;
+  const std::string cmd = uwb::test::cliPath() + " " + args + " 2>/dev/null";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (pipe == nullptr) return r;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), static_cast<int>(buf.size()), pipe) != nullptr) r.out += buf.data();
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+class SimulateCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!std::filesystem::exists(uwb::test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << uwb::test::cliPath();
+    dir_ = std::filesystem::temp_directory_path() / ("uwb_sim_cli_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::filesystem::path dir_;
+};
+
+TEST_F(SimulateCli, JsonModePrintsOneObjectAndWritesReadableFiles) {
+  // GIVEN a short figure-eight simulation with --json
+  const std::string flight = (dir_ / "f.csv").string();
+  const std::string survey = (dir_ / "s.txt").string();
+  const RunResult r = run("simulate --trajectory figure8 --duration 30 --seed 5 --json --out " + flight +
+                          " --survey-out " + survey);
+  // THEN it succeeds with exactly one JSON object on stdout
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.is_object());
+  EXPECT_EQ(j.at("trajectory"), "figure8");
+  EXPECT_GT(j.at("streams").at("tdoa").at("count").get<int>(), 10000);
+  EXPECT_LT(std::abs(j.at("residual_airborne").at("median_m").get<double>()), 0.05);
+  // AND the written flight and survey read back
+  const uwb::Flight f = uwb::readFlightCsv(flight);
+  EXPECT_EQ(f.tdoa.size(), j.at("streams").at("tdoa").at("count").get<std::size_t>());
+  EXPECT_EQ(uwb::readAnchorSurvey(survey).anchors.size(), 8u);
+}
+
+TEST_F(SimulateCli, ConfigOverridesParametersAndRejectsUnknownKeys) {
+  // GIVEN a config that switches the bias off, and one with a typo
+  const auto good = dir_ / "good.json";
+  const auto bad = dir_ / "bad.json";
+  std::ofstream(good) << R"({"bias": {"enabled": false}, "trajectory": {"radius_m": 1.0}})";
+  std::ofstream(bad) << R"({"bias": {"noise_sdt_m": 0.1}})";
+  const std::string outs = " --out " + (dir_ / "f.csv").string() + " --survey-out " + (dir_ / "s.txt").string();
+  // WHEN we run with each
+  const RunResult ok = run("simulate --duration 30 --json --config " + good.string() + outs);
+  const RunResult err = run("simulate --duration 30 --json --config " + bad.string() + outs);
+  // THEN the first gives noise-free residuals (up to the 1 mm pose rounding), the second fails
+  ASSERT_EQ(ok.exit_code, 0) << ok.out;
+  EXPECT_LT(nlohmann::json::parse(ok.out).at("residual_airborne").at("mean_abs_dev_m").get<double>(), 0.005);
+  EXPECT_NE(err.exit_code, 0);
+}
+
+TEST_F(SimulateCli, BadArgumentsExitNonZero) {
+  const std::string outs = " --out " + (dir_ / "f.csv").string() + " --survey-out " + (dir_ / "s.txt").string();
+  EXPECT_NE(run("simulate --trajectory spiral" + outs).exit_code, 0);
+  EXPECT_NE(run("simulate --duration 5" + outs).exit_code, 0);  // shorter than the ground and ramp phases
+  EXPECT_NE(run("simulate --anchors-preset nowhere" + outs).exit_code, 0);
+  EXPECT_NE(run("simulate --anchors-file /nonexistent/survey.txt" + outs).exit_code, 0);
+}
+
+}  // namespace
