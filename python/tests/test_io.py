@@ -134,3 +134,10 @@ def test_trajectory_csv_round_trip(tmp_path):
         np.testing.assert_allclose(back[key], traj[key], rtol=1e-6, atol=1e-6, err_msg=key)
     with pytest.raises(ValueError, match=r"trajectory\['p'\]"):
         u.write_trajectory_csv({"t": np.zeros(3), "p": np.zeros((2, 3))}, str(path))
+
+
+def test_malformed_survey_raises_value_error_naming_the_file(tmp_path):
+    path = tmp_path / "survey.txt"
+    path.write_text("an0_p,1.0,2.0,oops\n")
+    with pytest.raises(ValueError, match=r"survey\.txt:1"):
+        u.read_anchor_survey(str(path))
