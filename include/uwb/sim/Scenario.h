@@ -3,7 +3,8 @@
  *
  *  Presets: `paper` (8 anchors near the corners of a 7 × 8 × 3 m room, alternating low and high as in the UTIL
  *  arena) and `util-const1` … `util-const4` (the released UTIL constellations, read from
- *  <data_dir>/real/util-final-extract/survey/anchor_const{N}_survey.txt). The library reads no environment
+ *  <data_dir>/real/util-final-extract/survey/anchor_const{N}_survey.txt), and `util-pilot-0425` / `util-pilot-0426`
+ *  (<data_dir>/real/util-pilot/survey/anchor_{session}_survey.txt). The library reads no environment
  *  variables: the caller passes the data directory (the CLI uses uwb::app::defaultDataDir()).
  */
 #pragma once
