@@ -35,6 +35,8 @@ constexpr double kMlatMaxWindow_s = 3.0;
 constexpr double kStillAccStd_mps2 = 0.12;
 constexpr double kStillGyro_radps = 0.03;
 constexpr double kStillTau_s = 0.1;
+/// Touchdown: high-passed gyro rms above this [rad/s] (≈40 °/s; flight vibration is 3–10 °/s) (F18).
+constexpr double kTouchdownGyro_radps = 0.45;
 
 }  // namespace
 
@@ -107,7 +109,8 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
   double g_ref = kGravity_mps2;
   double v_det = 0.0;
   double t_last_imu = std::numeric_limits<double>::quiet_NaN();
-  double acc_mean = kGravity_mps2, acc_var = 1.0, gyro_ms = 1.0;
+  double acc_mean = kGravity_mps2, acc_var = 1.0, gyro_ms = 1.0, gyro_hp_ms = 0.0;
+  Vec3 gyro_mean = Vec3::Zero();
   double z_takeoff = p.ground_z_m;
   double t_low_slow = std::numeric_limits<double>::quiet_NaN();
   struct PairOffset {
@@ -211,7 +214,8 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
         e.x.w_p_b = r->w_p0;
         e.sigma_p_m = Vec3::Constant(sigma);
       }
-    z_takeoff = r->w_p0.z();
+    // the take-off height for landing detection; TDoA near the floor is poor, so not above ground_z + 0.2 m
+    z_takeoff = std::min(r->w_p0.z(), p.ground_z_m + 0.2);
     t_acq_end = t + p.acquisition_s;
     mlat.clear();
     t_mlat_start = std::numeric_limits<double>::quiet_NaN();
@@ -274,6 +278,8 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
         acc_mean = a * acc_mean + (1 - a) * an;
         acc_var = a * acc_var + (1 - a) * (an - acc_mean) * (an - acc_mean);
         gyro_ms = a * gyro_ms + (1 - a) * imu.b_gyro_radps.squaredNorm();
+        gyro_mean = a * gyro_mean + (1 - a) * imu.b_gyro_radps;
+        gyro_hp_ms = a * gyro_hp_ms + (1 - a) * (imu.b_gyro_radps - gyro_mean).squaredNorm();
       }
       const bool still = std::sqrt(acc_var) < kStillAccStd_mps2 && std::sqrt(gyro_ms) < kStillGyro_radps;
       if (phase == FlightPhase::kGround || phase == FlightPhase::kLanded) {
@@ -283,7 +289,9 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
           v_det = std::exp(-dt_imu / kTakeoffLeak_s) * v_det + dt_imu * (a_up - g_ref);
           if (still || v_det < 0.05) g_ref += (dt_imu / 2.0) * (a_up - g_ref);
         }
-        if (v_det > p.takeoff_climb_mps && !still) {
+        // after a landing, a new take-off must climb twice as fast (touchdown bounces and spin-down are not flight)
+        const double climb = phase == FlightPhase::kLanded ? 4.0 * p.takeoff_climb_mps : p.takeoff_climb_mps;
+        if (v_det > climb && !still) {
           predictTo(t);
           propagate(true);
           takeoff(t);
@@ -303,7 +311,12 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
       if (phase == FlightPhase::kTracking && !std::isnan(sum.takeoff_t_s)) {
         const NavState& x = ekf.state();
         const bool low_slow = x.w_p_b.z() - z_takeoff < p.landing_height_m && x.w_v_b.norm() < 0.25;
-        if (still || low_slow) {
+        // touchdown: the vibration burst of ground contact near the take-off height (F18)
+        const bool touchdown = std::sqrt(gyro_hp_ms) > kTouchdownGyro_radps && x.w_p_b.z() - z_takeoff < 0.8;
+        if (touchdown) {
+          sum.landing_t_s = t;
+          enterGround(FlightPhase::kLanded);
+        } else if (still || low_slow) {
           if (std::isnan(t_low_slow)) t_low_slow = t;
           if (t - t_low_slow >= (still ? 0.3 : p.landing_hold_s)) {
             if (std::isnan(sum.landing_t_s) || sum.landing_t_s < sum.takeoff_t_s) sum.landing_t_s = t;
