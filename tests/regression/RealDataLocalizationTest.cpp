@@ -1,0 +1,64 @@
+/** @file RealDataLocalizationTest.cpp
+ *  @brief Change indication on real flights (STYLE §10): replays UTIL pilot flights through the default filter and
+ *         checks the airborne RMSE stays under committed bounds. Skips when the data is absent.
+ *
+ *  Bounds = the value at the time of commit (scripts/localize_all.sh) + margin; a PR that changes the filter
+ *  updates them deliberately. Reference (default params): 0425-traj2 0.234 m, 0426-traj11 0.275 m,
+ *  const4-trial1-tdoa2-traj2 (TDoA-only) 0.169 m.
+ */
+#include <gtest/gtest.h>
+
+#include "support/TestSupport.h"
+#include "uwb/eval/Localization.h"
+#include "uwb/io/UtilCsv.h"
+
+namespace uwb {
+namespace {
+
+LocalizationRun replay(const std::filesystem::path& flight, const std::filesystem::path& survey) {
+  const AnchorSurvey s = readAnchorSurvey(survey.string());
+  const Flight f = readFlightCsv(flight.string());
+  return localizeFlight(f, s);
+}
+
+TEST(RealDataLocalization, Pilot0425Traj2AirborneRmseUnderBound) {
+  // GIVEN a real circle flight with ground phase and the 0425 accelerometer offset
+  const auto flight = test::pilotFlight("0425-traj2");
+  UWB_REQUIRE_REAL_DATA(flight);
+  // WHEN localizing with the defaults (no ground-truth start)
+  const LocalizationRun run = replay(*flight, test::pilotSurvey("0425"));
+  // THEN the airborne RMSE stays under the committed bound and nothing diverged
+  ASSERT_TRUE(run.metrics);
+  EXPECT_LT(run.metrics->airborne.rmse_m, 0.27);
+  EXPECT_LT(run.metrics->whole.rmse_m, 0.40);
+  EXPECT_LT(run.metrics->airborne.p99_m, 1.0);
+  EXPECT_GT(run.summary.n_tdoa_used, 10000u);
+  EXPECT_FALSE(std::isnan(run.summary.takeoff_t_s));
+}
+
+TEST(RealDataLocalization, Pilot0426Traj11WithObstaclesUnderBound) {
+  // GIVEN an obstacle (NLOS) flight
+  const auto flight = test::pilotFlight("0426-traj11");
+  UWB_REQUIRE_REAL_DATA(flight);
+  // WHEN localizing with the defaults
+  const LocalizationRun run = replay(*flight, test::pilotSurvey("0426"));
+  // THEN
+  ASSERT_TRUE(run.metrics);
+  EXPECT_LT(run.metrics->airborne.rmse_m, 0.32);
+}
+
+TEST(RealDataLocalization, FinalExtractTdoaOnlyUnderBound) {
+  // GIVEN a released UTIL flight without IMU
+  const std::filesystem::path dir = test::dataDir() / "real" / "util-final-extract";
+  const std::filesystem::path flight = dir / "const4-trial1-tdoa2-traj2.csv";
+  if (!std::filesystem::exists(flight)) GTEST_SKIP() << "real flight data not found under " << dir;
+  // WHEN localizing (the TDoA-only model is selected automatically)
+  const LocalizationRun run = replay(flight, dir / "survey" / "anchor_const4_survey.txt");
+  // THEN
+  ASSERT_TRUE(run.metrics);
+  EXPECT_EQ(run.summary.process_model, ProcessModel::kConstantVelocity);
+  EXPECT_LT(run.metrics->airborne.rmse_m, 0.20);
+}
+
+}  // namespace
+}  // namespace uwb
