@@ -98,6 +98,31 @@ void BM_SvgpPredictBatch(benchmark::State& state) {
 }
 BENCHMARK(BM_SvgpPredictBatch)->Arg(30)->Arg(170)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+/// Batch prediction of the latent mean only for 10,000 points.
+void BM_SvgpPredictMeanBatch(benchmark::State& state) {
+  const int M = static_cast<int>(state.range(0));
+  const Svgp gp = makeModel(M);
+  const SvgpPredictor pred = gp.predictor();
+  const MatX Xt = problem().X.topRows(10000);
+  for (auto _ : state) {
+    VecX mean = pred.predictMean(Xt);
+    benchmark::DoNotOptimize(mean.data());
+  }
+}
+BENCHMARK(BM_SvgpPredictMeanBatch)->Arg(30)->Arg(170)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// Reference point for the machine's speed at the moment: one 170×170 · 170×1024 GEMM (59 MFlop).
+void BM_EigenGemmCalibration(benchmark::State& state) {
+  const MatX W = MatX::Random(170, 170), K = MatX::Random(170, 1024);
+  MatX R(170, 1024);
+  for (auto _ : state) {
+    R.noalias() = W * K;
+    benchmark::DoNotOptimize(R.data());
+  }
+  state.counters["GFlops"] = benchmark::Counter(2.0 * 170 * 170 * 1024 * state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_EigenGemmCalibration)->Unit(benchmark::kMillisecond);
+
 /// Single-point prediction (what the filter calls once per TDoA measurement).
 void BM_SvgpPredictOne(benchmark::State& state) {
   const int M = static_cast<int>(state.range(0));

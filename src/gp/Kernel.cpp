@@ -300,13 +300,17 @@ MatX Kernel::cross(const MatX& X1, const MatX& X2, std::vector<MatX>* part_block
   if (X1.cols() < input_dim_ || X2.cols() < input_dim_)
     throw std::invalid_argument("kernel: inputs have " + std::to_string(std::min(X1.cols(), X2.cols())) +
                                 " columns, the kernel reads " + std::to_string(input_dim_));
-  MatX K = MatX::Zero(X1.rows(), X2.rows());
+  MatX K;
   if (part_blocks) part_blocks->assign(parts_.size(), MatX());
   for (const auto& term : terms_) {
     if (term.size() == 1 && !part_blocks) {
-      K += partCross(term[0], X1, X2);
+      if (K.size() == 0)
+        K = partCross(term[0], X1, X2);
+      else
+        K += partCross(term[0], X1, X2);
       continue;
     }
+    if (K.size() == 0) K = MatX::Zero(X1.rows(), X2.rows());
     MatX prod;
     for (std::size_t i = 0; i < term.size(); ++i) {
       MatX Kp = partCross(term[i], X1, X2);

@@ -146,7 +146,7 @@ ElboTerms Svgp::elbo(const MatX& X_raw, const VecX& y, double num_data, SvgpGrad
   const MatX Kzx = kernel_.cross(Z_, X, need_grad ? &zx_blocks : nullptr);
   const double kdiag = kernel_.diagValue();
   const MatX SmI = [&] {
-    MatX S = L_ * L_.transpose();
+    MatX S = L_.triangularView<Eigen::Lower>() * L_.transpose();
     S.diagonal().array() -= 1.0;
     return S;
   }();
@@ -216,14 +216,15 @@ ElboTerms Svgp::elbo(const MatX& X_raw, const VecX& y, double num_data, SvgpGrad
   g.m = beta * Ar - m_ / num_data;
   MatX Linv_diag = MatX::Zero(M, M);
   Linv_diag.diagonal() = L_.diagonal().cwiseInverse();
-  g.L = (-beta * (AAt * L_) - (L_ - Linv_diag) / num_data).triangularView<Eigen::Lower>();
+  const MatX AAtL = AAt * L_.triangularView<Eigen::Lower>();
+  g.L = (-beta * AAtL - (L_ - Linv_diag) / num_data).triangularView<Eigen::Lower>();
 
   // P17: ∂/∂Lz = tril(−K̄zx Aᵀ) = tril(−Lz⁻ᵀ Ā Aᵀ),  Ā Aᵀ = β (m (Ar)ᵀ − (S − I) A Aᵀ)
   MatX AbarAt = -beta * (SmI * AAt);
   AbarAt.noalias() += (beta * m_) * Ar.transpose();
   const MatX Lzbar = (-LzT.transpose().solve(AbarAt)).triangularView<Eigen::Lower>();
   // P18: Cholesky backward: K̄zz = ½ Lz⁻ᵀ (P + Pᵀ) Lz⁻¹, P = Φ(Lzᵀ L̄z)
-  const MatX P = phi(Lz.transpose() * Lzbar);
+  const MatX P = phi(Lz.transpose().triangularView<Eigen::Upper>() * Lzbar);
   const MatX Ps = P + P.transpose();
   MatX Kbar_zz = 0.5 * LzT.transpose().solve(LzT.transpose().solve(Ps).transpose());
   Kbar_zz = 0.5 * (Kbar_zz + Kbar_zz.transpose()).eval();
@@ -264,14 +265,38 @@ SvgpPredictor::SvgpPredictor(const Svgp& gp)
 SvgpPrediction SvgpPredictor::predict(const MatX& X_raw) const {
   MatX X = X_raw;
   if (shift_.size() > 0) X = ((X.rowwise() - shift_.transpose()).array().rowwise() / scale_.transpose().array()).matrix();
-  const MatX Kzt = kernel_.cross(Z_, X);
-  const MatX A = Lz_.triangularView<Eigen::Lower>().solve(Kzt);  // P13: a = Lz⁻¹ k_Z(x)
-  const MatX LtA = L_.transpose().triangularView<Eigen::Upper>() * A;
   SvgpPrediction p;
-  p.mean = (Kzt.transpose() * alpha_).array() + c_;  // c + aᵀm = c + k_Zᵀ Lz⁻ᵀ m
-  p.var_f = (LtA.colwise().squaredNorm() - A.colwise().squaredNorm()).transpose().array() + kdiag_ + jitter_;
+  const Eigen::Index N = X.rows();
+  p.mean.resize(N);
+  p.var_f.resize(N);
+  // Blocks of test points keep Kzt, A in cache and avoid huge temporaries.
+  constexpr Eigen::Index kBlock = 256;
+  for (Eigen::Index start = 0; start < N; start += kBlock) {
+    const Eigen::Index n = std::min(kBlock, N - start);
+    const MatX Kzt = kernel_.cross(Z_, X.middleRows(start, n));
+    const MatX A = Lz_.triangularView<Eigen::Lower>().solve(Kzt);  // P13: a = Lz⁻¹ k_Z(x)
+    const MatX LtA = L_.transpose().triangularView<Eigen::Upper>() * A;
+    p.mean.segment(start, n).noalias() = Kzt.transpose() * alpha_;  // aᵀm = k_Zᵀ Lz⁻ᵀ m
+    p.var_f.segment(start, n) = (LtA.colwise().squaredNorm() - A.colwise().squaredNorm()).transpose();
+  }
+  p.mean.array() += c_;
+  p.var_f.array() += kdiag_ + jitter_;
   p.var_y = p.var_f.array() + noise_;
   return p;
+}
+
+VecX SvgpPredictor::predictMean(const MatX& X_raw) const {
+  MatX X = X_raw;
+  if (shift_.size() > 0) X = ((X.rowwise() - shift_.transpose()).array().rowwise() / scale_.transpose().array()).matrix();
+  const Eigen::Index N = X.rows();
+  VecX mean(N);
+  constexpr Eigen::Index kBlock = 256;
+  for (Eigen::Index start = 0; start < N; start += kBlock) {
+    const Eigen::Index n = std::min(kBlock, N - start);
+    mean.segment(start, n).noalias() = kernel_.cross(Z_, X.middleRows(start, n)).transpose() * alpha_;
+  }
+  mean.array() += c_;
+  return mean;
 }
 
 void SvgpPredictor::predictOne(const Eigen::Ref<const RowVecX>& x_raw, double& mean, double& var_f) const {

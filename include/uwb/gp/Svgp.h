@@ -119,6 +119,8 @@ class SvgpPredictor {
   /// Latent mean and variance (var_f, with ε) at one raw input row; a few microseconds at M ≈ 170.
   void predictOne(const Eigen::Ref<const RowVecX>& x, double& mean, double& var_f) const;
   SvgpPrediction predict(const MatX& X) const;
+  /// Latent mean only (no variance): O(M) per point after the kernel row, for bulk corrections.
+  VecX predictMean(const MatX& X) const;
   double noiseVariance() const { return noise_; }
 
  private:
