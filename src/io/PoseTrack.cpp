@@ -97,19 +97,27 @@ PoseTrack::PoseTrack(const std::vector<PoseSample>& samples, bool has_orientatio
   std::vector<double> att_magnitude(n, 0.0);
   if (has_orientation) detectAttitudeGlitches(samples, params_, att_rejected, att_magnitude);
 
-  // Position spikes: farther from the neighbours' chord than the neighbours are from each other, and > threshold.
+  // Position spikes, among the samples with a valid attitude (a flipped Vicon solution also shifts the position
+  // by ~1.5 cm, so its samples must not serve as neighbours): farther from the neighbours' chord than the
+  // neighbours are from each other, and farther than max_position_jump_m.
+  std::vector<std::size_t> kept;
+  kept.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (att_rejected[i] == 0) kept.push_back(i);
+  }
   std::vector<char> pos_rejected(n, 0);
   std::vector<double> pos_magnitude(n, 0.0);
-  for (std::size_t i = 1; i + 1 < n; ++i) {
-    const PoseSample& a = samples[i - 1];
-    const PoseSample& b = samples[i + 1];
+  for (std::size_t k = 1; k + 1 < kept.size(); ++k) {
+    const PoseSample& a = samples[kept[k - 1]];
+    const PoseSample& b = samples[kept[k + 1]];
+    const PoseSample& c = samples[kept[k]];
     const double span_t = b.t_s - a.t_s;
-    const double u = span_t > 0.0 ? (samples[i].t_s - a.t_s) / span_t : 0.5;
+    const double u = span_t > 0.0 ? (c.t_s - a.t_s) / span_t : 0.5;
     const Vec3 chord = a.w_p_b + u * (b.w_p_b - a.w_p_b);
-    const double dev = (samples[i].w_p_b - chord).norm();
+    const double dev = (c.w_p_b - chord).norm();
     if (dev > params_.max_position_jump_m && dev > (b.w_p_b - a.w_p_b).norm()) {
-      pos_rejected[i] = 1;
-      pos_magnitude[i] = dev;
+      pos_rejected[kept[k]] = 1;
+      pos_magnitude[kept[k]] = dev;
     }
   }
 
