@@ -396,16 +396,16 @@ void Kernel::partGradient(int pi, const MatX& X1, const MatX& X2, const MatX& H,
         const Eigen::ArrayXXd r = R2.array().sqrt() * kSqrt5;
         Wg = H.array() * ((5.0 / 3.0) * s2 * (1.0 + r) * (-r).exp());
       }
+      Eigen::ArrayXd gx(A.rows()), delta(A.rows());  // buffers reused for every column (no per-column allocation)
       for (Eigen::Index d = 0; d < nd; ++d) {
         const Eigen::Index li = p.offset + 1 + (p.n_l == 1 ? 0 : d);
         const double l = theta_[li];
         double acc = 0.0;
-        Eigen::ArrayXd gx = Eigen::ArrayXd::Zero(A.rows());
+        gx.setZero();
         for (Eigen::Index j = 0; j < n2; ++j) {
-          const Eigen::ArrayXd delta = A.col(d).array() - B(j, d);
-          const Eigen::ArrayXd wd = Wg.col(j).array() * delta;
-          gx += wd;
-          acc += (wd * delta).sum();
+          delta = A.col(d).array() - B(j, d);
+          gx += Wg.col(j).array() * delta;
+          acc += (Wg.col(j).array() * delta.square()).sum();
         }
         grad_theta[li] += acc / (l * l * l);
         if (grad_X1) grad_X1->col(p.active_dims[d]) -= (gx / (l * l)).matrix();
@@ -414,18 +414,18 @@ void Kernel::partGradient(int pi, const MatX& X1, const MatX& X2, const MatX& H,
     }
     case PartType::kPeriodic: {
       // P7: u = πΔ/T; ∂k/∂l = 4k sin²u / l³; ∂k/∂T = k (2/l²) sin 2u · πΔ/T²; ∂k/∂x = −k (2/l²) sin 2u · π/T
+      Eigen::ArrayXd gx(A.rows()), delta(A.rows()), su(A.rows()), ws2(A.rows());
       for (Eigen::Index d = 0; d < nd; ++d) {
         const Eigen::Index li = p.offset + 1 + (p.n_l == 1 ? 0 : d);
         const Eigen::Index ti = p.offset + 1 + p.n_l + (p.n_T == 1 ? 0 : d);
         const double l = theta_[li], T = theta_[ti], c = kPi / T;
         double acc_l = 0.0, acc_T = 0.0;
-        Eigen::ArrayXd gx = Eigen::ArrayXd::Zero(A.rows());
+        gx.setZero();
         for (Eigen::Index j = 0; j < n2; ++j) {
-          const Eigen::ArrayXd delta = A.col(d).array() - B(j, d);
-          const Eigen::ArrayXd u = c * delta;
-          const Eigen::ArrayXd w = W.col(j).array();
-          acc_l += (w * u.sin().square()).sum();
-          const Eigen::ArrayXd ws2 = w * (2.0 * u).sin();
+          delta = A.col(d).array() - B(j, d);
+          su = (c * delta).sin();
+          acc_l += (W.col(j).array() * su.square()).sum();
+          ws2 = W.col(j).array() * 2.0 * su * (c * delta).cos();  // w sin 2u
           acc_T += (ws2 * delta).sum();
           gx += ws2;
         }
