@@ -42,6 +42,21 @@ void BM_ReadFlightCsv(benchmark::State& state) {
 }
 BENCHMARK(BM_ReadFlightCsv)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
+void BM_ParseFlightCsvInMemory(benchmark::State& state) {
+  const std::string path = benchFlight();
+  if (!std::filesystem::exists(path)) {
+    state.SkipWithError(("real flight absent: " + path).c_str());
+    return;
+  }
+  const std::string text = uwb::formatFlightCsv(uwb::readFlightCsv(path));  // same values, shortest form
+  for (auto _ : state) {
+    uwb::Flight f = uwb::parseFlightCsv(text, path);
+    benchmark::DoNotOptimize(f.tdoa.data());
+  }
+  state.SetBytesProcessed(static_cast<int64_t>(state.iterations() * text.size()));
+}
+BENCHMARK(BM_ParseFlightCsvInMemory)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+
 void BM_FormatFlightCsv(benchmark::State& state) {
   const std::string path = benchFlight();
   if (!std::filesystem::exists(path)) {
