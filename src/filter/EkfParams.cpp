@@ -42,6 +42,7 @@ void EkfParams::validate() const {
   requireNonNegative(pair_bias_tau_s, "pair_bias_tau_s");
   requirePositive(max_predict_dt_s, "max_predict_dt_s");
   requireNonNegative(cov_period_s, "cov_period_s");
+  requireNonNegative(update_predict_dt_s, "update_predict_dt_s");
   requirePositive(max_gap_s, "max_gap_s");
   requirePositive(takeoff_climb_mps, "takeoff_climb_mps");
   requirePositive(takeoff_acc_mps2, "takeoff_acc_mps2");

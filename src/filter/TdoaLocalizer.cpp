@@ -111,6 +111,7 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
   double t_last_imu = std::numeric_limits<double>::quiet_NaN();
   double acc_mean = kGravity_mps2, acc_var = 1.0, gyro_ms = 1.0, gyro_hp_ms = 0.0;
   Vec3 gyro_mean = Vec3::Zero();
+  double last_dt_imu = -1.0, ema_factor = 0.0;
   double z_takeoff = p.ground_z_m;
   double t_low_slow = std::numeric_limits<double>::quiet_NaN();
   struct PairOffset {
@@ -273,7 +274,11 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
       ++n_imu_acc;
       // stillness statistics (F18)
       if (dt_imu > 0.0) {
-        const double a = std::exp(-dt_imu / kStillTau_s);
+        if (dt_imu != last_dt_imu) {  // the IMU period is nearly constant: cache the EMA factor
+          last_dt_imu = dt_imu;
+          ema_factor = std::exp(-dt_imu / kStillTau_s);
+        }
+        const double a = ema_factor;
         const double an = imu.b_acc_mps2.norm();
         acc_mean = a * acc_mean + (1 - a) * an;
         acc_var = a * acc_var + (1 - a) * (an - acc_mean) * (an - acc_mean);
@@ -340,7 +345,9 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
       }
       initialize(t, Vec3(0, 0, kGravity_mps2), Vec3::Zero());
     }
-    predictTo(t);
+    // (F17) the nominal state is brought to the measurement time only when it lags by more than
+    // update_predict_dt_s (Crazyflie-style: updates between predictions use the last predicted state)
+    if (!imu_mode || t - t_pred >= p.update_predict_dt_s) predictTo(t);
     if (phase == FlightPhase::kGround || phase == FlightPhase::kLanded) {
       ++sum.n_tdoa_ground;
       emit(t);

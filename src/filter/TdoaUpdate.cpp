@@ -78,7 +78,17 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
     return res;
   }
   // (F11) χ² gate on the unweighted innovation
-  const InnovationStats st = ekf.innovation(*msg);
+  // The message row a = B12 C is non-zero only in the position and attitude blocks, so a P aᵀ needs only the
+  // 6×6 sub-block of P (F11; the same value as innovationOf, G17, at a sixth of the cost).
+  const ErrMat& P = ekf.covariance();
+  Eigen::Matrix<double, 6, 1> a6;
+  a6 << msg->a.segment<3>(kPos).transpose(), msg->a.segment<3>(kAtt).transpose();
+  Eigen::Matrix<double, 6, 6> P6;
+  P6 << P.block<3, 3>(kPos, kPos), P.block<3, 3>(kPos, kAtt), P.block<3, 3>(kAtt, kPos), P.block<3, 3>(kAtt, kAtt);
+  InnovationStats st;
+  st.innovation_m = msg->y;  // prior error state is zero
+  st.innovation_var_m2 = a6.dot(P6 * a6) + msg->var;
+  st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
   res.innovation_m = st.innovation_m;
   res.nis = st.nis;
   if (options.gate_sigma > 0.0 && !OutlierGate(options.gate_sigma).accept(st.nis)) {

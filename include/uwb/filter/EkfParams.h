@@ -66,8 +66,9 @@ struct EkfParams {
   double max_lost_s = 1.0;               ///< all TDoA rejected this long → re-acquire (inflate P, open gate)
 
   // --- scheduling ---
-  double max_predict_dt_s = 0.005;       ///< IMU samples are averaged over at most this interval [s]
-  double cov_period_s = 0.01;            ///< covariance propagated with the accumulated Φ at this period [s]
+  double max_predict_dt_s = 0.01;        ///< IMU samples are averaged over at most this interval [s]
+  double update_predict_dt_s = 0.005;    ///< a TDoA update first predicts to its stamp if the state lags more [s]
+  double cov_period_s = 0.02;            ///< covariance propagated with the accumulated Φ at this period [s]
   double max_gap_s = 0.2;                ///< a sensor gap longer than this is reported [s]
 
   // --- ground phase and start ---

@@ -1,0 +1,133 @@
+/** @file bench_filter.cpp
+ *  @brief Cost of one IMU prediction, one covariance propagation, one TDoA update (graph node), and a whole flight
+ *         (real-time factor). Run: build/bench_filter --benchmark_repetitions=5 --benchmark_report_aggregates_only.
+ *         The flight benchmark uses 0425-traj2 when the data is present, else a synthetic 40 s flight with 1 kHz IMU
+ *         and 400 Hz TDoA. The counter `rtf` = flight duration / wall time.
+ */
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <random>
+
+#include "uwb/eval/Localization.h"
+#include "uwb/filter/TdoaLocalizer.h"
+#include "uwb/io/UtilCsv.h"
+#include "uwb/model/TdoaModel.h"
+
+namespace uwb {
+namespace {
+
+AnchorTable benchAnchors() {
+  AnchorTable t;
+  const Vec3 c[8] = {{-3, -4, 0.2}, {-3, 4, 3}, {3.5, 4, 0.2}, {4, -4, 3}, {-3, -4.2, 3}, {4, -3.8, 0.2}, {4, 4, 3},
+                     {-3, 3.5, 0.2}};
+  for (int i = 0; i < 8; ++i) t.set(i, c[i]);
+  return t;
+}
+
+/// Synthetic circle flight (r = 1.5 m, ω = 0.6 rad/s, z = 1.5 m): 1 kHz IMU, 400 Hz TDoA on neighbour pairs.
+SensorLog syntheticFlight(const AnchorTable& anchors, double duration_s) {
+  std::mt19937 rng(1);
+  std::normal_distribution<double> n(0.0, 1.0);
+  SensorLog log;
+  const double w = 0.6, r = 1.5;
+  for (double t = 0.0; t <= duration_s; t += 0.001) {
+    TimedImu s;
+    s.t_s = t;
+    const Vec3 a(-r * w * w * std::cos(w * t), -r * w * w * std::sin(w * t), 0.0);
+    s.imu.b_acc_mps2 = a + Vec3(0, 0, kGravity_mps2) + 0.5 * Vec3(n(rng), n(rng), n(rng));
+    s.imu.b_gyro_radps = 0.08 * Vec3(n(rng), n(rng), n(rng));
+    log.imu.push_back(s);
+  }
+  int k = 0;
+  for (double t = 0.0; t <= duration_s; t += 0.0025, ++k) {
+    const int ia = k % 8, ib = (k + 1) % 8;
+    const Vec3 p(r * std::cos(w * t), r * std::sin(w * t), 1.5);
+    const Vec3 tag = tagPosition(p, Quat::Identity(), kUtilTagOffset_b);
+    log.tdoa.push_back({t, ia, ib, range(tag, anchors.find(ib)->m) - range(tag, anchors.find(ia)->m) + 0.1 * n(rng)});
+  }
+  return log;
+}
+
+void BM_ImuPrediction(benchmark::State& state) {
+  Ekf ekf(EkfParams{});
+  NavState x;
+  x.w_p_b = Vec3(0, 0, 1.5);
+  ekf.initialize(x, initialCovariance(EkfParams{}));
+  ImuReading imu;
+  imu.b_gyro_radps = Vec3(0.01, -0.02, 0.03);
+  for (auto _ : state) {
+    ekf.predict(imu, 0.0025);  // nominal integration + Φ accumulation (F2–F7)
+    benchmark::DoNotOptimize(ekf.state());
+  }
+}
+BENCHMARK(BM_ImuPrediction);
+
+void BM_CovariancePropagation(benchmark::State& state) {
+  Ekf ekf(EkfParams{});
+  ekf.initialize(NavState{}, initialCovariance(EkfParams{}));
+  ImuReading imu;
+  for (auto _ : state) {
+    ekf.predict(imu, 0.0025);
+    ekf.propagateCovariance();  // P ← Φ P Φᵀ + Q (F7)
+    benchmark::DoNotOptimize(ekf.covariance());
+  }
+}
+BENCHMARK(BM_CovariancePropagation);
+
+void BM_TdoaUpdate(benchmark::State& state) {
+  const AnchorTable anchors = benchAnchors();
+  Ekf ekf(EkfParams{});
+  NavState x;
+  x.w_p_b = Vec3(0.3, -0.2, 1.5);
+  ekf.initialize(x, initialCovariance(EkfParams{}));
+  TdoaUpdateOptions opt;
+  opt.gate_sigma = 0.0;
+  const Vec3 tag = tagPosition(x.w_p_b, x.w_q_b, kUtilTagOffset_b);
+  const double z = range(tag, anchors.find(1)->m) - range(tag, anchors.find(0)->m);
+  const ErrMat P0 = ekf.covariance();
+  std::size_t i = 0;
+  for (auto _ : state) {
+    if ((++i & 1023u) == 0) ekf.initialize(x, P0);  // keep P from collapsing
+    benchmark::DoNotOptimize(updateTdoa(ekf, anchors, {0.0, 0, 1, z + 0.05}, opt));  // graph TDoA node + equality
+  }
+}
+BENCHMARK(BM_TdoaUpdate);
+
+void BM_WholeFlightSynthetic(benchmark::State& state) {
+  const AnchorTable anchors = benchAnchors();
+  const double duration = 40.0;
+  const SensorLog log = syntheticFlight(anchors, duration);
+  EkfParams p;
+  p.ground_phase = GroundPhase::kNone;
+  const TdoaLocalizer localizer(p, anchors);
+  for (auto _ : state) benchmark::DoNotOptimize(localizer.run(log));
+  state.counters["rtf"] = benchmark::Counter(duration * static_cast<double>(state.iterations()),
+                                             benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_WholeFlightSynthetic)->Unit(benchmark::kMillisecond);
+
+void BM_WholeFlightReal0425Traj2(benchmark::State& state) {
+  const char* env = std::getenv("UWBTDOA_DATA");
+  const std::filesystem::path data = (env && *env) ? std::filesystem::path(env) : std::filesystem::path(UWB_DEFAULT_DATA_DIR);
+  const std::filesystem::path flight = data / "real/util-pilot/0425/0425-traj2.csv";
+  if (!std::filesystem::exists(flight)) {
+    state.SkipWithError("real data absent");
+    return;
+  }
+  const AnchorSurvey survey = readAnchorSurvey((data / "real/util-pilot/survey/anchor_0425_survey.txt").string());
+  const Flight f = readFlightCsv(flight.string());
+  const SensorLog log = sensorLogFromFlight(f);
+  const TdoaLocalizer localizer(EkfParams{}, anchorTableFromSurvey(survey));
+  const double duration = f.timeSpan().second - f.timeSpan().first;
+  for (auto _ : state) benchmark::DoNotOptimize(localizer.run(log));
+  state.counters["rtf"] = benchmark::Counter(duration * static_cast<double>(state.iterations()),
+                                             benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_WholeFlightReal0425Traj2)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace uwb
+
+BENCHMARK_MAIN();
