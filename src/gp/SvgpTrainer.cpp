@@ -126,29 +126,41 @@ void Adam::ascend(VecX& x, const VecX& g, const VecX& lr) {
   x.array() += lr.array() * (m_.array() / c1) / ((v_.array() / c2).sqrt() + eps_);
 }
 
+NaturalParams NaturalParams::fromSvgp(const Svgp& gp) {
+  const Eigen::Index M = gp.numInducing();
+  const MatX Linv = gp.variationalCholesky().triangularView<Eigen::Lower>().solve(MatX::Identity(M, M));
+  NaturalParams nat;
+  nat.Lambda = Linv.transpose() * Linv;  // S⁻¹ = L⁻ᵀ L⁻¹
+  nat.h = nat.Lambda * gp.variationalMean();
+  return nat;
+}
+
 void naturalGradientStep(Svgp& gp, const MatX& AAt, const VecX& A_y_centered, double batch_size, double num_data,
                          double step) {
+  NaturalParams nat = NaturalParams::fromSvgp(gp);
+  naturalGradientStep(gp, nat, AAt, A_y_centered, batch_size, num_data, step);
+}
+
+void naturalGradientStep(Svgp& gp, NaturalParams& nat, const MatX& AAt, const VecX& A_y_centered, double batch_size,
+                         double num_data, double step) {
   // P23: in natural parameters (Λ = S⁻¹, h = S⁻¹m) of q(v), a natural-gradient step of size γ with a Gaussian
   // likelihood is a convex combination with the batch optimum Λ* = I + (N/(Bσ²)) A Aᵀ, h* = (N/(Bσ²)) A (y − c).
   const Eigen::Index M = gp.numInducing();
-  const MatX& L = gp.variationalCholesky();
-  const MatX Linv = L.triangularView<Eigen::Lower>().solve(MatX::Identity(M, M));
-  MatX Lambda = Linv.transpose() * Linv;
-  VecX h = Lambda * gp.variationalMean();
   const double scale = num_data / (batch_size * gp.noiseVariance());
-  Lambda *= (1.0 - step);
-  Lambda.noalias() += (step * scale) * AAt;
-  Lambda.diagonal().array() += step;
-  Lambda = 0.5 * (Lambda + Lambda.transpose()).eval();
-  h = (1.0 - step) * h + (step * scale) * A_y_centered;
-  const Eigen::LLT<MatX> llt(Lambda);
+  nat.Lambda *= (1.0 - step);
+  nat.Lambda.noalias() += (step * scale) * AAt;
+  nat.Lambda.diagonal().array() += step;
+  nat.Lambda = 0.5 * (nat.Lambda + nat.Lambda.transpose()).eval();
+  nat.h = (1.0 - step) * nat.h + (step * scale) * A_y_centered;
+  // Lower factor of S = Λ⁻¹ from one Cholesky of the reversed Λ: JΛJ = R Rᵀ ⇒ S = (J R⁻ᵀ J)(J R⁻ᵀ J)ᵀ, and
+  // J R⁻ᵀ J is lower triangular with a positive diagonal.
+  const MatX Lambda_rev = nat.Lambda.reverse();
+  const Eigen::LLT<MatX> llt(Lambda_rev);
   if (llt.info() != Eigen::Success) throw std::runtime_error("natural-gradient step: Λ not positive definite");
-  MatX S = llt.solve(MatX::Identity(M, M));
-  S = 0.5 * (S + S.transpose()).eval();
-  const VecX m = llt.solve(h);
-  const Eigen::LLT<MatX> lls(S);
-  if (lls.info() != Eigen::Success) throw std::runtime_error("natural-gradient step: S not positive definite");
-  gp.setVariational(m, lls.matrixL());
+  const MatX Rinv = llt.matrixL().solve(MatX::Identity(M, M));
+  const MatX L = Rinv.transpose().reverse();
+  const VecX m = L * (L.transpose() * nat.h);  // m = S h
+  gp.setVariational(m, L);
 }
 
 SvgpTrainSummary trainSvgp(Svgp& gp, const MatX& X, const VecX& y, const SvgpTrainParams& params, const MatX* X_val,
@@ -196,6 +208,8 @@ SvgpTrainSummary trainSvgp(Svgp& gp, const MatX& X, const VecX& y, const SvgpTra
   };
   pack();
 
+  NaturalParams nat;
+  if (natgrad) nat = NaturalParams::fromSvgp(gp);
   std::mt19937_64 rng(params.seed);
   std::vector<Eigen::Index> perm(static_cast<std::size_t>(N));
   std::iota(perm.begin(), perm.end(), 0);
@@ -219,7 +233,7 @@ SvgpTrainSummary trainSvgp(Svgp& gp, const MatX& X, const VecX& y, const SvgpTra
       elbo_sum += e.elbo;
       if (natgrad) {
         const VecX Ay = g.Ar + g.AAt * gp.variationalMean();  // A (y − c) = A r + A Aᵀ m
-        naturalGradientStep(gp, g.AAt, Ay, static_cast<double>(size), static_cast<double>(N), params.natgrad_step);
+        naturalGradientStep(gp, nat, g.AAt, Ay, static_cast<double>(size), static_cast<double>(N), params.natgrad_step);
       }
       // ascent direction in the optimizer coordinates (log-space chain rule for positive parameters)
       grad.head(P) = g.kernel.cwiseProduct(gp.kernel().theta());

@@ -62,9 +62,19 @@ SvgpTrainSummary trainSvgp(Svgp& gp, const MatX& X, const VecX& y, const SvgpTra
                            const MatX* X_val = nullptr, const VecX* y_val = nullptr,
                            const std::function<void(const EpochReport&)>& on_epoch = {});
 
+/// Natural parameters of q(v): Λ = S⁻¹, h = S⁻¹ m (kept across steps by the trainer).
+struct NaturalParams {
+  MatX Lambda;
+  VecX h;
+  static NaturalParams fromSvgp(const Svgp& gp);
+};
+
 /// One natural-gradient step on q(v) for a Gaussian likelihood from a batch's A Aᵀ and A(y − c) (P23).
 void naturalGradientStep(Svgp& gp, const MatX& AAt, const VecX& A_y_centered, double batch_size, double num_data,
                          double step);
+/// The same, updating cached natural parameters `nat` (which must describe gp's current q).
+void naturalGradientStep(Svgp& gp, NaturalParams& nat, const MatX& AAt, const VecX& A_y_centered, double batch_size,
+                         double num_data, double step);
 
 /// Adam (Kingma & Ba 2015) on a flat vector (P22).
 class Adam {
