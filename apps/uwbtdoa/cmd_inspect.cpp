@@ -88,26 +88,7 @@ std::string statsCells(const uwb::ResidualStats& s) {
   return fmt::format("{:>7} {:>+8.3f} {:>7.3f}", s.n, s.median_m, s.mad_m);
 }
 
-void printHuman(const uwb::FlightSummary& s, const std::string& anchors_path) {
-  std::cout << fmt::format("flight    {}\n", s.source);
-  if (!anchors_path.empty()) std::cout << fmt::format("anchors   {}\n", anchors_path);
-  std::cout << fmt::format("duration  {:.2f} s  ({:.3f} … {:.3f} s)\n\n", s.duration_s, s.t_start_s, s.t_end_s);
-
-  std::cout << fmt::format("{:<8} {:>8} {:>10} {:>10} {:>10}\n", "stream", "count", "rate [Hz]", "first [s]",
-                           "last [s]");
-  for (const auto& st : s.streams) {
-    if (!st.present) continue;
-    std::cout << fmt::format("{:<8} {:>8} {:>10.1f} {:>10.3f} {:>10.3f}\n", st.name, st.count, st.rate_hz,
-                             st.t_first_s, st.t_last_s);
-  }
-  std::string absent;
-  for (const auto& st : s.streams) {
-    if (st.present) continue;
-    if (!absent.empty()) absent += ", ";
-    absent += st.name;
-  }
-  if (!absent.empty()) std::cout << fmt::format("(absent: {})\n", absent);
-
+void printPairs(const uwb::FlightSummary& s) {
   std::cout << fmt::format("\nTDoA pairs: {} measurements, neighbour-pair fraction {:.3f}\n", s.n_tdoa,
                            s.neighbour_pair_fraction);
   if (s.has_residuals) {
@@ -135,6 +116,33 @@ void printHuman(const uwb::FlightSummary& s, const std::string& anchors_path) {
     row("nbrs", "*", s.residual_neighbour.all.n, s.residual_neighbour);
     row("all", "", s.n_tdoa, s.residual);
   }
+}
+
+void printHuman(const uwb::FlightSummary& s, const std::string& anchors_path) {
+  std::cout << fmt::format("flight    {}\n", s.source);
+  if (!anchors_path.empty()) std::cout << fmt::format("anchors   {}\n", anchors_path);
+  std::cout << fmt::format("duration  {:.2f} s  ({:.3f} … {:.3f} s)\n\n", s.duration_s, s.t_start_s, s.t_end_s);
+
+  std::cout << fmt::format("{:<8} {:>8} {:>10} {:>10} {:>10}\n", "stream", "count", "rate [Hz]", "first [s]",
+                           "last [s]");
+  for (const auto& st : s.streams) {
+    if (!st.present) continue;
+    std::cout << fmt::format("{:<8} {:>8} {:>10.1f} {:>10.3f} {:>10.3f}\n", st.name, st.count, st.rate_hz,
+                             st.t_first_s, st.t_last_s);
+  }
+  std::string absent;
+  for (const auto& st : s.streams) {
+    if (st.present) continue;
+    if (!absent.empty()) absent += ", ";
+    absent += st.name;
+  }
+  if (!absent.empty()) std::cout << fmt::format("(absent: {})\n", absent);
+
+  if (s.n_tdoa == 0) {
+    std::cout << "\nTDoA: no measurements\n";
+  } else {
+    printPairs(s);
+  }
 
   if (s.has_ground_truth) {
     std::cout << fmt::format("\nground truth: {} pose, airborne (z > 0.3 m) {:.1f} % of samples, glitches excluded: "
@@ -147,6 +155,9 @@ void printHuman(const uwb::FlightSummary& s, const std::string& anchors_path) {
       } else {
         std::cout << fmt::format("  t = {:9.4f} s  position jump {:6.3f} m\n", g.t_s, g.magnitude);
       }
+    }
+    if (anchors_path.empty() && s.n_tdoa > 0) {
+      std::cout << "(pass --anchors SURVEY.txt for the TDoA residual against ground truth)\n";
     }
   } else {
     std::cout << "\nground truth: none (no pose stream)\n";
