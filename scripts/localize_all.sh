@@ -13,6 +13,8 @@ EXTRACT="$DATA/real/util-final-extract"
 [ -x "$CLI" ] || { echo "no $CLI; build first (cmake --build $BUILD --target uwbtdoa)" >&2; exit 1; }
 [ -d "$PILOT" ] || { echo "no data under $PILOT (set UWBTDOA_DATA)" >&2; exit 1; }
 
+TMP="$(mktemp)"
+trap 'rm -f "$TMP"' EXIT
 runs=()
 for i in 1 2 3 4 5 6 7 8 9 10 11 12; do runs+=("$PILOT/0425/0425-traj$i.csv|$PILOT/survey/anchor_0425_survey.txt"); done
 for i in 1 2 11 12; do runs+=("$PILOT/0426/0426-traj$i.csv|$PILOT/survey/anchor_0426_survey.txt"); done
@@ -31,9 +33,11 @@ a = j["airborne"]
 print("%-28s %-5s %8.3f %8.3f %7.3f %7.3f %7.3f %7.3f %7.3f %8d %8d %7.0f" % (os.path.basename(j["flight"]), j["process_model"],
       j["rmse_airborne_m"], j["rmse_m"], a["rmse_x_m"], a["rmse_y_m"], a["rmse_z_m"], a["p50_m"], a["p90_m"],
       j["n_tdoa_used"], j["n_tdoa_rejected"], j["real_time_factor"]))'
-done | tee /dev/stderr | /usr/bin/python3 -c '
+done > "$TMP"
+cat "$TMP"
+/usr/bin/python3 -c '
 import sys, statistics
 rows = [l.split() for l in sys.stdin if l.strip()]
 for model in ("imu", "cv"):
     v = [float(r[2]) for r in rows if r[1] == model]
-    if v: print("%s flights: %d, airborne RMSE median %.3f m, mean %.3f m, max %.3f m" % (model, len(v), statistics.median(v), statistics.mean(v), max(v)))'
+    if v: print("%s flights: %d, airborne RMSE median %.3f m, mean %.3f m, max %.3f m" % (model, len(v), statistics.median(v), statistics.mean(v), max(v)))' < "$TMP"
