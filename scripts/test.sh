@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # README command 2: install, build (Release and ASan+UBSan), run the whole test suite (ctest + pytest).
+# Suites named Slow* (Monte-Carlo, long real-data evaluations) run with: ctest --test-dir build -R "^Slow".
 # UWB_SKIP_SANITIZE=1 skips the sanitizer build (for quick local iterations only; CI always runs it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -7,7 +8,7 @@ scripts/setup.sh
 JOBS="${UWB_JOBS:-$(nproc)}"
 
 echo "[test] unit and regression tests (Release)"
-ctest --test-dir build --output-on-failure -j "$JOBS" -LE slow
+ctest --test-dir build --output-on-failure -j "$JOBS" -LE slow -E "^Slow"
 
 echo "[test] Python tests"
 PYTHONPATH="$PWD/build/python" /usr/bin/python3 -m pytest -q python/tests
@@ -20,6 +21,6 @@ if [ "${UWB_SKIP_SANITIZE:-0}" != "1" ]; then
   fi
   cmake --build build-asan -j "$JOBS"
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    ctest --test-dir build-asan --output-on-failure -j "$JOBS" -L unit -LE "slow|realdata"
+    ctest --test-dir build-asan --output-on-failure -j "$JOBS" -LE slow -E "^Slow|Cli"
 fi
 echo "[test] all passed"
