@@ -3,7 +3,7 @@
  *         checks the airborne RMSE stays under committed bounds. Skips when the data is absent.
  *
  *  Bounds = the value at the time of commit (scripts/localize_all.sh) + margin; a PR that changes the filter
- *  updates them deliberately. Reference (default params): 0425-traj2 0.234 m, 0426-traj11 0.275 m,
+ *  updates them deliberately. Reference (default params): 0425-traj2 0.204 m, 0426-traj11 0.265 m,
  *  const4-trial1-tdoa2-traj2 (TDoA-only) 0.169 m.
  */
 #include <gtest/gtest.h>
@@ -29,8 +29,8 @@ TEST(RealDataLocalization, Pilot0425Traj2AirborneRmseUnderBound) {
   const LocalizationRun run = replay(*flight, test::pilotSurvey("0425"));
   // THEN the airborne RMSE stays under the committed bound and nothing diverged
   ASSERT_TRUE(run.metrics);
-  EXPECT_LT(run.metrics->airborne.rmse_m, 0.27);
-  EXPECT_LT(run.metrics->whole.rmse_m, 0.40);
+  EXPECT_LT(run.metrics->airborne.rmse_m, 0.25);
+  EXPECT_LT(run.metrics->whole.rmse_m, 0.30);
   EXPECT_LT(run.metrics->airborne.p99_m, 1.0);
   EXPECT_GT(run.summary.n_tdoa_used, 10000u);
   EXPECT_FALSE(std::isnan(run.summary.takeoff_t_s));
@@ -44,7 +44,7 @@ TEST(RealDataLocalization, Pilot0426Traj11WithObstaclesUnderBound) {
   const LocalizationRun run = replay(*flight, test::pilotSurvey("0426"));
   // THEN
   ASSERT_TRUE(run.metrics);
-  EXPECT_LT(run.metrics->airborne.rmse_m, 0.32);
+  EXPECT_LT(run.metrics->airborne.rmse_m, 0.31);
 }
 
 TEST(RealDataLocalization, FinalExtractTdoaOnlyUnderBound) {

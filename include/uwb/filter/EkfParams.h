@@ -35,10 +35,10 @@ enum class GroundPhase {
 
 struct EkfParams {
   // --- process noise (continuous-time spectral densities) ---
-  double acc_noise_mps2_sqrthz = 0.5;         ///< accelerometer white noise on v (and vertical in kThrustOnly)
+  double acc_noise_mps2_sqrthz = 0.2;         ///< accelerometer white noise on v (and vertical in kThrustOnly)
   double lateral_acc_noise_mps2_sqrthz = 1.0; ///< extra white acceleration on horizontal v (drag, kThrustOnly)
   double gyro_noise_radps_sqrthz = 0.01;      ///< gyroscope white noise on δθ
-  double acc_bias_rw_mps3_sqrthz = 0.05;      ///< accelerometer-bias random walk
+  double acc_bias_rw_mps3_sqrthz = 0.01;      ///< accelerometer-bias random walk
   double gyro_bias_rw_radps2_sqrthz = 1e-4;   ///< gyroscope-bias random walk
   double pos_noise_m_sqrts = 0.0;             ///< direct position random walk (Crazyflie procNoisePos)
   double cv_acc_noise_mps2_sqrthz = 2.0;      ///< TDoA-only constant-velocity model: white acceleration
