@@ -15,6 +15,7 @@
 
 #include "Command.h"
 #include "uwb/core/Error.h"
+#include "uwb/eval/BiasModel.h"
 #include "uwb/eval/Localization.h"
 #include "uwb/io/UtilCsv.h"
 
@@ -145,8 +146,9 @@ void runLocalize(const LocalizeArgs& a) {
   }
   if (a.no_ground_detect) params.ground_phase = uwb::GroundPhase::kNone;
   params.validate();
-  if (!a.bias_model.empty())
-    throw std::invalid_argument("--bias-model: no bias-model loader is available in this build yet");
+  // issue 5: the GP bias model as a plain BiasPredictor (the filter knows nothing of GPs)
+  uwb::BiasPredictor bias;
+  if (!a.bias_model.empty()) bias = uwb::BiasModel::load(a.bias_model).predictor();
 
   const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(a.anchors);
   uwb::FlightReadOptions read_opt;
@@ -160,7 +162,7 @@ void runLocalize(const LocalizeArgs& a) {
   opt.output_period_s = a.output_period;
   opt.tdoa_only = a.tdoa_only;
   const auto t0 = std::chrono::steady_clock::now();
-  const uwb::LocalizationRun run = uwb::localizeFlight(flight, survey, opt);
+  const uwb::LocalizationRun run = uwb::localizeFlight(flight, survey, opt, bias);
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!a.out.empty()) uwb::writeTrajectoryCsv(run.trajectory, a.out);
 
@@ -170,6 +172,7 @@ void runLocalize(const LocalizeArgs& a) {
   j["flight"] = a.flight;
   j["duration_s"] = run.duration_s;
   j["process_model"] = uwb::toString(s.process_model);
+  j["bias_model"] = a.bias_model.empty() ? json(nullptr) : json(a.bias_model);
   j["n_tdoa"] = s.n_tdoa_total;
   j["n_tdoa_used"] = s.n_tdoa_used;
   j["n_tdoa_rejected"] = s.n_tdoa_rejected;
