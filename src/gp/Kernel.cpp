@@ -325,6 +325,69 @@ MatX Kernel::cross(const MatX& X1, const MatX& X2, std::vector<MatX>* part_block
   return K;
 }
 
+void Kernel::crossColumn(const MatX& X1, const Eigen::Ref<const RowVecX>& x, Eigen::Ref<VecX> out) const {
+  if (X1.cols() < input_dim_ || x.size() < input_dim_)
+    throw std::invalid_argument("kernel: inputs have too few columns for the kernel");
+  if (out.size() != X1.rows()) throw std::invalid_argument("kernel crossColumn: output has the wrong size");
+  constexpr int kChunk = 64;
+  using Chunk = Eigen::Array<double, Eigen::Dynamic, 1, 0, kChunk, 1>;  // stack storage, no allocation
+  const Eigen::Index n1 = X1.rows();
+  out.setZero();
+  for (Eigen::Index i0 = 0; i0 < n1; i0 += kChunk) {
+    const Eigen::Index c = std::min<Eigen::Index>(kChunk, n1 - i0);
+    for (const auto& term : terms_) {
+      Chunk prod = Chunk::Ones(c);
+      for (int pi : term) {
+        const Part& p = parts_[pi];
+        const double s2 = theta_[p.offset];
+        const Eigen::Index nd = static_cast<Eigen::Index>(p.active_dims.size());
+        Chunk acc = Chunk::Zero(c);
+        switch (p.type) {
+          case PartType::kRbf:
+          case PartType::kMatern52: {  // P2, P3
+            for (Eigen::Index d = 0; d < nd; ++d) {
+              const int dim = p.active_dims[static_cast<std::size_t>(d)];
+              const double il = 1.0 / theta_[p.offset + 1 + (p.n_l == 1 ? 0 : d)];
+              acc += ((X1.col(dim).segment(i0, c).array() - x[dim]) * il).square();
+            }
+            if (p.type == PartType::kRbf) {
+              prod *= s2 * (-0.5 * acc).exp();
+            } else {
+              const Chunk r = acc.sqrt() * kSqrt5;
+              prod *= s2 * (1.0 + r + r.square() / 3.0) * (-r).exp();
+            }
+            break;
+          }
+          case PartType::kPeriodic: {  // P1
+            for (Eigen::Index d = 0; d < nd; ++d) {
+              const int dim = p.active_dims[static_cast<std::size_t>(d)];
+              const double l = theta_[p.offset + 1 + (p.n_l == 1 ? 0 : d)];
+              const double T = theta_[p.offset + 1 + p.n_l + (p.n_T == 1 ? 0 : d)];
+              acc += (1.0 / (l * l)) * ((kPi / T) * (X1.col(dim).segment(i0, c).array() - x[dim])).sin().square();
+            }
+            prod *= s2 * (-2.0 * acc).exp();
+            break;
+          }
+          case PartType::kLedergerber: {  // P4
+            const double t1 = theta_[p.offset + 1], t2 = theta_[p.offset + 2];
+            const int d0 = p.active_dims[0], d1 = p.active_dims[1], d2 = p.active_dims[2];
+            const double nb = std::sqrt(x[d0] * x[d0] + x[d1] * x[d1] + x[d2] * x[d2]);
+            const auto a0 = X1.col(d0).segment(i0, c).array(), a1 = X1.col(d1).segment(i0, c).array(),
+                       a2 = X1.col(d2).segment(i0, c).array();
+            const Chunk na = (a0.square() + a1.square() + a2.square()).sqrt();
+            if (nb < 1e-12 || na.minCoeff() < 1e-12)
+              throw std::invalid_argument("ledergerber kernel: input vector of zero norm (k_L is undefined at x = 0)");
+            const Chunk gamma = (a0 * x[d0] + a1 * x[d1] + a2 * x[d2]) / (na * nb);
+            prod *= s2 * (-(1.0 - gamma) / t1 - (na - nb).square() / t2).exp();
+            break;
+          }
+        }
+      }
+      out.segment(i0, c).array() += prod;
+    }
+  }
+}
+
 double Kernel::operator()(const Eigen::Ref<const RowVecX>& x, const Eigen::Ref<const RowVecX>& xp) const {
   return cross(MatX(x), MatX(xp))(0, 0);
 }
@@ -383,10 +446,9 @@ void Kernel::partGradient(int pi, const MatX& X1, const MatX& X2, const MatX& H,
   switch (p.type) {
     case PartType::kRbf:
     case PartType::kMatern52: {
-      MatX Wg;  // weight multiplying Δ_d/l_d² in ∂k/∂x_d = −w Δ_d / l_d²  and  ∂k/∂l_d = w Δ_d² / l_d³
-      if (p.type == PartType::kRbf) {
-        Wg = W;  // P8: RBF: ∂k/∂l_d = k Δ_d²/l_d³, ∂k/∂x_d = −k Δ_d/l_d²
-      } else {
+      // weight w multiplying Δ_d/l_d² in ∂k/∂x_d = −w Δ_d / l_d²  and  ∂k/∂l_d = w Δ_d² / l_d³
+      MatX Wg_matern;
+      if (p.type == PartType::kMatern52) {
         // P9: Matérn-5/2, g = (5/3) σ² (1 + √5ρ) e^{−√5ρ}
         MatX R2 = MatX::Zero(A.rows(), n2);
         for (Eigen::Index d = 0; d < nd; ++d) {
@@ -394,21 +456,30 @@ void Kernel::partGradient(int pi, const MatX& X1, const MatX& X2, const MatX& H,
           for (Eigen::Index j = 0; j < n2; ++j) R2.col(j).array() += ((A.col(d).array() - B(j, d)) / l).square();
         }
         const Eigen::ArrayXXd r = R2.array().sqrt() * kSqrt5;
-        Wg = H.array() * ((5.0 / 3.0) * s2 * (1.0 + r) * (-r).exp());
+        Wg_matern = H.array() * ((5.0 / 3.0) * s2 * (1.0 + r) * (-r).exp());
       }
-      Eigen::ArrayXd gx(A.rows()), delta(A.rows());  // buffers reused for every column (no per-column allocation)
+      const MatX& Wg = p.type == PartType::kRbf ? W : Wg_matern;  // P8: RBF: w = H ∘ k
+      // Σ_j w_ij Δ_ij = a_i (Σ_j w_ij) − (W b)_i and Σ_ij w_ij Δ_ij² = Σ_i rs_i a_i² − 2 aᵀ(W b) + Σ_j cs_j b_j²:
+      // one GEMM W·B (n1×n2 · n2×d) instead of d passes over the n1×n2 block. Inputs are centred on A's column
+      // means first (Δ is unchanged) to keep the cancellation in the expanded square small.
+      MatX Ac = A, Bc = B;
+      for (Eigen::Index d = 0; d < nd; ++d) {
+        const double centre = A.rows() > 0 ? A.col(d).mean() : 0.0;
+        Ac.col(d).array() -= centre;
+        Bc.col(d).array() -= centre;
+      }
+      const VecX rs = Wg.rowwise().sum();
+      const VecX cs = Wg.colwise().sum().transpose();
+      MatX WB(A.rows(), nd);
+      WB.noalias() = Wg * Bc;
       for (Eigen::Index d = 0; d < nd; ++d) {
         const Eigen::Index li = p.offset + 1 + (p.n_l == 1 ? 0 : d);
         const double l = theta_[li];
-        double acc = 0.0;
-        gx.setZero();
-        for (Eigen::Index j = 0; j < n2; ++j) {
-          delta = A.col(d).array() - B(j, d);
-          gx += Wg.col(j).array() * delta;
-          acc += (Wg.col(j).array() * delta.square()).sum();
-        }
+        const auto a = Ac.col(d).array();
+        const double acc = (rs.array() * a.square()).sum() - 2.0 * (a * WB.col(d).array()).sum() +
+                           (cs.array() * Bc.col(d).array().square()).sum();
         grad_theta[li] += acc / (l * l * l);
-        if (grad_X1) grad_X1->col(p.active_dims[d]) -= (gx / (l * l)).matrix();
+        if (grad_X1) grad_X1->col(p.active_dims[d]) -= ((a * rs.array() - WB.col(d).array()) / (l * l)).matrix();
       }
       break;
     }

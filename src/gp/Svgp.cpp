@@ -156,6 +156,7 @@ ElboTerms Svgp::elbo(const MatX& X_raw, const VecX& y, double num_data, SvgpGrad
   MatX A, C;      // kExact: A = Lz⁻¹Kzx, C = (S − I)A
   VecX alpha;     // kFast: Lz⁻ᵀ m
   MatX WK;        // kFast: W Kzx, W = Lz⁻ᵀ (S − I) Lz⁻¹
+  MatX T1;        // kFast: Lz⁻ᵀ (S − I), reused by the reverse pass (P17)
   if (mode == ElboMode::kExact) {
     A = LzT.solve(Kzx);
     C.noalias() = SmI * A;
@@ -163,7 +164,7 @@ ElboTerms Svgp::elbo(const MatX& X_raw, const VecX& y, double num_data, SvgpGrad
     var_f = (A.array() * C.array()).colwise().sum().transpose();
   } else {
     alpha = LzT.transpose().solve(m_);
-    const MatX T1 = LzT.transpose().solve(SmI);                // Lz⁻ᵀ (S − I)
+    T1 = LzT.transpose().solve(SmI);                           // Lz⁻ᵀ (S − I)
     MatX W = LzT.transpose().solve(T1.transpose()).transpose();  // Lz⁻ᵀ (S − I) Lz⁻¹
     W = 0.5 * (W + W.transpose()).eval();
     WK.noalias() = W * Kzx;
@@ -220,9 +221,18 @@ ElboTerms Svgp::elbo(const MatX& X_raw, const VecX& y, double num_data, SvgpGrad
   g.L = (-beta * AAtL - (L_ - Linv_diag) / num_data).triangularView<Eigen::Lower>();
 
   // P17: ∂/∂Lz = tril(−K̄zx Aᵀ) = tril(−Lz⁻ᵀ Ā Aᵀ),  Ā Aᵀ = β (m (Ar)ᵀ − (S − I) A Aᵀ)
-  MatX AbarAt = -beta * (SmI * AAt);
-  AbarAt.noalias() += (beta * m_) * Ar.transpose();
-  const MatX Lzbar = (-LzT.transpose().solve(AbarAt)).triangularView<Eigen::Lower>();
+  MatX Lzbar;
+  if (mode == ElboMode::kExact) {
+    MatX AbarAt = -beta * (SmI * AAt);
+    AbarAt.noalias() += (beta * m_) * Ar.transpose();
+    Lzbar = (-LzT.transpose().solve(AbarAt)).triangularView<Eigen::Lower>();
+  } else {
+    // Lz⁻ᵀ Ā Aᵀ = β (α (Ar)ᵀ − T1 A Aᵀ): one GEMM with the cached T1 instead of a GEMM and a triangular solve
+    MatX LzAbarAt(M, M);
+    LzAbarAt.noalias() = (-beta) * T1 * AAt;
+    LzAbarAt.noalias() += (beta * alpha) * Ar.transpose();
+    Lzbar = (-LzAbarAt).triangularView<Eigen::Lower>();
+  }
   // P18: Cholesky backward: K̄zz = ½ Lz⁻ᵀ (P + Pᵀ) Lz⁻¹, P = Φ(Lzᵀ L̄z)
   const MatX P = phi(Lz.transpose().triangularView<Eigen::Upper>() * Lzbar);
   const MatX Ps = P + P.transpose();
@@ -242,14 +252,38 @@ ElboTerms Svgp::elbo(const MatX& X_raw, const VecX& y, double num_data, SvgpGrad
   return out;
 }
 
-SvgpPrediction Svgp::predict(const MatX& X) const { return predictor().predict(X); }
+SvgpPrediction Svgp::predict(const MatX& X_raw) const {
+  // Reference path (P13, FIXTURES.md §3): a = Lz⁻¹ k_Z(x) by triangular solves; the fixtures check it directly.
+  const MatX X = transformInputs(X_raw);
+  MatX Kzz = kernel_.gram(Z_);
+  Kzz.diagonal().array() += jitter_;
+  const MatX Lz = choleskyOrThrow(Kzz, "SVGP Kzz");
+  const VecX alpha = Lz.triangularView<Eigen::Lower>().transpose().solve(m_);
+  const double kdiag = kernel_.diagValue();
+  SvgpPrediction p;
+  const Eigen::Index N = X.rows();
+  p.mean.resize(N);
+  p.var_f.resize(N);
+  constexpr Eigen::Index kBlock = 256;
+  for (Eigen::Index start = 0; start < N; start += kBlock) {
+    const Eigen::Index n = std::min(kBlock, N - start);
+    const MatX Kzt = kernel_.cross(Z_, X.middleRows(start, n));
+    const MatX A = Lz.triangularView<Eigen::Lower>().solve(Kzt);  // P13: a = Lz⁻¹ k_Z(x)
+    const MatX LtA = L_.transpose().triangularView<Eigen::Upper>() * A;
+    p.mean.segment(start, n).noalias() = Kzt.transpose() * alpha;  // aᵀm = k_Zᵀ Lz⁻ᵀ m
+    p.var_f.segment(start, n) = (LtA.colwise().squaredNorm() - A.colwise().squaredNorm()).transpose();
+  }
+  p.mean.array() += c_;
+  p.var_f.array() += kdiag + jitter_;
+  p.var_y = p.var_f.array() + noise_;
+  return p;
+}
 
 SvgpPredictor Svgp::predictor() const { return SvgpPredictor(*this); }
 
 SvgpPredictor::SvgpPredictor(const Svgp& gp)
     : kernel_(gp.kernel()),
       Z_(gp.inducing()),
-      L_(gp.variationalCholesky()),
       c_(gp.meanConstant()),
       noise_(gp.noiseVariance()),
       jitter_(gp.jitter()),
@@ -257,27 +291,42 @@ SvgpPredictor::SvgpPredictor(const Svgp& gp)
       scale_(gp.inputScale()) {
   MatX Kzz = kernel_.gram(Z_);
   Kzz.diagonal().array() += jitter_;
-  Lz_ = choleskyOrThrow(Kzz, "SVGP Kzz");
-  alpha_ = Lz_.triangularView<Eigen::Lower>().transpose().solve(gp.variationalMean());
+  const MatX Lz = choleskyOrThrow(Kzz, "SVGP Kzz");
+  const auto LzT = Lz.triangularView<Eigen::Lower>().transpose();
+  alpha_ = LzT.solve(gp.variationalMean());
+  // P20: Q = Lz⁻ᵀ (S − I) Lz⁻¹ = G Gᵀ − Lz⁻ᵀ Lz⁻¹ with G = Lz⁻ᵀ L (no explicit S − I: less cancellation)
+  const Eigen::Index M = Z_.rows();
+  const MatX& L = gp.variationalCholesky();
+  const MatX G = LzT.solve(L);
+  const MatX Li = LzT.solve(MatX::Identity(M, M));  // Lz⁻ᵀ
+  Q_ = MatX::Zero(M, M);
+  Q_.selfadjointView<Eigen::Lower>().rankUpdate(G, 1.0);
+  Q_.selfadjointView<Eigen::Lower>().rankUpdate(Li, -1.0);
+  Q_ = Q_.selfadjointView<Eigen::Lower>();
   kdiag_ = kernel_.diagValue();
 }
 
+namespace {
+constexpr Eigen::Index kPredictBlock = 256;  ///< rows of test points per kernel block (≈ 350 kB at M = 170)
+}
+
 SvgpPrediction SvgpPredictor::predict(const MatX& X_raw) const {
-  MatX X = X_raw;
-  if (shift_.size() > 0) X = ((X.rowwise() - shift_.transpose()).array().rowwise() / scale_.transpose().array()).matrix();
+  const bool tf = shift_.size() > 0;
+  if (tf && X_raw.cols() != shift_.size()) throw std::invalid_argument("SVGP: input has the wrong number of columns");
   SvgpPrediction p;
-  const Eigen::Index N = X.rows();
+  const Eigen::Index N = X_raw.rows(), M = Z_.rows();
   p.mean.resize(N);
   p.var_f.resize(N);
-  // Blocks of test points keep Kzt, A in cache and avoid huge temporaries.
-  constexpr Eigen::Index kBlock = 256;
-  for (Eigen::Index start = 0; start < N; start += kBlock) {
-    const Eigen::Index n = std::min(kBlock, N - start);
-    const MatX Kzt = kernel_.cross(Z_, X.middleRows(start, n));
-    const MatX A = Lz_.triangularView<Eigen::Lower>().solve(Kzt);  // P13: a = Lz⁻¹ k_Z(x)
-    const MatX LtA = L_.transpose().triangularView<Eigen::Upper>() * A;
-    p.mean.segment(start, n).noalias() = Kzt.transpose() * alpha_;  // aᵀm = k_Zᵀ Lz⁻ᵀ m
-    p.var_f.segment(start, n) = (LtA.colwise().squaredNorm() - A.colwise().squaredNorm()).transpose();
+  MatX Xb, KQ(kPredictBlock, M);
+  for (Eigen::Index start = 0; start < N; start += kPredictBlock) {
+    const Eigen::Index n = std::min(kPredictBlock, N - start);
+    Xb = X_raw.middleRows(start, n);
+    if (tf) Xb = ((Xb.rowwise() - shift_.transpose()).array().rowwise() / scale_.transpose().array()).matrix();
+    const MatX Kxz = kernel_.cross(Xb, Z_);  // n×M: columns over Z, vectorized over the block's points
+    auto KQb = KQ.topRows(n);
+    KQb.noalias() = Kxz * Q_;  // P20: one GEMM for the variances
+    p.mean.segment(start, n).noalias() = Kxz * alpha_;
+    p.var_f.segment(start, n) = (KQb.array() * Kxz.array()).rowwise().sum();
   }
   p.mean.array() += c_;
   p.var_f.array() += kdiag_ + jitter_;
@@ -286,14 +335,16 @@ SvgpPrediction SvgpPredictor::predict(const MatX& X_raw) const {
 }
 
 VecX SvgpPredictor::predictMean(const MatX& X_raw) const {
-  MatX X = X_raw;
-  if (shift_.size() > 0) X = ((X.rowwise() - shift_.transpose()).array().rowwise() / scale_.transpose().array()).matrix();
-  const Eigen::Index N = X.rows();
+  const bool tf = shift_.size() > 0;
+  if (tf && X_raw.cols() != shift_.size()) throw std::invalid_argument("SVGP: input has the wrong number of columns");
+  const Eigen::Index N = X_raw.rows();
   VecX mean(N);
-  constexpr Eigen::Index kBlock = 256;
-  for (Eigen::Index start = 0; start < N; start += kBlock) {
-    const Eigen::Index n = std::min(kBlock, N - start);
-    mean.segment(start, n).noalias() = kernel_.cross(Z_, X.middleRows(start, n)).transpose() * alpha_;
+  MatX Xb;
+  for (Eigen::Index start = 0; start < N; start += kPredictBlock) {
+    const Eigen::Index n = std::min(kPredictBlock, N - start);
+    Xb = X_raw.middleRows(start, n);
+    if (tf) Xb = ((Xb.rowwise() - shift_.transpose()).array().rowwise() / scale_.transpose().array()).matrix();
+    mean.segment(start, n).noalias() = kernel_.cross(Xb, Z_) * alpha_;
   }
   mean.array() += c_;
   return mean;
@@ -302,11 +353,11 @@ VecX SvgpPredictor::predictMean(const MatX& X_raw) const {
 void SvgpPredictor::predictOne(const Eigen::Ref<const RowVecX>& x_raw, double& mean, double& var_f) const {
   RowVecX x = x_raw;
   if (shift_.size() > 0) x = (x - shift_.transpose()).cwiseQuotient(scale_.transpose());
-  const VecX k = kernel_.cross(Z_, MatX(x)).col(0);
-  const VecX a = Lz_.triangularView<Eigen::Lower>().solve(k);
-  const VecX b = L_.transpose().triangularView<Eigen::Upper>() * a;
+  VecX k(Z_.rows());
+  kernel_.crossColumn(Z_, x, k);
   mean = c_ + k.dot(alpha_);
-  var_f = kdiag_ + jitter_ + b.squaredNorm() - a.squaredNorm();
+  // P20: kᵀ Q k; Q is stored full (symmetric), so a plain GEMV vectorizes best
+  var_f = kdiag_ + jitter_ + k.dot(Q_ * k);
 }
 
 // ---------------------------------------------------------------------------------------------------------------

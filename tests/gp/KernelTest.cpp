@@ -86,6 +86,19 @@ TEST(Kernel, GramIsSymmetricAndPositiveSemiDefinite) {
   }
 }
 
+TEST(Kernel, CrossColumnEqualsCross) {
+  for (const auto& nk : kernelZoo()) {
+    SCOPED_TRACE(nk.name);
+    // GIVEN 150 points (three chunks of the allocation-free path) and one more point
+    const MatX X = inputsFor(nk, 150, 5), Y = inputsFor(nk, 1, 6);
+    // WHEN we evaluate the column both ways
+    VecX col(X.rows());
+    nk.kernel.crossColumn(X, Y.row(0), col);
+    // THEN they agree to rounding
+    EXPECT_LT((col - nk.kernel.cross(X, Y).col(0)).cwiseAbs().maxCoeff(), 1e-14);
+  }
+}
+
 TEST(Kernel, SumAndProductIdentities) {
   // GIVEN two kernels and a pair of points
   PartSpec a{PartType::kRbf, {0, 1}, 0.7, {0.8, 1.3}};

@@ -186,8 +186,9 @@ void checkFixture(const nlohmann::json& fx, ElboMode mode, double tol) {
   for (Eigen::Index i = 0; i < Xt.rows(); ++i) {
     double mean = 0, var_f = 0;
     predictor.predictOne(Xt.row(i), mean, var_f);
-    EXPECT_NEAR(mean, pred.mean[i], 1e-12 * std::max(1.0, std::abs(pred.mean[i])));
-    EXPECT_NEAR(var_f, pred.var_f[i], 1e-12 * std::max(1.0, pred.var_f[i]));
+    // the predictor's Q path (P20) against the reference triangular solves of Svgp::predict
+    EXPECT_NEAR(mean, pred.mean[i], 1e-10 * std::max(1.0, std::abs(pred.mean[i])));
+    EXPECT_NEAR(var_f, pred.var_f[i], 1e-10 * std::max(1.0, pred.var_f[i]));
   }
 }
 

@@ -166,6 +166,36 @@ TEST(Svgp, SinglePredictionEqualsBatchPrediction) {
   }
 }
 
+TEST(SvgpPredictor, BatchedAndSinglePredictionsAgreeWithTheReferencePath) {
+  // GIVEN models with an input transform, small and trained-size (M = 60 k-means inducing points)
+  for (int M : {7, 60}) {
+    SCOPED_TRACE(M);
+    Problem p = makeProblem(11, 700, M);
+    if (M > 7) p.gp = initSvgp(p.gp.kernel(), p.X, p.y, M, 3, InputNormalization::kStandardize);
+    if (M > 7) {
+      SvgpTrainParams tp;
+      tp.epochs = 3;
+      tp.batch_size = 128;
+      trainSvgp(p.gp, p.X, p.y, tp);
+    } else {
+      p.gp.setInputTransform(VecX::Constant(3, 0.1), VecX::Constant(3, 1.5));
+    }
+    // WHEN we predict with the precomputed predictor (α, Q; P20), batched (several blocks) and point by point
+    const SvgpPrediction ref = p.gp.predict(p.X);
+    const SvgpPredictor pred = p.gp.predictor();
+    const SvgpPrediction fast = pred.predict(p.X);
+    // THEN it agrees with the triangular-solve reference to 1e-10 relative
+    EXPECT_LT(relativeError(fast.mean, ref.mean), 1e-10);
+    EXPECT_LT(relativeError(fast.var_f, ref.var_f), 1e-10);
+    EXPECT_LT(relativeError(fast.var_y, ref.var_y), 1e-10);
+    EXPECT_LT(relativeError(pred.predictMean(p.X), ref.mean), 1e-10);
+    VecX mean1(p.X.rows()), var1(p.X.rows());
+    for (Eigen::Index i = 0; i < p.X.rows(); ++i) pred.predictOne(p.X.row(i), mean1[i], var1[i]);
+    EXPECT_LT(relativeError(mean1, ref.mean), 1e-10);
+    EXPECT_LT(relativeError(var1, ref.var_f), 1e-10);
+  }
+}
+
 TEST(SvgpModelFile, RoundTripGivesBitIdenticalPredictions) {
   // GIVEN a trained-looking model with an input transform
   Problem p = makeProblem(4);

@@ -90,6 +90,9 @@ class Kernel {
   double operator()(const Eigen::Ref<const RowVecX>& x, const Eigen::Ref<const RowVecX>& xp) const;
   /// K(X1, X2): n1×n2. When `part_blocks` is non-null it receives each part's own matrix (for gradients).
   MatX cross(const MatX& X1, const MatX& X2, std::vector<MatX>* part_blocks = nullptr) const;
+  /// k(X1_i, x) for every row i of X1 into out (size X1.rows()): the column K(X1, x) without heap allocation,
+  /// vectorized in chunks of 64 rows (stack buffers). Used for single-point predictions.
+  void crossColumn(const MatX& X1, const Eigen::Ref<const RowVecX>& x, Eigen::Ref<VecX> out) const;
   /// K(X, X).
   MatX gram(const MatX& X) const { return cross(X, X); }
   /// k(x_n, x_n) for every row (no jitter). Every part type is stationary on its diagonal: k(x,x) = σ².
