@@ -77,8 +77,6 @@ void Ekf::initialize(const NavState& x0, const ErrMat& P0) {
   P_ = 0.5 * (P0 + P0.transpose());
   phi_ = AccumulatedTransition{};
   pending_cv_dt_s_ = 0.0;
-  phi_cv_.setIdentity();
-  q_cv_.setZero();
 }
 
 void Ekf::predict(const ImuReading& imu, double dt_s) {
@@ -99,42 +97,56 @@ void Ekf::predict(const ImuReading& imu, double dt_s) {
 
 void Ekf::predictTdoaOnly(double dt_s) {
   if (!(dt_s > 0.0)) return;
-  const ErrMat F = tdoaOnlyProcess(x_, dt_s, params_.process_model);  // (F9)
-  phi_cv_ = F * phi_cv_;
-  // (F9) discrete white-acceleration / white-jerk noise, added at this step and carried by later F's.
-  ErrMat Q = ErrMat::Zero();
-  const double dt2 = dt_s * dt_s, dt3 = dt2 * dt_s;
-  if (params_.process_model == ProcessModel::kConstantAcceleration) {
-    const double q = params_.ca_jerk_noise_mps3_sqrthz * params_.ca_jerk_noise_mps3_sqrthz;
-    const double dt4 = dt3 * dt_s, dt5 = dt4 * dt_s;
-    for (int i = 0; i < 3; ++i) {
-      Q(kPos + i, kPos + i) = q * dt5 / 20.0;
-      Q(kPos + i, kVel + i) = Q(kVel + i, kPos + i) = q * dt4 / 8.0;
-      Q(kPos + i, kAccBias + i) = Q(kAccBias + i, kPos + i) = q * dt3 / 6.0;
-      Q(kVel + i, kVel + i) = q * dt3 / 3.0;
-      Q(kVel + i, kAccBias + i) = Q(kAccBias + i, kVel + i) = q * dt2 / 2.0;
-      Q(kAccBias + i, kAccBias + i) = q * dt_s;
-    }
-  } else {
-    const double q = params_.cv_acc_noise_mps2_sqrthz * params_.cv_acc_noise_mps2_sqrthz;
-    for (int i = 0; i < 3; ++i) {
-      Q(kPos + i, kPos + i) = q * dt3 / 3.0;
-      Q(kPos + i, kVel + i) = Q(kVel + i, kPos + i) = q * dt2 / 2.0;
-      Q(kVel + i, kVel + i) = q * dt_s;
-    }
-  }
-  q_cv_ = F * q_cv_ * F.transpose() + Q;
+  tdoaOnlyPredictNominal(x_, dt_s, params_.process_model);  // (F9)
+  // The CV/CA transitions and their continuous-white-noise Q compose exactly over time
+  // (F(t₂)F(t₁) = F(t₁+t₂), F(t₂)Q(t₁)F(t₂)ᵀ + Q(t₂) = Q(t₁+t₂)), so the pending transition is just its length.
   pending_cv_dt_s_ += dt_s;
 }
 
-void Ekf::propagateCovariance() {
-  if (pending_cv_dt_s_ > 0.0) {
-    P_ = phi_cv_ * P_ * phi_cv_.transpose() + q_cv_;
-    P_ = 0.5 * (P_ + P_.transpose());
-    phi_cv_.setIdentity();
-    q_cv_.setZero();
-    pending_cv_dt_s_ = 0.0;
+void Ekf::propagateTdoaOnlyCovariance() {
+  // docs/math/filter.md (F9, F7): P ← F(T) P F(T)ᵀ + Q(T) using the structure of F(T) = I + T E_pv
+  // (+ ½T² E_pa + T E_va for constant acceleration), per axis: O(15·3) instead of dense 15×15 products.
+  const double T = pending_cv_dt_s_;
+  const double T2 = T * T, T3 = T2 * T;
+  const bool ca = params_.process_model == ProcessModel::kConstantAcceleration;
+  // rows: P ← F P (the position row uses the old velocity row, so it goes first)
+  P_.middleRows<3>(kPos) += T * P_.middleRows<3>(kVel);
+  if (ca) {
+    P_.middleRows<3>(kPos) += (0.5 * T2) * P_.middleRows<3>(kAccBias);
+    P_.middleRows<3>(kVel) += T * P_.middleRows<3>(kAccBias);
   }
+  // columns: P ← (F P) Fᵀ
+  P_.middleCols<3>(kPos) += T * P_.middleCols<3>(kVel);
+  if (ca) {
+    P_.middleCols<3>(kPos) += (0.5 * T2) * P_.middleCols<3>(kAccBias);
+    P_.middleCols<3>(kVel) += T * P_.middleCols<3>(kAccBias);
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (ca) {
+      const double q = params_.ca_jerk_noise_mps3_sqrthz * params_.ca_jerk_noise_mps3_sqrthz;
+      const double T4 = T3 * T, T5 = T4 * T;
+      P_(kPos + i, kPos + i) += q * T5 / 20.0;
+      P_(kPos + i, kVel + i) += q * T4 / 8.0;
+      P_(kVel + i, kPos + i) += q * T4 / 8.0;
+      P_(kPos + i, kAccBias + i) += q * T3 / 6.0;
+      P_(kAccBias + i, kPos + i) += q * T3 / 6.0;
+      P_(kVel + i, kVel + i) += q * T3 / 3.0;
+      P_(kVel + i, kAccBias + i) += q * T2 / 2.0;
+      P_(kAccBias + i, kVel + i) += q * T2 / 2.0;
+      P_(kAccBias + i, kAccBias + i) += q * T;
+    } else {
+      const double q = params_.cv_acc_noise_mps2_sqrthz * params_.cv_acc_noise_mps2_sqrthz;
+      P_(kPos + i, kPos + i) += q * T3 / 3.0;
+      P_(kPos + i, kVel + i) += q * T2 / 2.0;
+      P_(kVel + i, kPos + i) += q * T2 / 2.0;
+      P_(kVel + i, kVel + i) += q * T;
+    }
+  }
+  pending_cv_dt_s_ = 0.0;
+}
+
+void Ekf::propagateCovariance() {
+  if (pending_cv_dt_s_ > 0.0) propagateTdoaOnlyCovariance();
   if (phi_.empty()) return;
   // docs/math/filter.md (F7): P ← Φ P Φᵀ + Q(T); Φ P Φᵀ = Φ (Φ P)ᵀ since P is symmetric.
   const ErrMat A = phi_.leftMultiply(P_);

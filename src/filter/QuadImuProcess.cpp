@@ -56,10 +56,11 @@ ProcessStep quadImuProcess(const NavState& x, const ImuReading& imu, double dt_s
   const Vec3 b_omega = imu.b_gyro_radps - x.b_gyro_bias;
   const Vec3 w_a = w_R_b * b_f + kWorldGravity_mps2;
   const Vec3 phi = b_omega * dt_s;
+  const Quat dq = expQuat(phi);  // one Exp for the nominal step and F_θθ
 
   out.next.w_p_b = x.w_p_b + x.w_v_b * dt_s + 0.5 * dt_s * dt_s * w_a;
   out.next.w_v_b = x.w_v_b + dt_s * w_a;
-  out.next.w_q_b = (x.w_q_b * expQuat(phi)).normalized();
+  out.next.w_q_b = (x.w_q_b * dq).normalized();
   out.next.b_acc_bias = x.b_acc_bias;
   out.next.b_gyro_bias = x.b_gyro_bias;
 
@@ -68,7 +69,7 @@ ProcessStep quadImuProcess(const NavState& x, const ImuReading& imu, double dt_s
   out.J.F_v_att = -(w_R_b * skew(b_f)) * dt_s;
   out.J.G_v_acc = w_R_b * S * dt_s;
   out.J.F_v_accbias = -out.J.G_v_acc;
-  out.J.F_att_att = expQuat(phi).toRotationMatrix().transpose();
+  out.J.F_att_att = dq.toRotationMatrix().transpose();
   out.J.F_att_gyrobias = -rightJacobianSo3(phi) * dt_s;
   return out;
 }
@@ -98,19 +99,25 @@ NoiseMat ProcessStep::G() const {
   return G;
 }
 
-ErrMat tdoaOnlyProcess(NavState& x, double dt_s, ProcessModel model) {
+void tdoaOnlyPredictNominal(NavState& x, double dt_s, ProcessModel model) {
   // (F9) constant velocity: p' = p + v dt; constant acceleration: p' = p + v dt + ½ a dt², v' = v + a dt.
-  ErrMat F = ErrMat::Identity();
-  F.block<3, 3>(kPos, kVel) = dt_s * Mat3::Identity();
   if (model == ProcessModel::kConstantAcceleration) {
     const Vec3& w_a = x.b_acc_bias;  // world-frame acceleration in this model
     x.w_p_b += x.w_v_b * dt_s + 0.5 * dt_s * dt_s * w_a;
     x.w_v_b += w_a * dt_s;
-    F.block<3, 3>(kPos, kAccBias) = 0.5 * dt_s * dt_s * Mat3::Identity();
-    F.block<3, 3>(kVel, kAccBias) = dt_s * Mat3::Identity();
   } else {
     x.w_p_b += x.w_v_b * dt_s;
   }
+}
+
+ErrMat tdoaOnlyProcess(NavState& x, double dt_s, ProcessModel model) {
+  ErrMat F = ErrMat::Identity();
+  F.block<3, 3>(kPos, kVel) = dt_s * Mat3::Identity();
+  if (model == ProcessModel::kConstantAcceleration) {
+    F.block<3, 3>(kPos, kAccBias) = 0.5 * dt_s * dt_s * Mat3::Identity();
+    F.block<3, 3>(kVel, kAccBias) = dt_s * Mat3::Identity();
+  }
+  tdoaOnlyPredictNominal(x, dt_s, model);
   return F;
 }
 

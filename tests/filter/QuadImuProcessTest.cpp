@@ -3,6 +3,7 @@
  */
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "support/TestSupport.h"
@@ -117,6 +118,77 @@ TEST(AccumulatedTransition, BlockProductEqualsDenseProduct) {
   EXPECT_LT((phi.dense() - dense).cwiseAbs().maxCoeff(), 1e-12);
   const ErrMat M = ErrMat::Random();
   EXPECT_LT((phi.leftMultiply(M) - dense * M).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+TEST(TdoaOnlyPropagation, StructuredEqualsDenseStepByStep) {
+  for (const ProcessModel model : {ProcessModel::kConstantVelocity, ProcessModel::kConstantAcceleration}) {
+    // GIVEN a random SPD covariance and several TDoA-only prediction steps of different lengths
+    EkfParams params;
+    params.process_model = model;
+    Ekf ekf(params);
+    std::mt19937 rng(3);
+    NavState x = randomState(rng);
+    const ErrMat L = ErrMat::Random();
+    const ErrMat P0 = L * L.transpose() + ErrMat::Identity();
+    ekf.initialize(x, P0);
+    ErrMat P_dense = ekf.covariance();
+    const double q = model == ProcessModel::kConstantAcceleration
+                         ? params.ca_jerk_noise_mps3_sqrthz * params.ca_jerk_noise_mps3_sqrthz
+                         : params.cv_acc_noise_mps2_sqrthz * params.cv_acc_noise_mps2_sqrthz;
+    for (const double dt : {0.0025, 0.004, 0.001, 0.0125}) {
+      // WHEN predicting in the filter (pending T, structured fold) and densely per step (F9)
+      ekf.predictTdoaOnly(dt);
+      const ErrMat F = tdoaOnlyProcess(x, dt, model);
+      ErrMat Q = ErrMat::Zero();
+      for (int i = 0; i < 3; ++i) {
+        if (model == ProcessModel::kConstantAcceleration) {
+          Q(kPos + i, kPos + i) = q * std::pow(dt, 5) / 20.0;
+          Q(kPos + i, kVel + i) = Q(kVel + i, kPos + i) = q * std::pow(dt, 4) / 8.0;
+          Q(kPos + i, kAccBias + i) = Q(kAccBias + i, kPos + i) = q * std::pow(dt, 3) / 6.0;
+          Q(kVel + i, kVel + i) = q * std::pow(dt, 3) / 3.0;
+          Q(kVel + i, kAccBias + i) = Q(kAccBias + i, kVel + i) = q * dt * dt / 2.0;
+          Q(kAccBias + i, kAccBias + i) = q * dt;
+        } else {
+          Q(kPos + i, kPos + i) = q * std::pow(dt, 3) / 3.0;
+          Q(kPos + i, kVel + i) = Q(kVel + i, kPos + i) = q * dt * dt / 2.0;
+          Q(kVel + i, kVel + i) = q * dt;
+        }
+      }
+      P_dense = F * P_dense * F.transpose() + Q;
+    }
+    ekf.propagateCovariance();
+    // THEN the covariance and the nominal state agree with the dense step-by-step propagation
+    EXPECT_LT((ekf.covariance() - P_dense).cwiseAbs().maxCoeff(), 1e-12 * P_dense.cwiseAbs().maxCoeff());
+    EXPECT_LT(boxMinus(ekf.state(), x).norm(), 1e-12);
+    EXPECT_DOUBLE_EQ(ekf.pendingDt(), 0.0);
+  }
+}
+
+TEST(ImuPropagation, BlockFoldEqualsDensePhiPPhiT) {
+  // GIVEN a random SPD covariance and several IMU steps
+  EkfParams params;
+  Ekf ekf(params);
+  std::mt19937 rng(17);
+  NavState x = randomState(rng);
+  const ErrMat L = ErrMat::Random();
+  ekf.initialize(x, L * L.transpose() + ErrMat::Identity());
+  const ErrMat P0 = ekf.covariance();
+  AccumulatedTransition phi;
+  for (int k = 0; k < 5; ++k) {
+    const ImuReading imu = randomImu(rng);
+    ekf.predict(imu, 0.002);
+    phi.accumulate(quadImuProcess(x, imu, 0.002, params.accel_model).J);
+    x = quadImuProcess(x, imu, 0.002, params.accel_model).next;
+  }
+  // WHEN folding Φ into P (F7)
+  ekf.propagateCovariance();
+  // THEN the result equals the dense Φ P Φᵀ up to the (diagonal) process noise and is symmetric
+  const ErrMat dense = phi.dense() * P0 * phi.dense().transpose();
+  ErrMat diff = ekf.covariance() - dense;
+  diff.diagonal().setZero();
+  EXPECT_LT(diff.cwiseAbs().maxCoeff(), 1e-12 * dense.cwiseAbs().maxCoeff());
+  EXPECT_LT((ekf.covariance() - ekf.covariance().transpose()).cwiseAbs().maxCoeff(), 1e-12 * dense.cwiseAbs().maxCoeff());
+  EXPECT_TRUE((ekf.covariance().diagonal() - dense.diagonal()).minCoeff() >= 0.0);
 }
 
 TEST(So3, ExpLogRoundTripAndRightJacobian) {

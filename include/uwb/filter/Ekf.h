@@ -90,9 +90,9 @@ class Ekf {
   NavState x_;
   ErrMat P_ = ErrMat::Identity();
   AccumulatedTransition phi_;
-  double pending_cv_dt_s_ = 0.0;  ///< TDoA-only models propagate densely, kept for pendingDt
-  ErrMat phi_cv_ = ErrMat::Identity();
-  ErrMat q_cv_ = ErrMat::Zero();
+  /// TDoA-only models (F9): the pending transition F(T) and noise Q(T) are determined by T alone.
+  double pending_cv_dt_s_ = 0.0;
+  void propagateTdoaOnlyCovariance();
 };
 
 /// The initial covariance from the params' init_* sigmas (F1).

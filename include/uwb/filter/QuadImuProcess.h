@@ -48,6 +48,8 @@ ProcessStep quadImuProcess(const NavState& state, const ImuReading& imu, double 
 /// TDoA-only step (F9): constant velocity (a = 0) or constant acceleration (a held in the b_acc_bias block,
 /// world frame). Attitude and gyro bias are carried unchanged. Returns the dense F.
 ErrMat tdoaOnlyProcess(NavState& state, double dt_s, ProcessModel model);
+/// The nominal part of tdoaOnlyProcess only (no F).
+void tdoaOnlyPredictNominal(NavState& state, double dt_s, ProcessModel model);
 
 /// Error between two nominal states, x1 ⊟ x0 (F1): [p1−p0, v1−v0, Log(q0⁻¹q1), b_a1−b_a0, b_g1−b_g0].
 ErrVec boxMinus(const NavState& x1, const NavState& x0);
