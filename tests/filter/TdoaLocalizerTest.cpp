@@ -166,7 +166,9 @@ TEST(GroundPhase, TdoaOnTheGroundIsIgnoredUntilTakeoff) {
   EXPECT_GT(r.summary.n_tdoa_ground, 700u);
   EXPECT_LT(finalError(r, truth), 0.15);
   for (const LocalizerEstimate& e : r.estimates) {
-    if (e.phase == FlightPhase::kGround) EXPECT_LT(e.x.w_v_b.norm(), 0.1) << "t = " << e.t_s;
+    if (e.phase == FlightPhase::kGround) {
+      EXPECT_LT(e.x.w_v_b.norm(), 0.1) << "t = " << e.t_s;
+    }
   }
 }
 

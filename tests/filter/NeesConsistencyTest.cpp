@@ -1,6 +1,6 @@
-/** @file SlowNeesConsistencyTest.cpp
+/** @file NeesConsistencyTest.cpp
  *  @brief Monte-Carlo consistency (STYLE §10): the position NEES of the filter on simulated hover flights with white
- *         TDoA noise and matched filter noise stays within χ² bounds. Suite `Slow*` (ctest label slow by name).
+ *         TDoA noise and matched filter noise stays within χ² bounds. Runs in ≈0.2 s: in the default suite.
  *
  *  The simulated flights here are generated in the test (the filter's tests link only the filter); the measurement
  *  noise is white, so σ_tdoa is set to its true value (no correlation inflation, F12), and gate/robust loss are off.
@@ -16,7 +16,7 @@
 namespace uwb {
 namespace {
 
-TEST(SlowNeesConsistency, PositionNeesWithinChiSquareBounds) {
+TEST(NeesConsistency, PositionNeesWithinChiSquareBounds) {
   // GIVEN N Monte-Carlo hover flights with white TDoA noise (σ = 0.1 m) and a matched filter
   AnchorTable anchors;
   const Vec3 c[8] = {{-3, -4, 0.2}, {-3, 4, 3}, {3.5, 4, 0.2}, {4, -4, 3}, {-3, -4.2, 3}, {4, -3.8, 0.2}, {4, 4, 3},
