@@ -37,6 +37,11 @@ constexpr double kStillGyro_radps = 0.03;
 constexpr double kStillTau_s = 0.1;
 /// Touchdown: high-passed gyro rms above this [rad/s] (≈40 °/s; flight vibration is 3–10 °/s) (F18).
 constexpr double kTouchdownGyro_radps = 0.45;
+/// Touchdown: the height test uses the lowest estimate of this recent window [s], sampled every 10 ms (F18):
+/// on ground contact the estimate can run away upwards (biased TDoA are gated, the thrust model integrates the
+/// contact force) before the vibration burst is seen.
+constexpr int kTouchdownHistory = 150;
+constexpr double kTouchdownHistoryPeriod_s = 0.01;
 
 }  // namespace
 
@@ -114,6 +119,14 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
   double last_dt_imu = -1.0, ema_factor = 0.0;
   double z_takeoff = p.ground_z_m;
   double t_low_slow = std::numeric_limits<double>::quiet_NaN();
+  // recent estimates (F18 touchdown): ring buffer of (t, p) every 10 ms while tracking
+  struct RecentPosition {
+    double t_s = 0.0;
+    Vec3 w_p_b = Vec3::Zero();
+  };
+  std::vector<RecentPosition> recent(kTouchdownHistory);
+  int n_recent = 0, i_recent = 0;
+  double t_last_recent = -1e300;
   struct PairOffset {
     double offset_m = 0.0;
     double t_last_s = std::numeric_limits<double>::quiet_NaN();
@@ -183,6 +196,7 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
     ekf.inflatePosition(0.0, 0.3);
     z_takeoff = ekf.state().w_p_b.z();
     t_low_slow = std::numeric_limits<double>::quiet_NaN();
+    n_recent = 0;
     if (position_known) {
       phase = FlightPhase::kAcquisition;
       t_acq_end = t + 0.5 * p.acquisition_s;
@@ -315,11 +329,38 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
       // landing (F18): nearly still, or low and slow for landing_hold_s
       if (phase == FlightPhase::kTracking && !std::isnan(sum.takeoff_t_s)) {
         const NavState& x = ekf.state();
+        if (t - t_last_recent >= kTouchdownHistoryPeriod_s) {
+          recent[i_recent] = {t, x.w_p_b};
+          i_recent = (i_recent + 1) % kTouchdownHistory;
+          n_recent = std::min(n_recent + 1, kTouchdownHistory);
+          t_last_recent = t;
+        }
         const bool low_slow = x.w_p_b.z() - z_takeoff < p.landing_height_m && x.w_v_b.norm() < 0.25;
-        // touchdown: the vibration burst of ground contact near the take-off height (F18)
-        const bool touchdown = std::sqrt(gyro_hp_ms) > kTouchdownGyro_radps && x.w_p_b.z() - z_takeoff < 0.8;
+        // touchdown: the vibration burst of ground contact near the take-off height (F18); the height test uses
+        // the lowest recent estimate, since on contact the estimate can already have run away upwards
+        bool touchdown = false;
+        int i_low = -1;
+        if (std::sqrt(gyro_hp_ms) > kTouchdownGyro_radps) {
+          for (int k = 0; k < n_recent; ++k)
+            if (i_low < 0 || recent[k].w_p_b.z() < recent[i_low].w_p_b.z()) i_low = k;
+          touchdown = i_low >= 0 && recent[i_low].w_p_b.z() - z_takeoff < 0.8;
+        }
         if (touchdown) {
-          sum.landing_t_s = t;
+          // hold the position of the lowest recent estimate at the take-off height, and rewrite the outputs since
+          // then (as the ground-phase outputs are rewritten after multilateration, F16)
+          const double t_touch = recent[i_low].t_s;
+          const Vec3 w_p_land(recent[i_low].w_p_b.x(), recent[i_low].w_p_b.y(), z_takeoff);
+          ErrVec dx = ErrVec::Zero();
+          dx.segment<3>(kPos) = w_p_land - x.w_p_b;
+          dx.segment<3>(kVel) = -x.w_v_b;
+          ekf.inject(dx);
+          for (auto it = result.estimates.rbegin(); it != result.estimates.rend() && it->t_s >= t_touch; ++it) {
+            it->x.w_p_b = w_p_land;
+            it->x.w_v_b.setZero();
+            it->phase = FlightPhase::kLanded;
+          }
+          n_recent = 0;
+          sum.landing_t_s = t_touch;
           enterGround(FlightPhase::kLanded);
         } else if (still || low_slow) {
           if (std::isnan(t_low_slow)) t_low_slow = t;
