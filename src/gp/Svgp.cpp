@@ -303,6 +303,8 @@ SvgpPredictor::SvgpPredictor(const Svgp& gp)
   Q_.selfadjointView<Eigen::Lower>().rankUpdate(G, 1.0);
   Q_.selfadjointView<Eigen::Lower>().rankUpdate(Li, -1.0);
   Q_ = Q_.selfadjointView<Eigen::Lower>();
+  Qu_ = (2.0 * Q_).triangularView<Eigen::StrictlyUpper>();
+  Qu_.diagonal() = Q_.diagonal();
   kdiag_ = kernel_.diagValue();
 }
 
@@ -324,7 +326,7 @@ SvgpPrediction SvgpPredictor::predict(const MatX& X_raw) const {
     if (tf) Xb = ((Xb.rowwise() - shift_.transpose()).array().rowwise() / scale_.transpose().array()).matrix();
     const MatX Kxz = kernel_.cross(Xb, Z_);  // n×M: columns over Z, vectorized over the block's points
     auto KQb = KQ.topRows(n);
-    KQb.noalias() = Kxz * Q_;  // P20: one GEMM for the variances
+    KQb.noalias() = Kxz * Qu_.triangularView<Eigen::Upper>();  // P20: one triangular product (M²/point)
     p.mean.segment(start, n).noalias() = Kxz * alpha_;
     p.var_f.segment(start, n) = (KQb.array() * Kxz.array()).rowwise().sum();
   }

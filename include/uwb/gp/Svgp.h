@@ -131,6 +131,7 @@ class SvgpPredictor {
   Kernel kernel_;
   MatX Z_;     ///< transformed space
   MatX Q_;     ///< Lz⁻ᵀ (S − I) Lz⁻¹, symmetric M×M
+  MatX Qu_;    ///< upper triangle of Q with the off-diagonal doubled: kᵀQk = kᵀ Qu k (half the flops)
   VecX alpha_; ///< Lz⁻ᵀ m
   double c_ = 0.0, noise_ = 0.0, jitter_ = 0.0, kdiag_ = 0.0;
   VecX shift_, scale_;
