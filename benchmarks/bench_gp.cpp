@@ -7,9 +7,19 @@
  *  Run: build-gp/benchmarks/bench_gp --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
  *  Eigen vectorizes with SSE2 only in the default build; configure with -DCMAKE_CXX_FLAGS=-march=native (whole
  *  project, so every translation unit agrees) for AVX2/FMA, about 2× faster GEMMs.
- *  Measured 2026-11-21 on the shared 2-core EPYC (load ≈ 8, CPU-time medians of 5):
- *    default:        epoch M=30 46 ms, M=170 1.00 s; predict 10k (mean+var) M=170 70 ms, mean only 14 ms
- *    -march=native:  epoch M=30 25 ms, M=170 0.54 s; predict 10k (mean+var) M=170 35 ms, mean only 5.2 ms
+ *  Measured 2026-11-21 on the shared 2-core EPYC (load ≈ 8–10, CPU-time medians of 5):
+ *    before (0552d0b):
+ *      default:        epoch M=30 46 ms, M=170 1.00 s; predict 10k (mean+var) M=170 70 ms, mean only 14 ms;
+ *                      one point M=30/170 1.2/10.5 µs
+ *      -march=native:  epoch M=30 25 ms, M=170 0.54 s; predict 10k (mean+var) M=170 35 ms, mean only 5.2 ms;
+ *                      one point 1.0/7.7 µs
+ *    after (predictor with α and Q, P20; T1 reuse and GEMM kernel gradients in training, P17/P8):
+ *      default:        epoch (Adam) M=30 46 ms, M=170 0.84 s; natgrad M=30 44 ms, M=170 0.86 s;
+ *                      predict 10k (mean+var) M=30 3.9 ms, M=170 35 ms, mean only 14 ms; one point 0.54/6.6 µs
+ *      -march=native:  epoch (Adam) M=30 22 ms, M=170 0.43 s; natgrad M=30 24 ms, M=170 0.42 s;
+ *                      predict 10k (mean+var) M=30 1.7 ms, M=170 17 ms, mean only 4.9 ms; one point 0.32/3.6 µs
+ *    GEMM calibration: 15 GFlop/s (default), 27–30 GFlop/s (native). The 10k/M=170 variance needs 0.29 GFlop
+ *    (M² per point, already halved by the triangular Q_u), so < 10 ms is not reachable on one float64 core here.
  */
 #include <benchmark/benchmark.h>
 
