@@ -26,6 +26,10 @@ void EvaluationCliOptions::addTo(CLI::App& sub) {
   sub.add_option("--epochs", epochs, "Training epochs (0: trainer default)")->capture_default_str();
   sub.add_option("--batch", batch, "Minibatch size (0: trainer default)")->capture_default_str();
   sub.add_option("--threads", threads, "Configurations run in parallel")->capture_default_str();
+  sub.add_option("--inputs", inputs,
+                 "GP inputs of the training data: the uncorrected filter's 'estimate' (as at run time) or the 'truth'")
+      ->check(CLI::IsMember({"estimate", "truth"}))
+      ->capture_default_str();
   sub.add_flag("--no-plots", no_plots, "Write the data and report but do not render PNG figures");
   sub.add_flag("--json", json, "Print one JSON object (results and paths) on stdout");
 }
@@ -36,6 +40,7 @@ EvaluationParams EvaluationCliOptions::toParams() const {
   p.inducing = inducing;
   p.repeats = repeats;
   p.threads = threads;
+  p.dataset.inputs = biasInputSourceFromString(inputs);
   if (epochs > 0) p.train.svgp.epochs = epochs;
   if (batch > 0) p.train.svgp.batch_size = batch;
   return p;

@@ -21,6 +21,7 @@ struct EvaluationCliOptions {
   int epochs = 0;      ///< 0: the trainer's default
   int batch = 0;       ///< 0: the trainer's default
   int threads = 2;
+  std::string inputs = "estimate";  ///< GP inputs of the training data: "estimate" (filter) or "truth"
   bool no_plots = false;
   bool json = false;
   std::string out_dir;

@@ -23,8 +23,8 @@ using nlohmann::json;
 
 struct TrainOptions {
   std::vector<std::string> flights;
-  std::string anchors, kernel = "z1", out;
-  int inducing = 30, epochs = 20, batch = 1024;
+  std::string anchors, kernel = "tdoa", out, inputs = "estimate";
+  int inducing = 100, epochs = 20, batch = 1024;
   std::uint64_t seed = 1;
   double lr = 0.01, lr_inducing = 0.01, natgrad = 0.2, holdout = 0.2;
   double min_z = 0.3, max_abs_error = 1.0;
@@ -54,6 +54,7 @@ void run(const TrainOptions& o) {
   dp.min_z_m = o.min_z;
   dp.max_abs_error_m = o.max_abs_error;
   dp.neighbour_pairs_only = o.neighbour_only;
+  dp.inputs = uwb::biasInputSourceFromString(o.inputs);
   const uwb::BiasDataset data = uwb::buildBiasDataset(flights, survey, dp);
   if (!o.quiet) std::cerr << data.reportText();
 
@@ -125,8 +126,8 @@ void setup(CLI::App& sub) {
   auto o = std::make_shared<TrainOptions>();
   sub.add_option("flights", o->flights, "Training flight CSV files (UTIL layout, with ground-truth pose)")->required()->check(CLI::ExistingFile);
   sub.add_option("--anchors", o->anchors, "Anchor survey (UTIL format)")->required()->check(CLI::ExistingFile);
-  sub.add_option("--kernel", o->kernel, "z1 | z2 | tdoa (paper eq. 7–9), or pair-tdoa | pair-pos (one GP per anchor pair)");
-  sub.add_option("--inducing", o->inducing, "Number of inducing points M (per GP)")->check(CLI::PositiveNumber);
+  sub.add_option("--kernel", o->kernel, "z1 | z2 | tdoa (paper eq. 7–9), or pair-tdoa | pair-pos (one GP per anchor pair)")->capture_default_str();
+  sub.add_option("--inducing", o->inducing, "Number of inducing points M (per GP)")->check(CLI::PositiveNumber)->capture_default_str();
   sub.add_option("--epochs", o->epochs, "Training epochs")->check(CLI::PositiveNumber);
   sub.add_option("--batch", o->batch, "Minibatch size")->check(CLI::PositiveNumber);
   sub.add_option("--seed", o->seed, "Random seed (k-means++, shuffling)");
@@ -137,6 +138,10 @@ void setup(CLI::App& sub) {
   sub.add_option("--min-z", o->min_z, "Exclude samples with ground-truth z below this [m] (on the ground)");
   sub.add_option("--max-abs-error", o->max_abs_error, "Exclude gross outliers |eps| above this [m] (0: off)");
   sub.add_flag("--neighbour-only", o->neighbour_only, "Keep only neighbour anchor pairs");
+  sub.add_option("--inputs", o->inputs,
+                 "GP inputs from the uncorrected filter's 'estimate' (as at run time) or the ground 'truth' pose")
+      ->check(CLI::IsMember({"estimate", "truth"}))
+      ->capture_default_str();
   sub.add_option("--out", o->out, "Output model JSON")->required();
   sub.add_flag("--json", o->json_out, "Print one JSON summary object on stdout");
   sub.add_flag("--quiet", o->quiet, "No progress or exclusion report on stderr");

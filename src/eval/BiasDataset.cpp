@@ -4,6 +4,8 @@
 #include "uwb/eval/BiasDataset.h"
 
 #include <algorithm>
+#include <optional>
+#include <tuple>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -12,6 +14,33 @@
 #include "uwb/io/FlightSummary.h"
 
 namespace uwb {
+
+std::string toString(BiasInputSource source) {
+  return source == BiasInputSource::kGroundTruth ? "truth" : "estimate";
+}
+
+BiasInputSource biasInputSourceFromString(const std::string& name) {
+  if (name == "truth") return BiasInputSource::kGroundTruth;
+  if (name == "estimate") return BiasInputSource::kFilterEstimate;
+  throw std::invalid_argument("unknown GP input source '" + name + "' (known: truth, estimate)");
+}
+
+namespace {
+
+/// Pose of an estimated trajectory at t (linear position, slerp attitude); nullopt outside it or across a gap.
+std::optional<std::pair<Vec3, Quat>> interpolateTrajectory(const Trajectory& traj, double t_s, double max_gap_s) {
+  if (traj.empty() || t_s < traj.front().t_s || t_s > traj.back().t_s) return std::nullopt;
+  const auto hi = std::lower_bound(traj.begin(), traj.end(), t_s,
+                                   [](const TrajectorySample& s, double t) { return s.t_s < t; });
+  if (hi == traj.begin()) return std::make_pair(hi->w_p_b, hi->w_q_b);
+  const auto lo = hi - 1;
+  const double dt = hi->t_s - lo->t_s;
+  if (dt > max_gap_s) return std::nullopt;
+  const double w = dt > 0 ? (t_s - lo->t_s) / dt : 0.0;
+  return std::make_pair(Vec3((1 - w) * lo->w_p_b + w * hi->w_p_b), lo->w_q_b.slerp(w, hi->w_q_b).normalized());
+}
+
+}  // namespace
 
 void BiasDatasetParams::validate() const {
   if (!std::isfinite(min_z_m)) throw std::invalid_argument("BiasDatasetParams.min_z_m must be finite");
@@ -46,6 +75,10 @@ BiasDataset buildBiasDataset(const std::vector<Flight>& flights, const AnchorSur
     rp.airborne_min_z_m = params.min_z_m;
     TdoaResidualReport rr;
     const std::vector<TdoaResidual> residuals = tdoaResiduals(flight, survey, track, rp, &rr);
+    Trajectory estimate;
+    if (params.inputs == BiasInputSource::kFilterEstimate) {
+      estimate = localizeFlight(flight, survey, params.localization).trajectory;
+    }
 
     BiasFlightReport rep;
     rep.source = name;
@@ -82,8 +115,18 @@ BiasDataset buildBiasDataset(const std::vector<Flight>& flights, const AnchorSur
         ++rep.n_outlier;
         continue;
       }
+      Vec3 w_p_b = r.w_p_b;
+      Quat w_q_b = r.w_q_b;
+      if (params.inputs == BiasInputSource::kFilterEstimate) {
+        const auto pose = interpolateTrajectory(estimate, r.t_s, 0.1);
+        if (!pose) {
+          ++rep.n_no_estimate;
+          continue;
+        }
+        std::tie(w_p_b, w_q_b) = *pose;
+      }
       BiasSample s;
-      s.feature = makeTdoaFeature(r.id_a, r.id_b, r.w_p_b, r.w_q_b, survey.position(r.id_a), survey.position(r.id_b));
+      s.feature = makeTdoaFeature(r.id_a, r.id_b, w_p_b, w_q_b, survey.position(r.id_a), survey.position(r.id_b));
       s.error_m = eps;
       s.t_s = r.t_s;
       s.flight = static_cast<int>(fi);
@@ -99,12 +142,14 @@ std::string BiasDataset::reportText() const {
   std::ostringstream os;
   os << "training data (paper eq. 6): rules min_z=" << params.min_z_m << " m, glitch margin=" << params.glitch_margin_s
      << " s, |eps| > " << params.max_abs_error_m << " m, neighbour pairs only=" << (params.neighbour_pairs_only ? "yes" : "no")
+     << ", GP inputs from " << (params.inputs == BiasInputSource::kGroundTruth ? "the ground-truth pose" : "the filter's estimate")
      << "\n";
-  os << "  flight: measurements | unknown anchor | no ground truth | pose glitch | on ground | non-neighbour | outlier | used\n";
+  os << "  flight: measurements | unknown anchor | no ground truth | pose glitch | on ground | non-neighbour | outlier | "
+        "no estimate | used\n";
   for (const auto& f : flights) {
     os << "  " << f.source << ": " << f.n_measurements << " | " << f.n_unknown_anchor << " | " << f.n_no_ground_truth
        << " | " << f.n_pose_glitch << " (" << f.n_pose_glitches_detected << " glitch samples) | " << f.n_on_ground << " | "
-       << f.n_non_neighbour << " | " << f.n_outlier << " | " << f.n_used << "\n";
+       << f.n_non_neighbour << " | " << f.n_outlier << " | " << f.n_no_estimate << " | " << f.n_used << "\n";
   }
   return os.str();
 }

@@ -153,7 +153,9 @@ EvaluationResult runEvaluation(const std::vector<NamedFlight>& train, const std:
   // Training data (paper eq. 6) from the training flights' ground truth.
   std::vector<Flight> train_flights;
   for (const auto& f : train) train_flights.push_back(f.flight);
-  const BiasDataset train_data = buildBiasDataset(train_flights, survey, params.dataset);
+  BiasDatasetParams dataset_params = params.dataset;
+  dataset_params.localization = params.localization;  // estimated GP inputs come from the same filter
+  const BiasDataset train_data = buildBiasDataset(train_flights, survey, dataset_params);
   result.dataset_report = train_data.reportText();
   result.n_train_samples = train_data.samples.size();
   say(fmt::format("training data: {} samples from {} flight(s)", train_data.samples.size(), train.size()));
@@ -161,7 +163,9 @@ EvaluationResult runEvaluation(const std::vector<NamedFlight>& train, const std:
   // Test data for the bias RMSE (ground-truth features), and the uncorrected localization once per flight.
   std::map<std::string, BiasDataset> test_data;
   for (const auto& f : test) {
-    test_data.emplace(f.name, buildBiasDataset({f.flight}, survey, params.dataset));
+    BiasDatasetParams truth_params = params.dataset;  // the bias RMSE on test flights uses ground-truth inputs
+    truth_params.inputs = BiasInputSource::kGroundTruth;
+    test_data.emplace(f.name, buildBiasDataset({f.flight}, survey, truth_params));
     LocalizationRun run = localizeFlight(f.flight, survey, params.localization);
     say(fmt::format("{}: uncorrected airborne RMSE {:.3f} m", f.name, airborneRmse(run, f.name)));
     result.uncorrected.emplace(f.name, std::move(run));

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "uwb/core/Types.h"
+#include "uwb/eval/Localization.h"
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/Flight.h"
 #include "uwb/io/PoseTrack.h"
@@ -21,8 +22,21 @@
 
 namespace uwb {
 
+/// Where the GP inputs of a training sample come from. The target ε always comes from the ground truth (eq. 6).
+enum class BiasInputSource {
+  kGroundTruth,  ///< the ground-truth pose (the paper's reading of eq. 6)
+  /// The uncorrected filter's own estimate on the training flight, as the GP will see it at run time (paper III-D:
+  /// "the Kalman filter was run on the uncorrected data and the actual GP input was computed"). On util-pilot this
+  /// is what makes the correction transfer: the run-time inputs carry the filter's position error (0.2–0.3 m).
+  kFilterEstimate,
+};
+std::string toString(BiasInputSource source);
+BiasInputSource biasInputSourceFromString(const std::string& name);  ///< "truth" | "estimate"
+
 /// The exclusion rules, applied in this order; a sample is counted under the first rule that removes it.
 struct BiasDatasetParams {
+  BiasInputSource inputs = BiasInputSource::kGroundTruth;
+  LocalizationOptions localization;  ///< the filter run for BiasInputSource::kFilterEstimate
   Vec3 b_t_tag = kUtilTagOffset_b;  ///< tag (antenna) offset in the body frame [m]
   double min_z_m = 0.3;             ///< on the ground: ground-truth body z below this is excluded [m]
   double glitch_margin_s = 0.05;    ///< measurements within this time of a rejected (glitch) pose sample [s]
@@ -47,6 +61,7 @@ struct BiasFlightReport {
   std::size_t n_measurements = 0;
   std::size_t n_unknown_anchor = 0;    ///< anchor id missing from the survey
   std::size_t n_no_ground_truth = 0;   ///< outside the pose track or in a pose gap
+  std::size_t n_no_estimate = 0;       ///< outside the filter's trajectory (kFilterEstimate only)
   std::size_t n_pose_glitch = 0;       ///< within glitch_margin_s of a rejected pose sample
   std::size_t n_on_ground = 0;         ///< ground-truth z < min_z_m
   std::size_t n_non_neighbour = 0;     ///< non-neighbour pair (only when neighbour_pairs_only)

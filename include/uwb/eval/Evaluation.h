@@ -25,7 +25,7 @@ struct EvaluationParams {
   std::vector<int> inducing{10, 30, 50, 100, 170};       ///< numbers of inducing points M
   int repeats = 3;                                       ///< trainings per (kernel, M), seeds 1..repeats
   BiasTrainParams train;         ///< preset, num_inducing and seed are set per configuration
-  BiasDatasetParams dataset;     ///< exclusion rules of the training data
+  BiasDatasetParams dataset;     ///< exclusion rules and GP input source of the training data
   LocalizationOptions localization;
   int threads = 2;               ///< configurations trained/localized in parallel
   double figure_rate_hz = 50.0;  ///< decimation of the per-sample error and trajectory figure data
