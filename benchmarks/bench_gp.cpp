@@ -16,7 +16,7 @@
  *    after (predictor with α and Q, P20; T1 reuse and GEMM kernel gradients in training, P17/P8):
  *      default:        epoch (Adam) M=30 46 ms, M=170 0.84 s; natgrad M=30 44 ms, M=170 0.86 s;
  *                      predict 10k (mean+var) M=30 3.9 ms, M=170 35 ms, mean only 14 ms; one point 0.54/6.6 µs
- *      -march=native:  epoch (Adam) M=30 22 ms, M=170 0.43 s; natgrad M=30 24 ms, M=170 0.42 s;
+ *      -march=native:  epoch (Adam) M=30 22 ms, M=170 0.38–0.43 s; natgrad M=30 24 ms, M=170 0.42 s;
  *                      predict 10k (mean+var) M=30 1.7 ms, M=170 17 ms, mean only 4.9 ms; one point 0.32/3.6 µs
  *    GEMM calibration: 15 GFlop/s (default), 27–30 GFlop/s (native). The 10k/M=170 variance needs 0.29 GFlop
  *    (M² per point, already halved by the triangular Q_u), so < 10 ms is not reachable on one float64 core here.
