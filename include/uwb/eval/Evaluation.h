@@ -64,6 +64,7 @@ struct EvaluationResult {
   BiasAngleFigure angle_figure;
   std::string dataset_report;  ///< exclusion counts of the training data
   std::size_t n_train_samples = 0;
+  bool inputs_from_estimate = false;  ///< GP inputs of the training/test data from the filter (else ground truth)
   double seconds = 0.0;
 };
 
