@@ -16,15 +16,17 @@ from uwbtdoa import plots
 
 repo = pathlib.Path(__file__).resolve().parents[1]
 pilot = pathlib.Path(os.environ.get("UWBTDOA_DATA", repo.parent / "shared" / "data")) / "real" / "util-pilot"
-train_name, test_name = (sys.argv[1:3] if len(sys.argv) > 2 else ("0425-traj6", "0425-traj2"))
+train_name, test_name = (sys.argv[1:3] if len(sys.argv) > 2 else ("0425-traj6,0425-traj7,0425-traj8,0425-traj9",
+                                                                   "0425-traj2"))
 out = pathlib.Path(sys.argv[3] if len(sys.argv) > 3 else "paper_experiment_out")
 out.mkdir(exist_ok=True)
 flight = lambda name: u.read_flight_csv(str(pilot / name[:4] / f"{name}.csv"), required=["tdoa", "pose"])
 survey = u.read_anchor_survey(str(pilot / "survey" / f"anchor_{train_name[:4]}_survey.txt"))
 train, test = [flight(n) for n in train_name.split(",")], flight(test_name)
 
-data = u.build_bias_dataset(train, survey)                       # GP targets ε (eq. 6) and inputs
-model, report = u.train_bias_model(data, "tdoa", num_inducing=30, seed=1)
+# GP targets ε (eq. 6) from Vicon; GP inputs from the uncorrected filter, as the GP will see them at run time
+data = u.build_bias_dataset(train, survey, inputs="estimate")
+model, report = u.train_bias_model(data, "tdoa", num_inducing=100, seed=1)
 print(f"trained on {train_name}: {report['n_train']} samples, held-out bias RMSE "
       f"{report['bias_rmse_before_m']:.3f} -> {report['bias_rmse_after_m']:.3f} m")
 

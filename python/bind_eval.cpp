@@ -153,10 +153,11 @@ BiasDatasetParams datasetParams(const py::kwargs& kw) {
     else if (n == "glitch_margin_s") p.glitch_margin_s = py::cast<double>(value);
     else if (n == "max_abs_error_m") p.max_abs_error_m = py::cast<double>(value);
     else if (n == "neighbour_pairs_only") p.neighbour_pairs_only = py::cast<bool>(value);
+    else if (n == "inputs") p.inputs = biasInputSourceFromString(py::cast<std::string>(value));
     else
       throw std::invalid_argument("unknown dataset parameter '" + n +
                                   "' (known: b_t_tag, min_z_m, glitch_margin_s, max_abs_error_m, "
-                                  "neighbour_pairs_only)");
+                                  "neighbour_pairs_only, inputs)");
   }
   p.validate();
   return p;
@@ -287,7 +288,8 @@ void bindEval(py::module_& m) {
       },
       py::arg("flights"), py::arg("survey"),
       "Training data from flights with ground-truth pose and orientation. Keyword arguments override\n"
-      "BiasDatasetParams (min_z_m, glitch_margin_s, max_abs_error_m, neighbour_pairs_only, b_t_tag).");
+      "BiasDatasetParams (min_z_m, glitch_margin_s, max_abs_error_m, neighbour_pairs_only, b_t_tag, "
+      "inputs='truth'|'estimate': GP inputs from the ground truth or from the uncorrected filter).");
 
   m.def("bias_preset_names", &BiasPreset::names, "Bias-model presets: z1, z2, tdoa (paper) and extras.");
   m.def(
