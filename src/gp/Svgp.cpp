@@ -4,7 +4,12 @@
 #include "uwb/gp/Svgp.h"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
+#include <exception>
+#include <thread>
+#include <utility>
+#include <vector>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -310,44 +315,86 @@ SvgpPredictor::SvgpPredictor(const Svgp& gp)
 
 namespace {
 constexpr Eigen::Index kPredictBlock = 256;  ///< rows of test points per kernel block (≈ 350 kB at M = 170)
-}
 
-SvgpPrediction SvgpPredictor::predict(const MatX& X_raw) const {
+/// Runs body(begin, end) over [0, n) split into at most `num_threads` contiguous ranges whose bounds are multiples
+/// of kPredictBlock, so every row falls into the same block, and gets the same floating-point result, whatever
+/// the split. num_threads = 0: one per hardware thread. The first range runs on the calling thread.
+template <class Body>
+void parallelRows(Eigen::Index n, int num_threads, const Body& body) {
+  if (num_threads < 0) throw std::invalid_argument("SVGP predict: num_threads must be >= 0");
+  if (num_threads == 0) num_threads = std::max(1u, std::thread::hardware_concurrency());
+  const Eigen::Index blocks = (n + kPredictBlock - 1) / kPredictBlock;
+  const Eigen::Index parts = std::min<Eigen::Index>(num_threads, blocks);
+  if (parts <= 1) {
+    body(Eigen::Index{0}, n);
+    return;
+  }
+  std::vector<std::thread> workers;
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(parts));
+  auto range = [&](Eigen::Index t) {
+    const Eigen::Index b0 = blocks * t / parts, b1 = blocks * (t + 1) / parts;
+    return std::pair{b0 * kPredictBlock, std::min(n, b1 * kPredictBlock)};
+  };
+  for (Eigen::Index t = 1; t < parts; ++t) {
+    workers.emplace_back([&, t] {
+      try {
+        const auto [b, e] = range(t);
+        body(b, e);
+      } catch (...) {
+        errors[static_cast<std::size_t>(t)] = std::current_exception();
+      }
+    });
+  }
+  try {
+    const auto [b, e] = range(0);
+    body(b, e);
+  } catch (...) {
+    errors[0] = std::current_exception();
+  }
+  for (auto& w : workers) w.join();
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+}  // namespace
+
+void SvgpPredictor::predictRows(const MatX& X_raw, Eigen::Index begin, Eigen::Index end, VecX& mean,
+                                VecX* var_f) const {
   const bool tf = shift_.size() > 0;
-  if (tf && X_raw.cols() != shift_.size()) throw std::invalid_argument("SVGP: input has the wrong number of columns");
-  SvgpPrediction p;
-  const Eigen::Index N = X_raw.rows(), M = Z_.rows();
-  p.mean.resize(N);
-  p.var_f.resize(N);
-  MatX Xb, KQ(kPredictBlock, M);
-  for (Eigen::Index start = 0; start < N; start += kPredictBlock) {
-    const Eigen::Index n = std::min(kPredictBlock, N - start);
+  const Eigen::Index M = Z_.rows();
+  MatX Xb, KQ;
+  if (var_f) KQ.resize(kPredictBlock, M);
+  for (Eigen::Index start = begin; start < end; start += kPredictBlock) {
+    const Eigen::Index n = std::min(kPredictBlock, end - start);
     Xb = X_raw.middleRows(start, n);
     if (tf) Xb = ((Xb.rowwise() - shift_.transpose()).array().rowwise() / scale_.transpose().array()).matrix();
     const MatX Kxz = kernel_.cross(Xb, Z_);  // n×M: columns over Z, vectorized over the block's points
+    mean.segment(start, n).noalias() = Kxz * alpha_;
+    if (!var_f) continue;
     auto KQb = KQ.topRows(n);
-    KQb.noalias() = Kxz * Qu_.triangularView<Eigen::Upper>();  // P20: one triangular product (M²/point)
-    p.mean.segment(start, n).noalias() = Kxz * alpha_;
-    p.var_f.segment(start, n) = (KQb.array() * Kxz.array()).rowwise().sum();
+    KQb.noalias() = Kxz * Qu_.triangularView<Eigen::Upper>();  // P20: one triangular product (M²/2 per point)
+    var_f->segment(start, n) = (KQb.array() * Kxz.array()).rowwise().sum();
   }
+}
+
+SvgpPrediction SvgpPredictor::predict(const MatX& X_raw, int num_threads) const {
+  if (shift_.size() > 0 && X_raw.cols() != shift_.size())
+    throw std::invalid_argument("SVGP: input has the wrong number of columns");
+  SvgpPrediction p;
+  const Eigen::Index N = X_raw.rows();
+  p.mean.resize(N);
+  p.var_f.resize(N);
+  parallelRows(N, num_threads, [&](Eigen::Index b, Eigen::Index e) { predictRows(X_raw, b, e, p.mean, &p.var_f); });
   p.mean.array() += c_;
   p.var_f.array() += kdiag_ + jitter_;
   p.var_y = p.var_f.array() + noise_;
   return p;
 }
 
-VecX SvgpPredictor::predictMean(const MatX& X_raw) const {
-  const bool tf = shift_.size() > 0;
-  if (tf && X_raw.cols() != shift_.size()) throw std::invalid_argument("SVGP: input has the wrong number of columns");
-  const Eigen::Index N = X_raw.rows();
-  VecX mean(N);
-  MatX Xb;
-  for (Eigen::Index start = 0; start < N; start += kPredictBlock) {
-    const Eigen::Index n = std::min(kPredictBlock, N - start);
-    Xb = X_raw.middleRows(start, n);
-    if (tf) Xb = ((Xb.rowwise() - shift_.transpose()).array().rowwise() / scale_.transpose().array()).matrix();
-    mean.segment(start, n).noalias() = kernel_.cross(Xb, Z_) * alpha_;
-  }
+VecX SvgpPredictor::predictMean(const MatX& X_raw, int num_threads) const {
+  if (shift_.size() > 0 && X_raw.cols() != shift_.size())
+    throw std::invalid_argument("SVGP: input has the wrong number of columns");
+  VecX mean(X_raw.rows());
+  parallelRows(X_raw.rows(), num_threads, [&](Eigen::Index b, Eigen::Index e) { predictRows(X_raw, b, e, mean, nullptr); });
   mean.array() += c_;
   return mean;
 }

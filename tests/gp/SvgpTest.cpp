@@ -196,6 +196,33 @@ TEST(SvgpPredictor, BatchedAndSinglePredictionsAgreeWithTheReferencePath) {
   }
 }
 
+TEST(SvgpPredictor, ThreadedPredictionIsBitIdenticalToOneThread) {
+  // GIVEN a model and more test points than one kernel block, with a ragged last block
+  Problem p = makeProblem(12, 1300, 9);
+  p.gp.setInputTransform(VecX::Constant(3, -0.2), VecX::Constant(3, 0.8));
+  const SvgpPredictor pred = p.gp.predictor();
+  const SvgpPrediction one = pred.predict(p.X, 1);
+  const VecX mean_one = pred.predictMean(p.X, 1);
+  // WHEN the rows are split over 2, 3, 7 threads or one per hardware thread (0)
+  for (int threads : {2, 3, 7, 0}) {
+    SCOPED_TRACE(threads);
+    const SvgpPrediction many = pred.predict(p.X, threads);
+    // THEN every value is the same bit for bit (each row is computed in the same block whatever the split)
+    EXPECT_EQ(many.mean, one.mean);
+    EXPECT_EQ(many.var_f, one.var_f);
+    EXPECT_EQ(many.var_y, one.var_y);
+    EXPECT_EQ(pred.predictMean(p.X, threads), mean_one);
+  }
+  // AND the single-point path agrees
+  double mean = 0.0, var = 0.0;
+  pred.predictOne(p.X.row(1299), mean, var);
+  EXPECT_NEAR(mean, one.mean[1299], 1e-12);
+  EXPECT_NEAR(var, one.var_f[1299], 1e-12);
+  // AND a negative thread count and an empty batch are handled
+  EXPECT_THROW(pred.predict(p.X, -1), std::invalid_argument);
+  EXPECT_EQ(pred.predict(MatX(0, 3), 4).mean.size(), 0);
+}
+
 TEST(SvgpModelFile, RoundTripGivesBitIdenticalPredictions) {
   // GIVEN a trained-looking model with an input transform
   Problem p = makeProblem(4);

@@ -122,12 +122,19 @@ class SvgpPredictor {
   explicit SvgpPredictor(const Svgp& gp);
   /// Latent mean and variance (var_f, with ε) at one raw input row; a few microseconds at M ≈ 170.
   void predictOne(const Eigen::Ref<const RowVecX>& x, double& mean, double& var_f) const;
-  SvgpPrediction predict(const MatX& X) const;
+  /// Batch prediction (P20). `num_threads` > 1 splits the rows into that many contiguous ranges, one std::thread
+  /// each (0: one per hardware thread); every row is computed the same way whatever the split, so the result
+  /// does not depend on the thread count. One thread is the default: callers that already run in parallel should
+  /// not oversubscribe.
+  SvgpPrediction predict(const MatX& X, int num_threads = 1) const;
   /// Latent mean only (no variance): O(M) per point after the kernel row, for bulk corrections.
-  VecX predictMean(const MatX& X) const;
+  VecX predictMean(const MatX& X, int num_threads = 1) const;
   double noiseVariance() const { return noise_; }
 
  private:
+  /// Rows [begin, end) of X_raw: mean and, when var_f is non-null, the latent variance (without c, k**, ε).
+  void predictRows(const MatX& X_raw, Eigen::Index begin, Eigen::Index end, VecX& mean, VecX* var_f) const;
+
   Kernel kernel_;
   MatX Z_;     ///< transformed space
   MatX Q_;     ///< Lz⁻ᵀ (S − I) Lz⁻¹, symmetric M×M
