@@ -244,16 +244,18 @@ void bindGp(py::module_& m) {
           "Minibatch ELBO per datum (num_data defaults to len(y)): {elbo, kl, exp_log_lik, exp_log_lik_sum}")
       .def(
           "predict",
-          [](const Svgp& g, const py::handle& X) {
+          [](const Svgp& g, const py::handle& X, int threads) {
             const MatX Xm = toMatX(X, "X", g.inputDim());
             gp::SvgpPrediction p;
             {
               py::gil_scoped_release release;
-              p = g.predictor().predict(Xm);
+              p = g.predictor().predict(Xm, threads);
             }
             return predictionDict(p);
           },
-          py::arg("X"), "Predictions at raw inputs X (N, D): {mean, var_f (latent), var_y (= var_f + noise)}")
+          py::arg("X"), py::arg("threads") = 1,
+          "Predictions at raw inputs X (N, D): {mean, var_f (latent), var_y (= var_f + noise)}. threads > 1 splits "
+          "the rows over that many threads (0: one per core); the result does not depend on it.")
       .def("to_json", [](const Svgp& g) { return g.toJson().dump(); })
       .def_static("from_json", [](const std::string& s) { return Svgp::fromJson(parseJson(s, "SVGP JSON")); })
       .def("save", [](const Svgp& g, const std::string& path) { writeText(g.toJson().dump(1), path); },

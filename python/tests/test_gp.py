@@ -54,6 +54,10 @@ def test_svgp_predicts_and_round_trips_through_json(tmp_path, X):
     np.testing.assert_allclose(q["mean"], p["mean"], rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(q["var_f"], p["var_f"], rtol=1e-12)
     assert np.isfinite(gp.elbo(X, np.sin(X[:, 0]))["elbo"])
+    big = np.tile(X, (20, 1))  # 800 rows: several blocks, so threads really split the work
+    one, two = gp.predict(big), gp.predict(big, threads=2)
+    for key in ("mean", "var_f", "var_y"):
+        np.testing.assert_array_equal(one[key], two[key])
 
 
 def test_svgp_errors(tmp_path, X):
