@@ -66,27 +66,6 @@ py::dict featuresToDict(const std::vector<const TdoaFeature*>& fs) {
 }
 
 // ------------------------------------------------------------------------------------------- parameters
-template <class T>
-using Setters = std::map<std::string, std::function<void(T&, const py::handle&)>>;
-
-template <class T>
-void applyOverrides(T& obj, const Setters<T>& setters, const py::dict& overrides, const std::string& what) {
-  for (const auto& [key, value] : overrides) {
-    const std::string name = py::str(key);
-    const auto it = setters.find(name);
-    if (it == setters.end()) {
-      std::string known;
-      for (const auto& [n, _] : setters) known += (known.empty() ? "" : ", ") + n;
-      throw std::invalid_argument("unknown " + what + " parameter '" + name + "' (known: " + known + ")");
-    }
-    try {
-      it->second(obj, value);
-    } catch (const py::cast_error&) {
-      throw std::invalid_argument(what + " parameter '" + name + "': wrong type");
-    }
-  }
-}
-
 const Setters<EkfParams>& ekfSetters() {
   static const Setters<EkfParams> s = [] {
     Setters<EkfParams> out;
@@ -111,7 +90,7 @@ const Setters<EkfParams>& ekfSetters() {
              {"landing_height_m", &P::landing_height_m}, {"landing_hold_s", &P::landing_hold_s},
              {"acquisition_s", &P::acquisition_s}, {"acquisition_tdoa_sigma_m", &P::acquisition_tdoa_sigma_m},
              {"ground_z_m", &P::ground_z_m}}) {
-      out[n] = [f](P& p, const py::handle& v) { p.*f = py::cast<double>(v); };
+      addField(out, n, f);
     }
     out["robust_iterations"] = [](P& p, const py::handle& v) { p.robust_iterations = py::cast<int>(v); };
     out["has_start_position"] = [](P& p, const py::handle& v) { p.has_start_position = py::cast<bool>(v); };

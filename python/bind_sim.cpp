@@ -18,35 +18,6 @@ namespace {
 
 using namespace uwb::sim;
 
-/// name → setter for one struct; unknown names raise ValueError listing the known ones.
-template <class T>
-using Setters = std::map<std::string, std::function<void(T&, const py::handle&)>>;
-
-template <class T, class F>
-void addField(Setters<T>& s, const std::string& name, F T::*field) {
-  s[name] = [field, name](T& obj, const py::handle& v) {
-    try {
-      obj.*field = py::cast<F>(v);
-    } catch (const py::cast_error&) {
-      throw std::invalid_argument("parameter '" + name + "': wrong type");
-    }
-  };
-}
-
-template <class T>
-void applyOverrides(T& obj, const Setters<T>& setters, const py::dict& overrides, const std::string& what) {
-  for (const auto& [key, value] : overrides) {
-    const std::string name = py::str(key);
-    const auto it = setters.find(name);
-    if (it == setters.end()) {
-      std::string known;
-      for (const auto& [n, _] : setters) known += (known.empty() ? "" : ", ") + n;
-      throw std::invalid_argument("unknown " + what + " parameter '" + name + "' (known: " + known + ")");
-    }
-    it->second(obj, value);
-  }
-}
-
 Setters<TrajectoryParams> trajectorySetters() {
   Setters<TrajectoryParams> s;
   using P = TrajectoryParams;
@@ -80,12 +51,8 @@ Setters<SimParams> simSetters() {
   Setters<SimParams> s;
   const auto sub = [&s](const std::string& prefix, auto member, auto fields) {
     for (const auto& [n, f] : fields) {
-      s[prefix + n] = [member, f, name = prefix + n](SimParams& p, const py::handle& v) {
-        try {
-          (p.*member).*f = py::cast<std::remove_reference_t<decltype((p.*member).*f)>>(v);
-        } catch (const py::cast_error&) {
-          throw std::invalid_argument("parameter '" + name + "': wrong type");
-        }
+      s[prefix + n] = [member, f](SimParams& p, const py::handle& v) {  // cast errors: applyOverrides
+        (p.*member).*f = py::cast<std::remove_reference_t<decltype((p.*member).*f)>>(v);
       };
     }
   };
@@ -117,7 +84,9 @@ Setters<SimParams> simSetters() {
           {"multipath_std_m", &B::multipath_std_m}, {"multipath_length_m", &B::multipath_length_m},
           {"noise_std_m", &B::noise_std_m}, {"outlier_probability", &B::outlier_probability},
           {"outlier_scale_m", &B::outlier_scale_m}, {"outlier_dof", &B::outlier_dof},
-          {"outlier_max_m", &B::outlier_max_m}, {"ground_low_anchor_z_m", &B::ground_low_anchor_z_m},
+          {"outlier_max_m", &B::outlier_max_m}, {"burst_probability", &B::burst_probability},
+          {"burst_length_s", &B::burst_length_s}, {"burst_scale_m", &B::burst_scale_m},
+          {"ground_low_anchor_z_m", &B::ground_low_anchor_z_m},
           {"ground_low_min_m", &B::ground_low_min_m}, {"ground_low_max_m", &B::ground_low_max_m},
           {"ground_high_abs_m", &B::ground_high_abs_m}, {"ground_noise_std_m", &B::ground_noise_std_m},
           {"ground_blend_height_m", &B::ground_blend_height_m}});

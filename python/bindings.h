@@ -12,6 +12,8 @@
 #include <pybind11/stl.h>
 
 #include <Eigen/Core>
+#include <functional>
+#include <map>
 #include <stdexcept>
 #include <string>
 
@@ -141,5 +143,36 @@ void bindGp(py::module_& m);
 void bindSim(py::module_& m);
 void bindGpTrain(py::module_& m);
 void bindEval(py::module_& m);
+
+// ------------------------------------------------------------------------------- parameter structs from dicts
+/// name → setter for one field of a parameter struct (EkfParams, SimParams, ...).
+template <class T>
+using Setters = std::map<std::string, std::function<void(T&, const py::handle&)>>;
+
+/// Registers the plain field `field` under `name`; the value is cast with pybind11.
+template <class T, class F>
+void addField(Setters<T>& s, const std::string& name, F T::*field) {
+  s[name] = [field](T& obj, const py::handle& v) { obj.*field = py::cast<F>(v); };
+}
+
+/// Applies {name: value} overrides; an unknown name raises ValueError listing the known ones, a value of the wrong
+/// type raises ValueError naming the parameter. `what` names the struct in messages ("filter", "simulation").
+template <class T>
+void applyOverrides(T& obj, const Setters<T>& setters, const py::dict& overrides, const std::string& what) {
+  for (const auto& [key, value] : overrides) {
+    const std::string name = py::str(key);
+    const auto it = setters.find(name);
+    if (it == setters.end()) {
+      std::string known;
+      for (const auto& [n, _] : setters) known += (known.empty() ? "" : ", ") + n;
+      throw std::invalid_argument("unknown " + what + " parameter '" + name + "' (known: " + known + ")");
+    }
+    try {
+      it->second(obj, value);
+    } catch (const py::cast_error&) {
+      throw std::invalid_argument(what + " parameter '" + name + "': wrong type");
+    }
+  }
+}
 
 }  // namespace uwb::python

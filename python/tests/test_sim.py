@@ -27,6 +27,12 @@ def test_simulation_is_deterministic_per_seed_and_checks_its_parameters():
     np.testing.assert_array_equal(a, b)
     with pytest.raises(ValueError, match="unknown simulation parameter 'bias.nope'"):
         u.simulate_flight(params={"bias.nope": 1.0})
+    with pytest.raises(ValueError, match="simulation parameter 'bias.burst_scale_m': wrong type"):
+        u.simulate_flight(params={"bias.burst_scale_m": "big"})
+    # the burst fields reach the simulator: no bursts and no spikes change the error
+    calm = u.simulate_flight("zigzag", 20.0, seed=9, params={"bias.burst_probability": 0.0,
+                                                              "bias.outlier_probability": 0.0})
+    assert not np.array_equal(calm["flight"].tdoa["tdoa"], a)
     with pytest.raises(ValueError, match="unknown trajectory 'square'"):
         u.simulate_flight("square")
 
