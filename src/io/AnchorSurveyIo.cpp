@@ -25,31 +25,15 @@ AnchorSurvey readAnchorSurvey(const std::string& path) {
     throw InputError(SourceLocation{path, line, column, field}, msg);
   };
 
-  const char* p = text.data();
-  const char* const end = p + text.size();
-  if (text.size() >= 3 && std::memcmp(p, "\xEF\xBB\xBF", 3) == 0) p += 3;
-  std::size_t line = 0;
-  while (p < end) {
-    const char* b = p;
-    const void* nl = std::memchr(p, '\n', static_cast<std::size_t>(end - p));
-    const char* e = nl != nullptr ? static_cast<const char*>(nl) : end;
-    p = nl != nullptr ? e + 1 : end;
-    ++line;
-    if (e > b && e[-1] == '\r') --e;
+  io_detail::LineCursor lines(text);
+  std::vector<std::string_view> cells;
+  const char* b = nullptr;
+  const char* e = nullptr;
+  while (lines.next(b, e)) {
+    const std::size_t line = lines.line();
     io_detail::trim(b, e);
     if (b == e || *b == '#') continue;  // blank lines and comments
-
-    std::vector<std::string_view> cells;
-    for (const char* c = b;;) {
-      const char* comma = static_cast<const char*>(std::memchr(c, ',', static_cast<std::size_t>(e - c)));
-      const char* ce = comma != nullptr ? comma : e;
-      const char* tb = c;
-      const char* te = ce;
-      io_detail::trim(tb, te);
-      cells.emplace_back(tb, static_cast<std::size_t>(te - tb));
-      if (comma == nullptr) break;
-      c = comma + 1;
-    }
+    io_detail::splitCells(b, e, cells);
     const std::string_view label = cells[0];
     // Label: an<id>_p or an<id>_quat
     int id = 0;
@@ -113,7 +97,7 @@ AnchorSurvey readAnchorSurvey(const std::string& path) {
     }
     survey.anchors.push_back(entry.anchor);  // std::map: sorted by id
   }
-  if (survey.anchors.empty()) fail(line == 0 ? 1 : line, 0, "", "survey holds no anchors");
+  if (survey.anchors.empty()) fail(std::max<std::size_t>(lines.line(), 1), 0, "", "survey holds no anchors");
   return survey;
 }
 

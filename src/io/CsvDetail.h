@@ -10,8 +10,10 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "uwb/core/Error.h"
 
@@ -28,6 +30,49 @@ inline bool isBlank(char c) { return c == ' ' || c == '\t'; }
 inline void trim(const char*& b, const char*& e) {
   while (b < e && isBlank(*b)) ++b;
   while (e > b && isBlank(e[-1])) --e;
+}
+
+/// Walks a text buffer line by line for the readers: skips a leading UTF-8 byte-order mark, strips the '\r' of
+/// CRLF line ends, and counts lines from 1 so that errors can name them.
+class LineCursor {
+ public:
+  explicit LineCursor(std::string_view text) : p_(text.data()), end_(text.data() + text.size()) {
+    if (text.size() >= 3 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) p_ += 3;
+  }
+  /// The next line as [b, e), without its line end; false when the text is exhausted.
+  bool next(const char*& b, const char*& e) {
+    if (p_ >= end_) return false;
+    b = p_;
+    const void* nl = std::memchr(p_, '\n', static_cast<std::size_t>(end_ - p_));
+    e = nl != nullptr ? static_cast<const char*>(nl) : end_;
+    p_ = nl != nullptr ? e + 1 : end_;
+    if (e > b && e[-1] == '\r') --e;
+    ++line_;
+    return true;
+  }
+  /// 1-based number of the line last returned by next() (0 before the first).
+  std::size_t line() const { return line_; }
+  /// The text not yet returned.
+  std::string_view rest() const { return {p_, static_cast<std::size_t>(end_ - p_)}; }
+
+ private:
+  const char* p_;
+  const char* end_;
+  std::size_t line_ = 0;
+};
+
+/// Splits [b, e) at commas into cells trimmed of spaces and tabs (replaces the contents of `cells`).
+inline void splitCells(const char* b, const char* e, std::vector<std::string_view>& cells) {
+  cells.clear();
+  for (const char* c = b;;) {
+    const char* comma = static_cast<const char*>(std::memchr(c, ',', static_cast<std::size_t>(e - c)));
+    const char* tb = c;
+    const char* te = comma != nullptr ? comma : e;
+    trim(tb, te);
+    cells.emplace_back(tb, static_cast<std::size_t>(te - tb));
+    if (comma == nullptr) return;
+    c = comma + 1;
+  }
 }
 
 enum class NumberStatus { kOk, kNotANumber, kOutOfRange, kNonFinite };

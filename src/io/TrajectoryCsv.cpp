@@ -44,38 +44,23 @@ Trajectory readTrajectoryCsv(const std::string& path) {
   const auto fail = [&](std::size_t line, std::size_t column, const std::string& field, const std::string& msg) {
     throw InputError(SourceLocation{path, line, column, field}, msg);
   };
-  const char* p = text.data();
-  const char* const end = p + text.size();
-  std::size_t line = 0;
+  io_detail::LineCursor lines(text);
   std::array<int, 14> col{};  // file column of each trajectory field
   col.fill(-1);
   std::size_t n_cols = 0;
   std::vector<std::string> names;
   Trajectory out;
-  std::vector<std::pair<const char*, const char*>> cells;
-  while (p < end) {
-    const char* b = p;
-    const void* nl = std::memchr(p, '\n', static_cast<std::size_t>(end - p));
-    const char* e = nl != nullptr ? static_cast<const char*>(nl) : end;
-    p = nl != nullptr ? e + 1 : end;
-    ++line;
-    if (e > b && e[-1] == '\r') --e;
+  std::vector<std::string_view> cells;
+  const char* b = nullptr;
+  const char* e = nullptr;
+  while (lines.next(b, e)) {
+    const std::size_t line = lines.line();
     io_detail::trim(b, e);
     if (b == e) continue;
-    cells.clear();
-    for (const char* c = b;;) {
-      const char* comma = static_cast<const char*>(std::memchr(c, ',', static_cast<std::size_t>(e - c)));
-      const char* ce = comma != nullptr ? comma : e;
-      const char* tb = c;
-      const char* te = ce;
-      io_detail::trim(tb, te);
-      cells.emplace_back(tb, te);
-      if (comma == nullptr) break;
-      c = comma + 1;
-    }
+    io_detail::splitCells(b, e, cells);
     if (names.empty()) {  // header
       for (std::size_t i = 0; i < cells.size(); ++i) {
-        names.emplace_back(cells[i].first, cells[i].second);
+        names.emplace_back(cells[i]);
         bool known = false;
         for (std::size_t f = 0; f < kTrajectoryColumns.size(); ++f) {
           if (names.back() == kTrajectoryColumns[f]) {
@@ -97,11 +82,11 @@ Trajectory readTrajectoryCsv(const std::string& path) {
     }
     double v[14];
     for (std::size_t f = 0; f < 14; ++f) {
-      const auto [cb, ce] = cells[static_cast<std::size_t>(col[f])];
-      const auto st = io_detail::parseDouble(cb, ce, v[f]);
+      const std::string_view cell = cells[static_cast<std::size_t>(col[f])];
+      const auto st = io_detail::parseDouble(cell.data(), cell.data() + cell.size(), v[f]);
       if (st != io_detail::NumberStatus::kOk) {
         fail(line, static_cast<std::size_t>(col[f]) + 1, kTrajectoryColumns[f],
-             fmt::format("{}: '{}'", io_detail::describe(st), std::string_view(cb, static_cast<std::size_t>(ce - cb))));
+             fmt::format("{}: '{}'", io_detail::describe(st), cell));
       }
     }
     if (!out.empty() && v[0] < out.back().t_s) {

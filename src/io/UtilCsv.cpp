@@ -224,20 +224,12 @@ Flight parseFlightCsv(std::string_view text, const std::string& source, const Fl
   rep = ReadReport{};
   rep.n_bytes = text.size();
 
-  const char* p = text.data();
-  const char* const end = p + text.size();
-  if (text.size() >= 3 && std::memcmp(p, "\xEF\xBB\xBF", 3) == 0) p += 3;  // UTF-8 BOM
-
+  io_detail::LineCursor lines(text);  // skips a UTF-8 BOM, strips CR
   std::size_t line = 0;
-  const auto nextLine = [&](const char*& b, const char*& e) -> bool {
-    if (p >= end) return false;
-    b = p;
-    const void* nl = std::memchr(p, '\n', static_cast<std::size_t>(end - p));
-    e = nl != nullptr ? static_cast<const char*>(nl) : end;
-    p = nl != nullptr ? e + 1 : end;
-    if (e > b && e[-1] == '\r') --e;
-    ++line;
-    return true;
+  const auto nextLine = [&](const char*& b, const char*& e) {
+    const bool more = lines.next(b, e);
+    line = lines.line();
+    return more;
   };
   const auto failAt = [&](std::size_t at_line, std::size_t column, const std::string& field,
                           const std::string& message) {
@@ -286,7 +278,8 @@ Flight parseFlightCsv(std::string_view text, const std::string& source, const Fl
   const std::size_t n_cols = names.size();
 
   // Capacity: no stream is longer than the number of lines left (one vectorised pass over the buffer).
-  const std::size_t approx_rows = static_cast<std::size_t>(std::count(p, end, '\n')) + 1;
+  const std::string_view rest = lines.rest();
+  const std::size_t approx_rows = static_cast<std::size_t>(std::count(rest.begin(), rest.end(), '\n')) + 1;
   for (Stream s : allStreams()) {
     if (!layout.present[streamIndex(s)]) continue;
     switch (s) {

@@ -51,6 +51,29 @@ TEST(TrajectoryCsv, EmptyTrajectoryRoundTrips) {
   EXPECT_TRUE(readTrajectoryCsv(dir.file("e.csv")).empty());
 }
 
+TEST(TrajectoryCsv, ReadsFilesSavedWithAByteOrderMarkAndCrlfLineEnds) {
+  // GIVEN a trajectory as a spreadsheet program saves it: UTF-8 BOM, CRLF, blanks around cells, a blank line
+  TempDir dir;
+  const std::string path = dir.write("bom.csv",
+                                     "\xEF\xBB\xBFt, x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz\r\n"
+                                     "\r\n"
+                                     "0.5, 1,2,3,0,0,0,1,0.1,0.1,0.1,0,0,0\r\n"
+                                     "0.6,1,2, 3.5 ,0,0,0,1,0.1,0.1,0.1,0,0,0\r\n");
+  // WHEN read
+  const Trajectory t = readTrajectoryCsv(path);
+  // THEN both rows arrive with their values, and an error names the line counted from the file's first line
+  ASSERT_EQ(t.size(), 2u);
+  EXPECT_EQ(t[0].t_s, 0.5);
+  EXPECT_EQ(t[1].w_p_b.z(), 3.5);
+  try {
+    (void)readTrajectoryCsv(dir.write("bad.csv", "\xEF\xBB\xBFt,x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz\r\n\r\n"
+                                                 "0,1,2,3,0,0,0,1,0.1,0.1,0.1,0,0,x\r\n"));
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr(":3:14 (vz)"));
+  }
+}
+
 TEST(TrajectoryCsv, MalformedInputNamesTheLocation) {
   TempDir dir;
   const std::string header = "t,x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz\n";
