@@ -1,0 +1,12 @@
+/** @file eval.h
+ *  @brief Umbrella header of the eval module (STYLE.md, as in albatross and Ceres): every public header of
+ *         include/uwb/eval/, so that one include gives the whole module.
+ */
+#pragma once
+
+#include "uwb/eval/BiasDataset.h"
+#include "uwb/eval/BiasModel.h"
+#include "uwb/eval/Evaluation.h"
+#include "uwb/eval/EvaluationTable.h"
+#include "uwb/eval/Localization.h"
+#include "uwb/eval/TrajectoryMetrics.h"

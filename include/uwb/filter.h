@@ -1,0 +1,16 @@
+/** @file filter.h
+ *  @brief Umbrella header of the filter module (STYLE.md, as in albatross and Ceres): every public header of
+ *         include/uwb/filter/, so that one include gives the whole module.
+ */
+#pragma once
+
+#include "uwb/filter/Ekf.h"
+#include "uwb/filter/EkfParams.h"
+#include "uwb/filter/Multilateration.h"
+#include "uwb/filter/NavState.h"
+#include "uwb/filter/OutlierGate.h"
+#include "uwb/filter/QuadImuProcess.h"
+#include "uwb/filter/SensorEvents.h"
+#include "uwb/filter/StateIndex.h"
+#include "uwb/filter/TdoaLocalizer.h"
+#include "uwb/filter/TdoaUpdate.h"

@@ -1,0 +1,12 @@
+/** @file io.h
+ *  @brief Umbrella header of the io module (STYLE.md, as in albatross and Ceres): every public header of
+ *         include/uwb/io/, so that one include gives the whole module.
+ */
+#pragma once
+
+#include "uwb/io/AnchorSurvey.h"
+#include "uwb/io/Flight.h"
+#include "uwb/io/FlightSummary.h"
+#include "uwb/io/PoseTrack.h"
+#include "uwb/io/TrajectoryCsv.h"
+#include "uwb/io/UtilCsv.h"
