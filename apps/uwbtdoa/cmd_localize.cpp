@@ -61,6 +61,7 @@ void applyConfig(const json& j, uwb::EkfParams& p) {
     else if (key == "ca_jerk_noise_mps3_sqrthz") p.ca_jerk_noise_mps3_sqrthz = num();
     else if (key == "accel_model") p.accel_model = uwb::parseAccelModel(value.get<std::string>());
     else if (key == "ground_accel_model") p.ground_accel_model = uwb::parseAccelModel(value.get<std::string>());
+    else if (key == "takeoff_acc_bias_sigma_mps2") p.takeoff_acc_bias_sigma_mps2 = num();
     else if (key == "process_model") p.process_model = uwb::parseProcessModel(value.get<std::string>());
     else if (key == "init_pos_sigma_m") p.init_pos_sigma_m = num();
     else if (key == "init_vel_sigma_mps") p.init_vel_sigma_mps = num();

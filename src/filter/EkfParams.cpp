@@ -49,6 +49,7 @@ void EkfParams::validate() const {
   requirePositive(landing_height_m, "landing_height_m");
   requirePositive(landing_hold_s, "landing_hold_s");
   requireNonNegative(acquisition_s, "acquisition_s");
+  requireNonNegative(takeoff_acc_bias_sigma_mps2, "takeoff_acc_bias_sigma_mps2");
   requirePositive(acquisition_tdoa_sigma_m, "acquisition_tdoa_sigma_m");
   if (!start_w_p_b.allFinite()) throw std::invalid_argument("EkfParams.start_w_p_b must be finite");
   if (!std::isfinite(ground_z_m)) throw std::invalid_argument("EkfParams.ground_z_m must be finite");

@@ -182,7 +182,7 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
 
   auto enterGround = [&](FlightPhase ph) {
     phase = ph;
-    if (imu_mode) ekf.setAccelModel(AccelModel::kFull);
+    if (imu_mode) ekf.setAccelModel(p.ground_accel_model);  // (F15)
     v_det = 0.0;
   };
 
@@ -194,6 +194,12 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
     dx(kVel + 2) = v_det - ekf.state().w_v_b.z();
     ekf.inject(dx);
     ekf.inflatePosition(0.0, 0.3);
+    if (p.takeoff_acc_bias_sigma_mps2 > 0.0) {
+      // (F20) the thrust-axis accelerometer bias in flight differs from the one learned on the ground
+      ErrMat P = ekf.covariance();
+      P(kAccBias + 2, kAccBias + 2) += p.takeoff_acc_bias_sigma_mps2 * p.takeoff_acc_bias_sigma_mps2;
+      ekf.initialize(ekf.state(), P);
+    }
     z_takeoff = ekf.state().w_p_b.z();
     t_low_slow = std::numeric_limits<double>::quiet_NaN();
     n_recent = 0;

@@ -35,7 +35,11 @@ enum class GroundPhase {
 
 struct EkfParams {
   // --- process noise (continuous-time spectral densities) ---
-  double acc_noise_mps2_sqrthz = 0.2;         ///< accelerometer white noise on v (and vertical in kThrustOnly)
+  /// Accelerometer white noise on v (the vertical channel in kThrustOnly). In flight the thrust-model vertical
+  /// acceleration minus the Vicon one is a constant −0.06…−0.09 m/s² plus 1-s means that scatter by only
+  /// 0.02–0.09 m/s² (util-pilot, incl. Vicon differentiation noise), i.e. ≈ 0.05 m/s²/√Hz; 0.2 let the
+  /// position-dependent TDoA bias pull the height around (z is the largest error axis). docs/math/filter.md F7.
+  double acc_noise_mps2_sqrthz = 0.05;
   double lateral_acc_noise_mps2_sqrthz = 1.0; ///< extra white acceleration on horizontal v (drag, kThrustOnly)
   double gyro_noise_radps_sqrthz = 0.01;      ///< gyroscope white noise on δθ
   double acc_bias_rw_mps3_sqrthz = 0.01;      ///< accelerometer-bias random walk
@@ -44,6 +48,13 @@ struct EkfParams {
   double cv_acc_noise_mps2_sqrthz = 2.0;      ///< TDoA-only constant-velocity model: white acceleration
   double ca_jerk_noise_mps3_sqrthz = 8.0;     ///< TDoA-only constant-acceleration model: white jerk
   AccelModel accel_model = AccelModel::kThrustOnly;
+  /// Accelerometer model on the ground (zero-velocity updates before take-off and after landing, F14–F15).
+  /// kFull (default) levels the attitude from all three axes. On the 0425 logs the motors' spin-up adds
+  /// −0.3…−0.5 g to acc_x while the drone still sits level (Vicon pitch within 1°), so kFull takes off with a 4–9°
+  /// pitch error that decays over 10–20 s; kThrustOnly keeps the attitude within 1° but its take-off detector
+  /// fires 0.3–1 s later (the spurious tilt no longer projects the x offset onto the vertical), the start window
+  /// then sees the climb, and the airborne RMSE got worse (16-flight median 0.261 → 0.276 m with acc noise 0.05).
+  AccelModel ground_accel_model = AccelModel::kFull;
   ProcessModel process_model = ProcessModel::kImu;
 
   // --- initial uncertainty ---
@@ -84,6 +95,11 @@ struct EkfParams {
   double takeoff_acc_mps2 = 0.6;         ///< …or mean vertical specific-force excess over 0.1 s above this
   double landing_height_m = 0.12;        ///< landed: estimate this close to the take-off height …
   double landing_hold_s = 0.5;           ///< … and nearly still for this long
+  /// Added (as a std) to the thrust-axis accelerometer bias at take-off (docs/math/filter.md F20). The bias learned on the ground
+  /// (zero-velocity updates) is not the one in flight: with the motors running the thrust-model residual against
+  /// the Vicon acceleration is −0.06…−0.09 m/s² while the ground estimate is +0.01…+0.04 m/s² (util-pilot), a step
+  /// the bias random walk would need minutes to follow. 0 disables.
+  double takeoff_acc_bias_sigma_mps2 = 0.1;
   double acquisition_s = 1.0;            ///< after take-off: robust, gate-free acquisition window [s]
   double acquisition_tdoa_sigma_m = 0.6; ///< TDoA std used during acquisition
   bool has_start_position = false;       ///< true: start at start_w_p_b instead of multilateration
