@@ -95,10 +95,10 @@ struct EkfParams {
   double takeoff_acc_mps2 = 0.6;         ///< …or mean vertical specific-force excess over 0.1 s above this
   double landing_height_m = 0.12;        ///< landed: estimate this close to the take-off height …
   double landing_hold_s = 0.5;           ///< … and nearly still for this long
-  /// Added (as a std) to the thrust-axis accelerometer bias at take-off (docs/math/filter.md F20). The bias learned on the ground
-  /// (zero-velocity updates) is not the one in flight: with the motors running the thrust-model residual against
-  /// the Vicon acceleration is −0.06…−0.09 m/s² while the ground estimate is +0.01…+0.04 m/s² (util-pilot), a step
-  /// the bias random walk would need minutes to follow. 0 disables.
+  /// Added (as a std) to the thrust-axis accelerometer bias at take-off (docs/math/filter.md F20). The bias learned
+  /// on the ground (zero-velocity updates) is not the one in flight: with the motors running the thrust-model
+  /// residual against the Vicon acceleration is −0.06…−0.09 m/s² while the ground estimate is −0.09…+0.10 m/s²
+  /// (util-pilot; a step of median −0.07 m/s²), which the bias random walk would need minutes to follow. 0 disables.
   double takeoff_acc_bias_sigma_mps2 = 0.1;
   double acquisition_s = 1.0;            ///< after take-off: robust, gate-free acquisition window [s]
   double acquisition_tdoa_sigma_m = 0.6; ///< TDoA std used during acquisition
