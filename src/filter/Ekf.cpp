@@ -53,6 +53,22 @@ ErrMat AccumulatedTransition::leftMultiply(const ErrMat& M) const {
   return out;
 }
 
+ErrMat AccumulatedTransition::rightMultiplyTransposed(const ErrMat& M) const {
+  // Column blocks of M Φᵀ = (Φ Mᵀ)ᵀ: column block j of the result is Σ_k M_{:,k} Φ_jkᵀ; bias columns are copies.
+  // lazyProduct: a 15×3 · 3×3 product is evaluated coefficient-wise in packets along the rows (no GEMM kernel).
+  ErrMat out = M;
+  out.middleCols<3>(kPos).noalias() += T_s * M.middleCols<3>(kVel);
+  out.middleCols<3>(kPos).noalias() += M.middleCols<3>(kAtt).lazyProduct(pos_att.transpose());
+  out.middleCols<3>(kPos).noalias() += M.middleCols<3>(kAccBias).lazyProduct(pos_accbias.transpose());
+  out.middleCols<3>(kPos).noalias() += M.middleCols<3>(kGyroBias).lazyProduct(pos_gyrobias.transpose());
+  out.middleCols<3>(kVel).noalias() += M.middleCols<3>(kAtt).lazyProduct(vel_att.transpose());
+  out.middleCols<3>(kVel).noalias() += M.middleCols<3>(kAccBias).lazyProduct(vel_accbias.transpose());
+  out.middleCols<3>(kVel).noalias() += M.middleCols<3>(kGyroBias).lazyProduct(vel_gyrobias.transpose());
+  out.middleCols<3>(kAtt).noalias() = M.middleCols<3>(kAtt).lazyProduct(att_att.transpose());
+  out.middleCols<3>(kAtt).noalias() += M.middleCols<3>(kGyroBias).lazyProduct(att_gyrobias.transpose());
+  return out;
+}
+
 Ekf::Ekf(const EkfParams& params) : params_(params) {
   params_.validate();
   P_ = initialCovariance(params_);
@@ -148,10 +164,12 @@ void Ekf::propagateTdoaOnlyCovariance() {
 void Ekf::propagateCovariance() {
   if (pending_cv_dt_s_ > 0.0) propagateTdoaOnlyCovariance();
   if (phi_.empty()) return;
-  // docs/math/filter.md (F7): P ← Φ P Φᵀ + Q(T); Φ P Φᵀ = Φ (Φ P)ᵀ since P is symmetric.
-  const ErrMat A = phi_.leftMultiply(P_);
-  const ErrMat At = A.transpose();
-  P_ = phi_.leftMultiply(At);
+  // docs/math/filter.md (F7): P ← Φ P Φᵀ + Q(T); Φ P Φᵀ = (P Φᵀ)ᵀ Φᵀ since P is symmetric: two block
+  // right-multiplications by Φᵀ (column operations, which vectorise along the 15 rows; the same block sums as
+  // Φ (Φ P)ᵀ with row operations).
+  const ErrMat B = phi_.rightMultiplyTransposed(P_);
+  const ErrMat Bt = B.transpose();
+  P_ = phi_.rightMultiplyTransposed(Bt);
   const double T = phi_.T_s;
   P_.diagonal().segment<3>(kVel) += phi_.q_vel_diag;
   P_.diagonal().segment<3>(kPos).array() += params_.pos_noise_m_sqrts * params_.pos_noise_m_sqrts * T;
@@ -171,6 +189,15 @@ std::optional<InnovationStats> Ekf::correct(const ScalarLinearMessage<kDim>& mes
   // Paper Fig. 3: equality node between the predicted error state N(0, P) and the TDoA message (G18).
   ErrVec dx = ErrVec::Zero();
   const std::optional<InnovationStats> st = equalityRankOneInPlace<kDim>(dx, P_, message);
+  if (!st) return std::nullopt;
+  inject(dx);  // (F8)
+  return st;
+}
+
+std::optional<InnovationStats> Ekf::correctPositionAttitude(const ScalarLinearMessage<kDim>& message) {
+  // As correct(); the equality node (G18) skips the velocity and bias columns, where the TDoA row is zero (G16).
+  ErrVec dx = ErrVec::Zero();
+  const std::optional<InnovationStats> st = equalityRankOneTwoBlocksInPlace<kDim>(dx, P_, message, kPos, kAtt);
   if (!st) return std::nullopt;
   inject(dx);  // (F8)
   return st;

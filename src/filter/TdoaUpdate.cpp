@@ -31,6 +31,19 @@ std::vector<int> AnchorTable::ids() const {
 
 std::size_t AnchorTable::size() const { return ids().size(); }
 
+ScalarLinearMessage<kDim> tdoaMessageOnPositionAttitude(const TdoaNodeMessages& node, const Mat3& J_tag_att,
+                                                        const Vec3& w_p_tag) {
+  // (G16) a = B12 C, y = m7 − B12 x̃_k, var = Σ7, with the structure of C = [I 0 J_tag_att 0 0] used directly:
+  // a_p = B12 I = B12, a_θ = B12 J_tag_att, and every other entry of a is zero (no 3×15 C, no 1×3·3×15 product).
+  ScalarLinearMessage<kDim> out;
+  out.a.setZero();
+  out.a.segment<3>(kPos) = node.B12;
+  out.a.segment<3>(kAtt).noalias() = node.B12 * J_tag_att;
+  out.y = node.mu7.m - node.B12.dot(w_p_tag);
+  out.var = node.mu7.V;
+  return out;
+}
+
 std::optional<ScalarLinearMessage<kDim>> tdoaMessage(const NavState& x, const AnchorTable& anchors,
                                                      const TdoaObservation& z, double z_corrected_m, double var_m2,
                                                      const Vec3& b_t_tag) {
@@ -38,16 +51,16 @@ std::optional<ScalarLinearMessage<kDim>> tdoaMessage(const NavState& x, const An
   const Moments3* anchor_b = anchors.find(z.id_b);
   if (!anchor_a || !anchor_b) return std::nullopt;
   // (F10) linearise at the tag position x̃_k = p + R b_t; UTIL convention ⇒ x_i = anchor B, x_j = anchor A.
-  const Vec3 w_p_tag = tagPosition(x.w_p_b, x.w_q_b, b_t_tag);
+  // One rotation matrix serves the tag position (M2) and its attitude Jacobian −R[b_t]× (M4).
+  const Mat3 w_R_b = x.w_q_b.toRotationMatrix();
+  const Vec3 w_p_tag = x.w_p_b + w_R_b * b_t_tag;
   const std::optional<TdoaLinearization> lin = linearizeTdoa(w_p_tag, anchor_b->m, anchor_a->m);
   if (!lin) return std::nullopt;
   // Paper Fig. 2: the TDoA node's forward pass (G11–G13) …
   const TdoaNodeMessages node = tdoaNodeForward(*lin, *anchor_b, *anchor_a, z_corrected_m, var_m2);
   // … and the message on δx through x_k = x̃_k + C δx, C = [I 0 −R[b_t]× 0 0] (G16; model M4).
-  Eigen::Matrix<double, 3, kDim> C = Eigen::Matrix<double, 3, kDim>::Zero();
-  C.block<3, 3>(0, kPos).setIdentity();
-  C.block<3, 3>(0, kAtt) = tagPositionJacobianAttitude(x.w_q_b, b_t_tag);
-  return tdoaMessageOnState<kDim>(node, C, w_p_tag);
+  const Mat3 J_tag_att = -(w_R_b * skew(b_t_tag));  // = tagPositionJacobianAttitude(w_q_b, b_t_tag) (M4)
+  return tdoaMessageOnPositionAttitude(node, J_tag_att, w_p_tag);
 }
 
 TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObservation& z,
@@ -79,15 +92,15 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
   }
   // (F11) χ² gate on the unweighted innovation
   // The message row a = B12 C is non-zero only in the position and attitude blocks, so a P aᵀ needs only the
-  // 6×6 sub-block of P (F11; the same value as innovationOf, G17, at a sixth of the cost).
+  // 6×6 sub-block of P (F11; the same value as innovationOf, G17, at a sixth of the cost), read in place by blocks.
   const ErrMat& P = ekf.covariance();
-  Eigen::Matrix<double, 6, 1> a6;
-  a6 << msg->a.segment<3>(kPos).transpose(), msg->a.segment<3>(kAtt).transpose();
-  Eigen::Matrix<double, 6, 6> P6;
-  P6 << P.block<3, 3>(kPos, kPos), P.block<3, 3>(kPos, kAtt), P.block<3, 3>(kAtt, kPos), P.block<3, 3>(kAtt, kAtt);
+  const Vec3 a_p = msg->a.segment<3>(kPos).transpose();
+  const Vec3 a_att = msg->a.segment<3>(kAtt).transpose();
+  const Vec3 Pa_p = P.block<3, 3>(kPos, kPos) * a_p + P.block<3, 3>(kPos, kAtt) * a_att;
+  const Vec3 Pa_att = P.block<3, 3>(kAtt, kPos) * a_p + P.block<3, 3>(kAtt, kAtt) * a_att;
   InnovationStats st;
   st.innovation_m = msg->y;  // prior error state is zero
-  st.innovation_var_m2 = a6.dot(P6 * a6) + msg->var;
+  st.innovation_var_m2 = a_p.dot(Pa_p) + a_att.dot(Pa_att) + msg->var;
   st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
   res.innovation_m = st.innovation_m;
   res.nis = st.nis;
@@ -100,7 +113,7 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
   res.weight = robustUpdateWeight(options.loss, options.robust_k, st.innovation_m, hph, msg->var,
                                   options.robust_iterations);
   msg->var /= res.weight;
-  if (!ekf.correct(*msg)) {
+  if (!ekf.correctPositionAttitude(*msg)) {  // the TDoA row touches only δp and δθ (G16)
     res.outcome = UpdateOutcome::kDegenerate;
     return res;
   }

@@ -38,6 +38,9 @@ struct AccumulatedTransition {
   ErrMat dense() const;
   /// Returns Φ M for a 15×15 M using the block structure.
   ErrMat leftMultiply(const ErrMat& M) const;
+  /// Returns M Φᵀ for a 15×15 M using the block structure, as column operations (contiguous in Eigen's column-major
+  /// storage, so each 15×3 · 3×3 block product vectorises along the 15 rows).
+  ErrMat rightMultiplyTransposed(const ErrMat& M) const;
   bool empty() const { return T_s == 0.0; }
 };
 
@@ -66,6 +69,9 @@ class Ekf {
   /// equality node (G18), followed by the reset (F8). Returns nullopt and leaves the filter unchanged if the
   /// equality node fails (S ≤ 0 or not finite).
   std::optional<InnovationStats> correct(const ScalarLinearMessage<kDim>& message);
+  /// correct() for a message whose row is zero outside the position and attitude blocks (a TDoA message,
+  /// a = B12 C, G16): the equality node then reads only those 6 columns of P (equalityRankOneTwoBlocksInPlace).
+  std::optional<InnovationStats> correctPositionAttitude(const ScalarLinearMessage<kDim>& message);
   /// Innovation statistics of a message without applying it (G17).
   InnovationStats innovation(const ScalarLinearMessage<kDim>& message) const;
 

@@ -63,6 +63,12 @@ std::optional<ScalarLinearMessage<kDim>> tdoaMessage(const NavState& x, const An
                                                      const TdoaObservation& z, double z_corrected_m, double var_m2,
                                                      const Vec3& b_t_tag);
 
+/// (G16) The TDoA node's message on the error state through x_k = x̃_k + C δx for the tag Jacobian
+/// C = [I 0 J_tag_att 0 0] (J_tag_att = ∂x_k/∂δθ = −R[b_t]×, M4): the same message as tdoaMessageOnState<kDim> with
+/// that dense C, built from C's two non-zero blocks. The returned row is zero outside δp and δθ.
+ScalarLinearMessage<kDim> tdoaMessageOnPositionAttitude(const TdoaNodeMessages& node, const Mat3& J_tag_att,
+                                                        const Vec3& w_p_tag);
+
 /// Full TDoA update of `ekf` (F10–F13). The covariance should be propagated (Ekf::propagateCovariance) by the
 /// caller according to its schedule. `bias` may be null (no bias correction).
 TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObservation& z,

@@ -85,20 +85,16 @@ InnovationStats innovationOf(const ScalarLinearMessage<N>& msg, const Eigen::Mat
   return st;
 }
 
-/// (G18) Equality node combining the prior N(m, V) (moment form) with a rank-one message, Kalman-gain form
-/// (Table 4), Joseph-equivalent covariance update, in place. V must be symmetric (it then stays exactly symmetric). Returns the innovation statistics, or nullopt (and leaves m, V
-/// untouched) when S ≤ 0 or anything is not finite.
+namespace detail {
+
+/// Tail of the (G18) equality node once u = V aᵀ and a m are known: innovation statistics, m⁺ = m + K r, V⁺ = V − w wᵀ.
 template <int N>
-std::optional<InnovationStats> equalityRankOneInPlace(Eigen::Matrix<double, N, 1>& m, Eigen::Matrix<double, N, N>& V,
-                                                      const ScalarLinearMessage<N>& msg) {
-  // u = V aᵀ, skipping the zero entries of a (a = B12 C touches only the position and attitude blocks).
-  Eigen::Matrix<double, N, 1> u = Eigen::Matrix<double, N, 1>::Zero(V.rows());
-  for (Eigen::Index c = 0; c < V.cols(); ++c) {
-    if (msg.a[c] != 0.0) u.noalias() += V.col(c) * msg.a[c];
-  }
+std::optional<InnovationStats> applyRankOneGain(Eigen::Matrix<double, N, 1>& m, Eigen::Matrix<double, N, N>& V,
+                                                const ScalarLinearMessage<N>& msg, const Eigen::Matrix<double, N, 1>& u,
+                                                double a_m, double a_u) {
   InnovationStats st;
-  st.innovation_m = msg.y - msg.a.dot(m.transpose());
-  st.innovation_var_m2 = msg.a.dot(u.transpose()) + msg.var;
+  st.innovation_m = msg.y - a_m;
+  st.innovation_var_m2 = a_u + msg.var;
   if (!(st.innovation_var_m2 > 0.0) || !std::isfinite(st.innovation_var_m2) || !std::isfinite(st.innovation_m)) {
     return std::nullopt;
   }
@@ -108,9 +104,44 @@ std::optional<InnovationStats> equalityRankOneInPlace(Eigen::Matrix<double, N, 1
   // Joseph form (I − K a) V (I − K a)ᵀ + K var Kᵀ = V − K uᵀ − u Kᵀ + S K Kᵀ, which for the optimal rank-one gain
   // K = u/S equals V − u uᵀ/S = V − w wᵀ with w = u/√S. Evaluated as w wᵀ, element (i, j) and (j, i) are the same
   // floating-point product, so a symmetric V stays exactly symmetric without a mirror pass.
-  const Eigen::Matrix<double, N, 1> w = u / std::sqrt(S);
+  const Eigen::Matrix<double, N, 1> w = u * (1.0 / std::sqrt(S));
   V.noalias() -= w * w.transpose();
   return st;
+}
+
+}  // namespace detail
+
+/// (G18) Equality node combining the prior N(m, V) (moment form) with a rank-one message, Kalman-gain form
+/// (Table 4), Joseph-equivalent covariance update, in place. V must be symmetric (it then stays exactly symmetric). Returns the innovation statistics, or nullopt (and leaves m, V
+/// untouched) when S ≤ 0 or anything is not finite.
+template <int N>
+std::optional<InnovationStats> equalityRankOneInPlace(Eigen::Matrix<double, N, 1>& m, Eigen::Matrix<double, N, N>& V,
+                                                      const ScalarLinearMessage<N>& msg) {
+  // u = V aᵀ, skipping the zero entries of a.
+  Eigen::Matrix<double, N, 1> u = Eigen::Matrix<double, N, 1>::Zero(V.rows());
+  for (Eigen::Index c = 0; c < V.cols(); ++c) {
+    if (msg.a[c] != 0.0) u.noalias() += V.col(c) * msg.a[c];
+  }
+  return detail::applyRankOneGain<N>(m, V, msg, u, msg.a.dot(m.transpose()), msg.a.dot(u.transpose()));
+}
+
+/// (G18) The same equality node for a message whose row a is zero outside the two 3-blocks starting at b0 and b1
+/// (a TDoA message a = B12 C touches only δp and δθ, G16). Exploits that sparsity: u = V aᵀ and a m are formed from
+/// those 6 columns / entries only (fixed-size 15×3 blocks, no per-column test); the O(N²) rank-one downdate is
+/// unchanged. Equal to equalityRankOneInPlace up to floating-point summation order. Precondition: a is zero
+/// outside [b0, b0+3) ∪ [b1, b1+3).
+template <int N>
+std::optional<InnovationStats> equalityRankOneTwoBlocksInPlace(Eigen::Matrix<double, N, 1>& m,
+                                                               Eigen::Matrix<double, N, N>& V,
+                                                               const ScalarLinearMessage<N>& msg, int b0, int b1) {
+  const Vec3 a0 = msg.a.template segment<3>(b0).transpose();
+  const Vec3 a1 = msg.a.template segment<3>(b1).transpose();
+  Eigen::Matrix<double, N, 1> u;
+  u.noalias() = V.template middleCols<3>(b0) * a0;
+  u.noalias() += V.template middleCols<3>(b1) * a1;
+  const double a_m = a0.dot(m.template segment<3>(b0)) + a1.dot(m.template segment<3>(b1));
+  const double a_u = a0.dot(u.template segment<3>(b0)) + a1.dot(u.template segment<3>(b1));
+  return detail::applyRankOneGain<N>(m, V, msg, u, a_m, a_u);
 }
 
 /// (G16–G18) The whole correction step of Fig. 3 for one TDoA, by value.
