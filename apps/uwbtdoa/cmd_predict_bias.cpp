@@ -1,8 +1,12 @@
 /** @file cmd_predict_bias.cpp
  *  @brief `uwbtdoa predict-bias FLIGHT.csv --anchors SURVEY.txt --model MODEL.json --out OUT.csv [--json]`
  *
- *  Applies a bias model (eval/BiasModel.h) to every TDoA measurement that has ground truth (features from the
- *  interpolated ground-truth pose) and writes t, ids, measured TDoA, ε (paper eq. 6), predicted mean and std.
+ *  Applies a bias model (eval/BiasModel.h) to every TDoA measurement that has ground truth and writes t, ids,
+ *  measured TDoA, ε (paper eq. 6), predicted mean and std. GP inputs (--inputs): "truth" = the interpolated
+ *  ground-truth pose (every measurement, airborne flag), "estimate" = the uncorrected filter's estimate on this
+ *  flight, as at run time (only the samples of the training-data rules, eval/BiasDataset.h). The default is the
+ *  source the model was trained with (its file's "training.inputs"), else "truth". A model trained on estimated
+ *  inputs must be scored on estimated inputs: on ground-truth inputs its bias RMSE does not drop.
  */
 #include <fmt/format.h>
 
@@ -13,6 +17,7 @@
 
 #include "Command.h"
 #include "uwb/core/Error.h"
+#include "uwb/eval/BiasDataset.h"
 #include "uwb/eval/BiasModel.h"
 #include "uwb/io/PoseTrack.h"
 #include "uwb/io/UtilCsv.h"
@@ -22,6 +27,7 @@ namespace {
 struct Options {
   std::string flight, anchors, model, out;
   double min_z = 0.3;
+  std::string inputs;  ///< "" = from the model file, else "truth" | "estimate"
   bool json_out = false;
 };
 
@@ -34,14 +40,36 @@ void run(const Options& o) {
     throw uwb::InputError(uwb::SourceLocation{o.flight, 0, 0, "pose_qw"},
                           "predict-bias needs the ground-truth pose with orientation to compute the GP features");
   const uwb::BiasModel model = uwb::BiasModel::load(o.model);
-  const uwb::PoseTrack track(flight);
-  const auto residuals = uwb::tdoaResiduals(flight, survey, track);
-
+  std::string inputs = o.inputs;
+  if (inputs.empty()) {
+    const auto meta = nlohmann::json::parse(model.metadata_json, nullptr, false);
+    inputs = meta.is_object() && meta.contains("inputs") ? meta.at("inputs").get<std::string>() : "truth";
+  }
+  const uwb::BiasInputSource source = uwb::biasInputSourceFromString(inputs);
   std::ofstream out(o.out);
   if (!out) throw uwb::FileError("cannot write '" + o.out + "'");
   out << "t,idA,idB,tdoa_meas,error_m,bias_mean_m,bias_std_m,airborne\n";
   double se_b = 0, se_a = 0;
-  std::size_t n_air = 0;
+  std::size_t n_air = 0, n_rows = 0;
+  if (source == uwb::BiasInputSource::kFilterEstimate) {
+    uwb::BiasDatasetParams dp;
+    dp.inputs = source;
+    dp.min_z_m = o.min_z;
+    const uwb::BiasDataset data = uwb::buildBiasDataset({flight}, survey, dp);
+    for (const auto& smp : data.samples) {
+      const uwb::BiasPrediction p = model.predict(smp.feature);
+      out << fmt::format("{:.6f},{},{},,{:.7g},{:.7g},{:.7g},1\n", smp.t_s, smp.feature.id_a, smp.feature.id_b,
+                         smp.error_m, p.mean_m, std::sqrt(p.variance_m2));
+      ++n_air;
+      se_b += smp.error_m * smp.error_m;
+      se_a += (smp.error_m - p.mean_m) * (smp.error_m - p.mean_m);
+    }
+    n_rows = data.samples.size();
+  }
+  const uwb::PoseTrack track(flight);
+  const auto residuals =
+      source == uwb::BiasInputSource::kGroundTruth ? uwb::tdoaResiduals(flight, survey, track) : std::vector<uwb::TdoaResidual>{};
+  if (source == uwb::BiasInputSource::kGroundTruth) n_rows = residuals.size();
   for (const auto& r : residuals) {
     const uwb::TdoaFeature f = uwb::makeTdoaFeature(r.id_a, r.id_b, r.w_p_b, r.w_q_b, survey.position(r.id_a), survey.position(r.id_b));
     const uwb::BiasPrediction p = model.predict(f);
@@ -57,14 +85,16 @@ void run(const Options& o) {
   if (!out) throw uwb::FileError("error while writing '" + o.out + "'");
   const double before = n_air ? std::sqrt(se_b / n_air) : std::nan(""), after = n_air ? std::sqrt(se_a / n_air) : std::nan("");
   if (o.json_out) {
-    std::cout << nlohmann::json{{"flight", o.flight}, {"model", o.model}, {"n_rows", residuals.size()},
+    std::cout << nlohmann::json{{"flight", o.flight}, {"model", o.model}, {"inputs", inputs}, {"n_rows", n_rows},
                                 {"n_airborne", n_air}, {"bias_rmse_before_m", before}, {"bias_rmse_after_m", after},
                                 {"out", o.out}}
                      .dump()
               << '\n';
   } else {
-    std::cout << fmt::format("{} rows written to {}; airborne (|eps| ≤ 1 m, {} samples) bias RMSE before {:.4f} m, after {:.4f} m\n",
-                             residuals.size(), o.out, n_air, before, after);
+    std::cout << fmt::format("{} rows written to {}; GP inputs from the {}; airborne (|eps| ≤ 1 m, {} samples) bias RMSE "
+                             "before {:.4f} m, after {:.4f} m\n",
+                             n_rows, o.out, inputs == "truth" ? "ground truth" : "uncorrected filter's estimate", n_air,
+                             before, after);
   }
 }
 
@@ -75,6 +105,9 @@ void setup(CLI::App& sub) {
   sub.add_option("--model", o->model, "Bias model JSON from `uwbtdoa train`")->required()->check(CLI::ExistingFile);
   sub.add_option("--out", o->out, "Output CSV")->required();
   sub.add_option("--min-z", o->min_z, "Airborne threshold for the summary [m]");
+  sub.add_option("--inputs", o->inputs,
+                 "GP inputs: 'truth' (ground-truth pose) or 'estimate' (uncorrected filter); default: as in training")
+      ->check(CLI::IsMember({"truth", "estimate"}));
   sub.add_flag("--json", o->json_out, "Print one JSON summary object on stdout");
   sub.callback([o] { run(*o); });
 }

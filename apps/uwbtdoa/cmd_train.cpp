@@ -24,9 +24,9 @@ using nlohmann::json;
 struct TrainOptions {
   std::vector<std::string> flights;
   std::string anchors, kernel = "tdoa", out, inputs = "estimate";
-  int inducing = 100, epochs = 20, batch = 1024;
+  int inducing = 100, epochs = 20, batch = 1024, passes = 1;
   std::uint64_t seed = 1;
-  double lr = 0.01, lr_inducing = 0.01, natgrad = 0.2, holdout = 0.2;
+  double lr = 0.01, lr_inducing = 0.01, natgrad = 0.2, holdout = 0.2, extra_sigma = uwb::BiasTrainParams{}.extra_sigma_m;
   double min_z = 0.3, max_abs_error = 1.0;
   bool neighbour_only = false, json_out = false, quiet = false;
 };
@@ -55,7 +55,7 @@ void run(const TrainOptions& o) {
   dp.max_abs_error_m = o.max_abs_error;
   dp.neighbour_pairs_only = o.neighbour_only;
   dp.inputs = uwb::biasInputSourceFromString(o.inputs);
-  const uwb::BiasDataset data = uwb::buildBiasDataset(flights, survey, dp);
+  uwb::BiasDataset data = uwb::buildBiasDataset(flights, survey, dp);
   if (!o.quiet) std::cerr << data.reportText();
 
   uwb::BiasTrainParams tp;
@@ -68,8 +68,18 @@ void run(const TrainOptions& o) {
   tp.svgp.lr = o.lr;
   tp.svgp.lr_inducing = o.lr_inducing;
   tp.svgp.natgrad_step = o.natgrad;
+  tp.extra_sigma_m = o.extra_sigma;
   uwb::BiasTrainReport rep;
   uwb::BiasModel model = uwb::trainBiasModel(data, tp, &rep, o.quiet ? uwb::BiasTrainProgress{} : uwb::BiasTrainProgress{progressBar});
+  // docs/math/gp.md (P30): further passes take the GP inputs from the filter corrected by the previous pass's model
+  for (int pass = 2; pass <= o.passes; ++pass) {
+    if (dp.inputs != uwb::BiasInputSource::kFilterEstimate)
+      throw std::invalid_argument("--passes > 1 needs --inputs estimate");
+    dp.estimate_bias = model.predictor();
+    data = uwb::buildBiasDataset(flights, survey, dp);
+    if (!o.quiet) std::cerr << "pass " << pass << ": GP inputs from the filter corrected by pass " << pass - 1 << '\n';
+    model = uwb::trainBiasModel(data, tp, &rep, o.quiet ? uwb::BiasTrainProgress{} : uwb::BiasTrainProgress{progressBar});
+  }
 
   json hyper = json::object();
   for (const auto& e : model.entries()) {
@@ -83,6 +93,9 @@ void run(const TrainOptions& o) {
                {"epochs", o.epochs},
                {"batch", o.batch},
                {"seed", o.seed},
+               {"passes", o.passes},
+               {"inputs", o.inputs},
+               {"extra_sigma_m", o.extra_sigma},
                {"flights", o.flights},
                {"n_train", rep.n_train},
                {"n_holdout", rep.n_holdout},
@@ -126,10 +139,16 @@ void setup(CLI::App& sub) {
   auto o = std::make_shared<TrainOptions>();
   sub.add_option("flights", o->flights, "Training flight CSV files (UTIL layout, with ground-truth pose)")->required()->check(CLI::ExistingFile);
   sub.add_option("--anchors", o->anchors, "Anchor survey (UTIL format)")->required()->check(CLI::ExistingFile);
-  sub.add_option("--kernel", o->kernel, "z1 | z2 | tdoa (paper eq. 7–9), or pair-tdoa | pair-pos (one GP per anchor pair)")->capture_default_str();
+  sub.add_option("--kernel", o->kernel, "z1 | z2 | tdoa (paper eq. 7–9), pair-tdoa | pair-pos (one GP per anchor pair), tdoa-pm | anchor-tdoa | anchor-tdoa-pm (per-pair mean / anchor-specific eq. 9, docs/math/gp.md P28–P29)")->capture_default_str();
   sub.add_option("--inducing", o->inducing, "Number of inducing points M (per GP)")->check(CLI::PositiveNumber)->capture_default_str();
   sub.add_option("--epochs", o->epochs, "Training epochs")->check(CLI::PositiveNumber);
   sub.add_option("--batch", o->batch, "Minibatch size")->check(CLI::PositiveNumber);
+  sub.add_option("--passes", o->passes,
+                 "Training passes; pass k > 1 takes the GP inputs from the filter corrected by pass k-1's model")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  sub.add_option("--extra-sigma", o->extra_sigma,
+                 "Std [m] added in quadrature to the filter's TDoA noise when the correction is on (docs/math/gp.md P31)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   sub.add_option("--seed", o->seed, "Random seed (k-means++, shuffling)");
   sub.add_option("--lr", o->lr, "Adam learning rate of the hyperparameters");
   sub.add_option("--lr-inducing", o->lr_inducing, "Adam learning rate of the inducing points");

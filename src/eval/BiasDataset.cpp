@@ -77,7 +77,7 @@ BiasDataset buildBiasDataset(const std::vector<Flight>& flights, const AnchorSur
     const std::vector<TdoaResidual> residuals = tdoaResiduals(flight, survey, track, rp, &rr);
     Trajectory estimate;
     if (params.inputs == BiasInputSource::kFilterEstimate) {
-      estimate = localizeFlight(flight, survey, params.localization).trajectory;
+      estimate = localizeFlight(flight, survey, params.localization, params.estimate_bias).trajectory;
     }
 
     BiasFlightReport rep;

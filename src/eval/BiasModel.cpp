@@ -20,6 +20,7 @@ std::string toString(FeatureMap map) {
     case FeatureMap::kYawAngles: return "yaw_angles";
     case FeatureMap::kBodyPositions: return "body_positions";
     case FeatureMap::kWorldPosition: return "world_position";
+    case FeatureMap::kBodyPositionsAnchors: return "body_positions_anchors";
   }
   return "unknown";
 }
@@ -28,7 +29,9 @@ FeatureMap featureMapFromString(const std::string& name) {
   if (name == "yaw_angles") return FeatureMap::kYawAngles;
   if (name == "body_positions") return FeatureMap::kBodyPositions;
   if (name == "world_position") return FeatureMap::kWorldPosition;
-  throw std::invalid_argument("unknown feature map '" + name + "' (yaw_angles, body_positions, world_position)");
+  if (name == "body_positions_anchors") return FeatureMap::kBodyPositionsAnchors;
+  throw std::invalid_argument("unknown feature map '" + name +
+                              "' (yaw_angles, body_positions, world_position, body_positions_anchors)");
 }
 
 int featureDim(FeatureMap map) {
@@ -36,6 +39,7 @@ int featureDim(FeatureMap map) {
     case FeatureMap::kYawAngles: return 2;
     case FeatureMap::kBodyPositions: return 6;
     case FeatureMap::kWorldPosition: return 3;
+    case FeatureMap::kBodyPositionsAnchors: return 12;
   }
   return 0;
 }
@@ -55,6 +59,14 @@ void featureRow(FeatureMap map, const TdoaFeature& f, double* row) {
     case FeatureMap::kWorldPosition:
       for (int i = 0; i < 3; ++i) row[i] = f.w_p_b[i];
       return;
+    case FeatureMap::kBodyPositionsAnchors:  // eq. (9) inputs plus the anchors' world positions (P29)
+      for (int i = 0; i < 3; ++i) {
+        row[i] = f.b_p_a[i];
+        row[3 + i] = f.b_p_b[i];
+        row[6 + i] = f.w_p_anchor_a[i];
+        row[9 + i] = f.w_p_anchor_b[i];
+      }
+      return;
   }
 }
 
@@ -69,7 +81,24 @@ MatX featureMatrix(FeatureMap map, const std::vector<TdoaFeature>& features) {
 
 gp::Kernel BiasPreset::kernel() const {
   if (name == "z1" || name == "z2" || name == "tdoa") return gp::Kernel::preset(name);
-  if (name == "pair-tdoa") return gp::Kernel::preset("tdoa");
+  if (name == "pair-tdoa" || name == "tdoa-pm") return gp::Kernel::preset("tdoa");
+  if (name == "anchor-tdoa" || name == "anchor-tdoa-pm") {
+    // docs/math/gp.md (P29): k = k_L(x_A) k_rbf(a_A) + k_L(x_B) k_rbf(a_B); the RBF outputscale is fixed to 1
+    // (the product's scale is k_L's θ0, paper eq. 9), its length scale [m] sets how much anchors share.
+    gp::PartSpec la{gp::PartType::kLedergerber, {0, 1, 2}, 0.05};
+    la.t1 = 0.5;
+    la.t2 = 4.0;
+    gp::PartSpec lb = la;
+    lb.active_dims = {3, 4, 5};
+    const gp::PartSpec ra{gp::PartType::kRbf, {6, 7, 8}, 1.0, {1.0}};
+    gp::PartSpec rb = ra;
+    rb.active_dims = {9, 10, 11};
+    gp::Kernel k({la, ra, lb, rb}, {{0, 1}, {2, 3}});
+    for (const auto& n : k.paramNames()) {
+      if (n.find("rbf.sigma2") != std::string::npos) k.setTrainable(n, false);
+    }
+    return k;
+  }
   if (name == "pair-pos") {
     gp::PartSpec s{gp::PartType::kRbf, {0, 1, 2}, 0.02, {0.5, 0.5, 0.5}};
     return gp::Kernel::sum({s});
@@ -87,17 +116,26 @@ BiasPreset BiasPreset::byName(const std::string& name) {
   } else if (name == "pair-tdoa") {
     p.features = FeatureMap::kBodyPositions;
     p.per_pair = true;
+  } else if (name == "tdoa-pm") {
+    p.features = FeatureMap::kBodyPositions;
+    p.pair_mean = true;
+  } else if (name == "anchor-tdoa" || name == "anchor-tdoa-pm") {
+    p.features = FeatureMap::kBodyPositionsAnchors;
+    p.pair_mean = name == "anchor-tdoa-pm";
   } else if (name == "pair-pos") {
     p.features = FeatureMap::kWorldPosition;
     p.per_pair = true;
     p.normalization = gp::InputNormalization::kStandardize;
   } else {
-    throw std::invalid_argument("unknown bias-model kernel/preset '" + name + "' (expected z1, z2, tdoa, pair-tdoa, pair-pos)");
+    throw std::invalid_argument("unknown bias-model kernel/preset '" + name + "' (expected z1, z2, tdoa, pair-tdoa, pair-pos, tdoa-pm, "
+                                "anchor-tdoa, anchor-tdoa-pm)");
   }
   return p;
 }
 
-std::vector<std::string> BiasPreset::names() { return {"z1", "z2", "tdoa", "pair-tdoa", "pair-pos"}; }
+std::vector<std::string> BiasPreset::names() {
+  return {"z1", "z2", "tdoa", "pair-tdoa", "pair-pos", "tdoa-pm", "anchor-tdoa", "anchor-tdoa-pm"};
+}
 
 void BiasTrainParams::validate() const {
   BiasPreset::byName(preset);
@@ -105,13 +143,15 @@ void BiasTrainParams::validate() const {
   if (!(holdout_fraction >= 0) || holdout_fraction >= 1) throw std::invalid_argument("holdout_fraction must be in [0, 1)");
   if (!(holdout_block_s > 0)) throw std::invalid_argument("holdout_block_s must be > 0");
   if (min_samples_per_inducing < 1) throw std::invalid_argument("min_samples_per_inducing must be ≥ 1");
+  if (!(extra_sigma_m >= 0) || !std::isfinite(extra_sigma_m)) throw std::invalid_argument("extra_sigma_m must be ≥ 0");
   svgp.validate();
 }
 
 // ---------------------------------------------------------------------------------------------------------------
 
-BiasModel::BiasModel(std::string preset, FeatureMap features, std::vector<Entry> entries)
-    : preset_(std::move(preset)), features_(features), entries_(std::move(entries)) {
+BiasModel::BiasModel(std::string preset, FeatureMap features, std::vector<Entry> entries,
+                     std::vector<PairMean> pair_means)
+    : preset_(std::move(preset)), features_(features), entries_(std::move(entries)), pair_means_(std::move(pair_means)) {
   for (const auto& e : entries_) {
     if (e.gp.inputDim() != featureDim(features_))
       throw std::invalid_argument("bias model: GP input dimension " + std::to_string(e.gp.inputDim()) +
@@ -128,13 +168,26 @@ void BiasModel::buildPredictors() {
   predictors_ = preds;
 }
 
+void BiasModel::setExtraVariance(double variance_m2) {
+  if (!(variance_m2 >= 0) || !std::isfinite(variance_m2))
+    throw std::invalid_argument("bias model: extra variance must be finite and ≥ 0");
+  extra_variance_m2_ = variance_m2;
+}
+
+double BiasModel::pairMean(int id_a, int id_b) const {
+  for (const auto& p : pair_means_) {
+    if (p.id_a == id_a && p.id_b == id_b) return p.mean_m;
+  }
+  return 0.0;
+}
+
 namespace {
 BiasPrediction predictWith(const std::vector<BiasModel::Entry>& entries, const std::vector<gp::SvgpPredictor>& preds,
                            FeatureMap map, const TdoaFeature& f) {
   for (std::size_t i = 0; i < entries.size(); ++i) {
     const auto& e = entries[i];
     if (e.id_a >= 0 && (e.id_a != f.id_a || e.id_b != f.id_b)) continue;
-    double row[6];
+    double row[kMaxFeatureDim];
     featureRow(map, f, row);
     double mean = 0, var = 0;
     preds[i].predictOne(Eigen::Map<const RowVecX>(row, featureDim(map)), mean, var);
@@ -144,7 +197,12 @@ BiasPrediction predictWith(const std::vector<BiasModel::Entry>& entries, const s
 }
 }  // namespace
 
-BiasPrediction BiasModel::predict(const TdoaFeature& f) const { return predictWith(entries_, *predictors_, features_, f); }
+BiasPrediction BiasModel::predict(const TdoaFeature& f) const {
+  BiasPrediction p = predictWith(entries_, *predictors_, features_, f);
+  p.mean_m += pairMean(f.id_a, f.id_b);  // docs/math/gp.md (P28): m_AB + GP mean
+  p.variance_m2 += extra_variance_m2_;    // (P31)
+  return p;
+}
 
 BiasPredictor BiasModel::predictor() const {
   auto self = std::make_shared<const BiasModel>(*this);
@@ -154,6 +212,8 @@ BiasPredictor BiasModel::predictor() const {
 nlohmann::json BiasModel::toJson() const {
   nlohmann::json models = nlohmann::json::array();
   for (const auto& e : entries_) models.push_back({{"id_a", e.id_a}, {"id_b", e.id_b}, {"svgp", e.gp.toJson()}});
+  nlohmann::json means = nlohmann::json::array();
+  for (const auto& p : pair_means_) means.push_back({{"id_a", p.id_a}, {"id_b", p.id_b}, {"mean_m", p.mean_m}});
   nlohmann::json meta = nlohmann::json::parse(metadata_json, nullptr, false);
   if (meta.is_discarded()) meta = nlohmann::json::object();
   return {{"format", "uwbtdoa-bias-model"},
@@ -163,6 +223,8 @@ nlohmann::json BiasModel::toJson() const {
           {"feature_columns", featureDim(features_)},
           {"per_pair", !entries_.empty() && entries_[0].id_a >= 0},
           {"models", models},
+          {"pair_means", means},
+          {"extra_variance_m2", extra_variance_m2_},
           {"training", meta}};
 }
 
@@ -179,8 +241,16 @@ BiasModel BiasModel::fromJson(const nlohmann::json& j) {
     std::vector<Entry> entries;
     for (const auto& m : j.at("models")) entries.push_back({m.at("id_a").get<int>(), m.at("id_b").get<int>(), gp::Svgp::fromJson(m.at("svgp"))});
     if (entries.empty()) throw std::invalid_argument("no models in the file");
-    BiasModel model(j.at("preset").get<std::string>(), map, std::move(entries));
+    std::vector<PairMean> means;  // optional (P28); absent in files of the paper presets
+    if (j.contains("pair_means")) {
+      for (const auto& m : j.at("pair_means")) {
+        means.push_back({m.at("id_a").get<int>(), m.at("id_b").get<int>(), m.at("mean_m").get<double>()});
+        if (!std::isfinite(means.back().mean_m)) throw std::invalid_argument("pair_means: mean_m is not finite");
+      }
+    }
+    BiasModel model(j.at("preset").get<std::string>(), map, std::move(entries), std::move(means));
     if (j.contains("training")) model.metadata_json = j.at("training").dump();
+    if (j.contains("extra_variance_m2")) model.setExtraVariance(j.at("extra_variance_m2").get<double>());
     return model;
   } catch (const nlohmann::json::exception& e) {
     throw std::invalid_argument(std::string("bias model: ") + e.what());
@@ -230,6 +300,23 @@ std::vector<bool> holdoutMask(const std::vector<BiasSample>& samples, double fra
   return mask;
 }
 
+std::vector<BiasModel::PairMean> pairMeans(const std::vector<BiasSample>& samples, const std::vector<bool>& use,
+                                           double n0) {
+  if (!(n0 >= 0)) throw std::invalid_argument("pairMeans: n0 must be ≥ 0");
+  std::map<std::pair<int, int>, std::pair<double, double>> acc;  // sum ε, n
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (!use.empty() && !use[i]) continue;
+    auto& a = acc[{samples[i].feature.id_a, samples[i].feature.id_b}];
+    a.first += samples[i].error_m;
+    a.second += 1.0;
+  }
+  std::vector<BiasModel::PairMean> out;
+  for (const auto& [key, a] : acc) {
+    if (a.second + n0 > 0) out.push_back({key.first, key.second, a.first / (a.second + n0)});  // (P28)
+  }
+  return out;
+}
+
 BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params, BiasTrainReport* report,
                          const BiasTrainProgress& progress) {
   params.validate();
@@ -252,6 +339,20 @@ BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params,
                                 std::to_string(need) + " for " + std::to_string(params.num_inducing) +
                                 " inducing points (reduce --inducing or add flights)");
 
+  // docs/math/gp.md (P28): per-pair constant means from the training part; the GP learns what remains.
+  std::vector<BiasModel::PairMean> means;
+  if (preset.pair_mean) {
+    std::vector<bool> use(hold.size());
+    for (std::size_t i = 0; i < hold.size(); ++i) use[i] = !hold[i];
+    means = pairMeans(data.samples, use);
+  }
+  const auto meanOf = [&](const TdoaFeature& f) {
+    for (const auto& m : means) {
+      if (m.id_a == f.id_a && m.id_b == f.id_b) return m.mean_m;
+    }
+    return 0.0;
+  };
+
   std::vector<BiasModel::Entry> entries;
   int model_index = 0;
   const int num_models = static_cast<int>(groups.size());
@@ -260,7 +361,7 @@ BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params,
     std::vector<double> ytr, yho;
     for (std::size_t i : idx) {
       (hold[i] ? fho : ftr).push_back(data.samples[i].feature);
-      (hold[i] ? yho : ytr).push_back(data.samples[i].error_m);
+      (hold[i] ? yho : ytr).push_back(data.samples[i].error_m - meanOf(data.samples[i].feature));
     }
     ++model_index;
     if (ftr.size() < need) continue;  // per-pair: too few for this pair → no model (predicts 0)
@@ -277,7 +378,8 @@ BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params,
     entries.push_back({key.first, key.second, std::move(svgp)});
   }
   if (entries.empty()) throw std::invalid_argument("no anchor pair has enough training samples for the requested inducing points");
-  BiasModel model(preset.name, preset.features, std::move(entries));
+  BiasModel model(preset.name, preset.features, std::move(entries), std::move(means));
+  model.setExtraVariance(params.extra_sigma_m * params.extra_sigma_m);  // (P31)
 
   if (report) {
     BiasTrainReport r;

@@ -18,6 +18,8 @@ TdoaFeature makeTdoaFeature(int id_a, int id_b, const Vec3& w_p_b, const Quat& w
   f.yaw_a_rad = std::atan2(f.b_p_a.y(), f.b_p_a.x());  // (M11): α = atan2(y, x) of the body-frame direction
   f.yaw_b_rad = std::atan2(f.b_p_b.y(), f.b_p_b.x());
   f.w_p_b = w_p_b;
+  f.w_p_anchor_a = w_p_anchor_a;
+  f.w_p_anchor_b = w_p_anchor_b;
   return f;
 }
 

@@ -37,6 +37,9 @@ BiasInputSource biasInputSourceFromString(const std::string& name);  ///< "truth
 struct BiasDatasetParams {
   BiasInputSource inputs = BiasInputSource::kGroundTruth;
   LocalizationOptions localization;  ///< the filter run for BiasInputSource::kFilterEstimate
+  /// Bias correction of that filter run (empty: uncorrected). A second training pass sets it to the first pass's
+  /// model, so the GP inputs carry the error of the corrected filter that will use the model (docs/math/gp.md P30).
+  BiasPredictor estimate_bias;
   Vec3 b_t_tag = kUtilTagOffset_b;  ///< tag (antenna) offset in the body frame [m]
   double min_z_m = 0.3;             ///< on the ground: ground-truth body z below this is excluded [m]
   double glitch_margin_s = 0.05;    ///< measurements within this time of a rejected (glitch) pose sample [s]

@@ -9,6 +9,11 @@
  *   beyond the paper:
  *   - "pair-tdoa" one "tdoa" GP per anchor pair
  *   - "pair-pos"  one GP per anchor pair, RBF-ARD on the body position w_p_b (standardized inputs)
+ *   - "tdoa-pm"   "tdoa" on ε minus a per-pair constant mean m_AB (docs/math/gp.md P28)
+ *   - "anchor-tdoa"    k_L(b_p_a)·k_rbf(w_a_A) + k_L(b_p_b)·k_rbf(w_a_B): the eq. 9 kernel made anchor-specific
+ *                      by the anchor's surveyed world position (learned length scale sets how much anchors
+ *                      share; docs/math/gp.md P29)
+ *   - "anchor-tdoa-pm" "anchor-tdoa" plus the per-pair constant mean
  *  A pair without a model predicts {0, 0} (no correction, no added variance).
  *  Model file: JSON, {"format": "uwbtdoa-bias-model", "version": 1, ...}; see toJson().
  */
@@ -33,7 +38,9 @@ enum class FeatureMap {
   kYawAngles,      ///< [yaw_a_rad, yaw_b_rad]
   kBodyPositions,  ///< [b_p_a (3), b_p_b (3)] [m]
   kWorldPosition,  ///< [w_p_b (3)] [m]
+  kBodyPositionsAnchors,  ///< [b_p_a (3), b_p_b (3), w_p_anchor_a (3), w_p_anchor_b (3)] [m]
 };
+constexpr int kMaxFeatureDim = 12;
 std::string toString(FeatureMap map);
 FeatureMap featureMapFromString(const std::string& name);
 int featureDim(FeatureMap map);
@@ -46,6 +53,7 @@ struct BiasPreset {
   std::string name;
   FeatureMap features = FeatureMap::kYawAngles;
   bool per_pair = false;
+  bool pair_mean = false;  ///< subtract a per-pair constant mean before the GP (docs/math/gp.md P28)
   gp::InputNormalization normalization = gp::InputNormalization::kNone;
   gp::Kernel kernel() const;  ///< fresh kernel with default hyperparameters
   static BiasPreset byName(const std::string& name);  ///< throws std::invalid_argument listing the presets
@@ -59,6 +67,9 @@ struct BiasTrainParams {
   double holdout_fraction = 0.2;    ///< share of the data held out (whole time blocks) for the before/after RMSE
   double holdout_block_s = 5.0;     ///< block length of the held-out split [s] (the error is correlated in time)
   int min_samples_per_inducing = 2; ///< need ≥ this × M training samples (per GP)
+  /// Std added (in quadrature) to every predicted bias variance, i.e. to the filter's TDoA noise R when the
+  /// correction is on [m] (docs/math/gp.md P31). 0: the paper's R + latent variance only.
+  double extra_sigma_m = 0.0;
   void validate() const;
 };
 
@@ -81,9 +92,14 @@ class BiasModel {
     int id_a = -1, id_b = -1;  ///< -1: the global model (all pairs)
     gp::Svgp gp;
   };
+  /// Constant mean of one ordered anchor pair, added to the GP mean (docs/math/gp.md P28).
+  struct PairMean {
+    int id_a = -1, id_b = -1;
+    double mean_m = 0.0;
+  };
 
   BiasModel() = default;
-  BiasModel(std::string preset, FeatureMap features, std::vector<Entry> entries);
+  BiasModel(std::string preset, FeatureMap features, std::vector<Entry> entries, std::vector<PairMean> pair_means = {});
 
   /// Predicted bias (mean, latent variance) for one measurement's feature. {0, 0} when no model covers the pair.
   BiasPrediction predict(const TdoaFeature& f) const;
@@ -93,6 +109,12 @@ class BiasModel {
   const std::string& preset() const { return preset_; }
   FeatureMap features() const { return features_; }
   const std::vector<Entry>& entries() const { return entries_; }
+  const std::vector<PairMean>& pairMeans() const { return pair_means_; }
+  /// Variance added to every prediction [m²] (P31).
+  double extraVariance() const { return extra_variance_m2_; }
+  void setExtraVariance(double variance_m2);  ///< throws std::invalid_argument when negative or not finite
+  /// Constant mean of the pair (0 when none was learned).
+  double pairMean(int id_a, int id_b) const;
 
   nlohmann::json toJson() const;
   static BiasModel fromJson(const nlohmann::json& j);  ///< throws std::invalid_argument (clear message)
@@ -107,6 +129,8 @@ class BiasModel {
   std::string preset_;
   FeatureMap features_ = FeatureMap::kYawAngles;
   std::vector<Entry> entries_;
+  std::vector<PairMean> pair_means_;
+  double extra_variance_m2_ = 0.0;
   std::shared_ptr<const std::vector<gp::SvgpPredictor>> predictors_;
 };
 
@@ -114,6 +138,11 @@ class BiasModel {
 /// the held-out bias RMSE before and after. Throws std::invalid_argument when there are too few samples for M.
 BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params, BiasTrainReport* report = nullptr,
                          const BiasTrainProgress& progress = {});
+
+/// Per-pair constant means of ε over the samples with use[i] (P28): m_AB = Σ ε / (n_AB + n0), shrunk to 0 by
+/// n0 pseudo-samples.
+std::vector<BiasModel::PairMean> pairMeans(const std::vector<BiasSample>& samples, const std::vector<bool>& use,
+                                           double n0 = 10.0);
 
 /// Indices of held-out samples: every k-th block of `block_s` seconds of each flight, k = round(1/fraction).
 std::vector<bool> holdoutMask(const std::vector<BiasSample>& samples, double fraction, double block_s);

@@ -22,6 +22,8 @@ struct TdoaFeature {
   double yaw_a_rad = 0.0;     ///< azimuth of anchor A in the body frame, atan2(y, x) ∈ (−π, π] (α of eq. 7)
   double yaw_b_rad = 0.0;     ///< azimuth of anchor B in the body frame
   Vec3 w_p_b = Vec3::Zero();  ///< body origin in the world frame [m]
+  Vec3 w_p_anchor_a = Vec3::Zero();  ///< anchor A in the world frame [m] (identifies the anchor; bias-model inputs)
+  Vec3 w_p_anchor_b = Vec3::Zero();  ///< anchor B in the world frame [m]
 };
 
 /// Builds the feature from a pose (w_p_b, w_q_b) and the world positions of anchors A and B.

@@ -1,0 +1,175 @@
+/** @file BiasPairStructureTest.cpp
+ *  @brief Per-anchor-pair structure of the bias model (docs/math/gp.md P28–P29): per-pair constant means
+ *         (shrinkage, training on the remainder, prediction, model file), and the anchor-specific eq. 9 kernel
+ *         (reduces to the paper kernel for the same anchors; derivatives against finite differences).
+ */
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "support/TestSupport.h"
+#include "uwb/eval/BiasModel.h"
+
+namespace uwb {
+namespace {
+
+/// Samples of three anchor pairs with constant offsets and white noise; features vary smoothly.
+std::vector<BiasSample> offsetSamples(const std::vector<double>& offsets_m, int n_per_pair, double noise_m) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, noise_m);
+  std::vector<BiasSample> out;
+  for (int k = 0; k < n_per_pair; ++k) {
+    for (int p = 0; p < static_cast<int>(offsets_m.size()); ++p) {
+      BiasSample s;
+      s.feature.id_a = p;
+      s.feature.id_b = p + 1;
+      const double phase = 0.01 * k + p;
+      s.feature.b_p_a = Vec3(3 * std::cos(phase), 3 * std::sin(phase), 1.0);
+      s.feature.b_p_b = Vec3(3 * std::cos(phase + 1), 3 * std::sin(phase + 1), -1.0);
+      s.feature.w_p_anchor_a = Vec3(p, 0, 0);
+      s.feature.w_p_anchor_b = Vec3(p + 1, 0, 0);
+      s.error_m = offsets_m[p] + noise(rng);
+      s.t_s = 0.1 * k;  // 40 s: eight 5 s blocks, every fifth held out
+      out.push_back(s);
+    }
+  }
+  return out;
+}
+
+TEST(PairMeans, GivenSamplesWhenComputedThenShrunkMeanPerOrderedPair) {
+  // GIVEN two samples of pair (0,1) and one of (1,0)
+  std::vector<BiasSample> s(3);
+  s[0].feature.id_a = 0, s[0].feature.id_b = 1, s[0].error_m = 0.3;
+  s[1].feature.id_a = 0, s[1].feature.id_b = 1, s[1].error_m = 0.1;
+  s[2].feature.id_a = 1, s[2].feature.id_b = 0, s[2].error_m = -0.5;
+  // WHEN the means are computed with n0 = 2 pseudo-samples, and with sample 1 excluded
+  const auto m = pairMeans(s, {}, 2.0);
+  const auto m_use = pairMeans(s, {true, false, true}, 0.0);
+  // THEN m_AB = Σ ε / (n + n0) (P28), ordered pairs kept apart, excluded samples ignored
+  ASSERT_EQ(m.size(), 2u);
+  EXPECT_EQ(m[0].id_a, 0);
+  EXPECT_EQ(m[0].id_b, 1);
+  EXPECT_NEAR(m[0].mean_m, 0.4 / 4.0, 1e-15);
+  EXPECT_NEAR(m[1].mean_m, -0.5 / 3.0, 1e-15);
+  EXPECT_NEAR(m_use[0].mean_m, 0.3, 1e-15);
+  EXPECT_THROW(pairMeans(s, {}, -1.0), std::invalid_argument);
+}
+
+TEST(PairMeans, GivenConstantPairOffsetsWhenTrainedWithPmPresetThenRecoveredAndStoredInTheModelFile) {
+  // GIVEN errors that are pair constants plus white noise
+  const std::vector<double> offsets{0.25, -0.15, 0.05};
+  BiasDataset data;
+  data.samples = offsetSamples(offsets, 400, 0.05);
+  BiasTrainParams tp;
+  tp.preset = "tdoa-pm";
+  tp.num_inducing = 10;
+  tp.svgp.epochs = 3;
+  // WHEN the tdoa-pm model is trained
+  BiasTrainReport rep;
+  const BiasModel model = trainBiasModel(data, tp, &rep);
+  // THEN the pair means are close to the offsets, predictions carry them, and the file round trip keeps them
+  ASSERT_EQ(model.pairMeans().size(), 3u);
+  for (int p = 0; p < 3; ++p) {
+    EXPECT_NEAR(model.pairMean(p, p + 1), offsets[p], 0.02) << "pair " << p;
+    EXPECT_NEAR(model.predict(data.samples[p].feature).mean_m, offsets[p], 0.05) << "pair " << p;
+  }
+  EXPECT_EQ(model.pairMean(5, 6), 0.0);
+  EXPECT_LT(rep.bias_rmse_after_m, 0.07);
+  const BiasModel loaded = BiasModel::fromJson(model.toJson());
+  for (const auto& s : data.samples) {
+    EXPECT_EQ(loaded.predict(s.feature).mean_m, model.predict(s.feature).mean_m);
+  }
+  // and a paper preset has no pair means (and files without the key load as before)
+  tp.preset = "tdoa";
+  const BiasModel plain = trainBiasModel(data, tp);
+  EXPECT_TRUE(plain.pairMeans().empty());
+  nlohmann::json j = plain.toJson();
+  j.erase("pair_means");
+  EXPECT_TRUE(BiasModel::fromJson(j).pairMeans().empty());
+}
+
+TEST(AnchorTdoaKernel, GivenTheSameAnchorsWhenEvaluatedThenEqualsThePaperKernel) {
+  // GIVEN the anchor-specific kernel (P29) and the paper's eq. 9 kernel with the same hyperparameters
+  const gp::Kernel ka = BiasPreset::byName("anchor-tdoa").kernel();
+  const gp::Kernel kt = BiasPreset::byName("tdoa").kernel();
+  ASSERT_EQ(ka.inputDim(), featureDim(FeatureMap::kBodyPositionsAnchors));
+  RowVecX x(12), y(12);
+  x << 1.0, 2.0, 0.5, -1.0, 3.0, 1.5, 4.0, 0.0, 2.5, 0.0, 4.0, 0.2;
+  y << 0.7, 2.2, 0.1, -1.5, 2.0, 1.0, 4.0, 0.0, 2.5, 0.0, 4.0, 0.2;  // same anchors as x
+  // WHEN evaluated for the same anchors, and for anchor A 6 m away
+  const double k_same = ka(x, y);
+  RowVecX y_far = y;
+  y_far(6) = -2.0;
+  // THEN it equals the paper kernel on the body-frame columns; the slot-A term of another anchor decays by
+  // exp(−½ d²/l²) with d = 6 m, l = 1 m (P29), the slot-B term is unchanged
+  EXPECT_NEAR(k_same, kt(x.head(6), y.head(6)), 1e-14);
+  const gp::Kernel kl_a = gp::Kernel::sum({kt.partSpec(0)});
+  const gp::Kernel kl_b = gp::Kernel::sum({kt.partSpec(1)});
+  const double expected = kl_a(x.head(6), y.head(6)) * std::exp(-0.5 * 36.0) + kl_b(x.head(6), y.head(6));
+  EXPECT_NEAR(ka(x, y_far), expected, 1e-14);
+}
+
+TEST(AnchorTdoaKernel, GivenRandomInputsWhenDifferentiatedThenMatchesFiniteDifferences) {
+  // GIVEN the anchor-specific kernel with non-default hyperparameters and a few input pairs
+  gp::Kernel k = BiasPreset::byName("anchor-tdoa").kernel();
+  VecX theta = k.theta();
+  for (Eigen::Index i = 0; i < theta.size(); ++i) theta[i] *= 1.0 + 0.1 * static_cast<double>(i % 3);
+  k.setTheta(theta);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  MatX X1(4, 12), X2(3, 12);
+  for (Eigen::Index i = 0; i < X1.size(); ++i) X1.data()[i] = u(rng);
+  for (Eigen::Index i = 0; i < X2.size(); ++i) X2.data()[i] = u(rng);
+  X2.block(0, 6, 1, 6) = X1.block(0, 6, 1, 6);  // one pair shares both anchors
+  MatX G(4, 3);
+  for (Eigen::Index i = 0; i < G.size(); ++i) G.data()[i] = u(rng);
+  // WHEN the analytic gradients of Σ G ∘ K w.r.t. θ and X1 are computed
+  std::vector<MatX> blocks;
+  k.cross(X1, X2, &blocks);
+  VecX g_theta = VecX::Zero(k.numParams());
+  MatX g_X1 = MatX::Zero(X1.rows(), X1.cols());
+  k.accumulateCrossGradient(X1, X2, G, blocks, g_theta, &g_X1);
+  // THEN they match central differences
+  const auto objective_theta = [&](const VecX& th) {
+    gp::Kernel kk = k;
+    kk.setTheta(th);
+    VecX out(1);
+    out[0] = (G.array() * kk.cross(X1, X2).array()).sum();
+    return out;
+  };
+  const MatX J_theta = test::numericalJacobian(objective_theta, k.theta());
+  for (int i = 0; i < k.numParams(); ++i) {
+    if (!k.trainable()[i]) continue;
+    EXPECT_NEAR(g_theta[i], J_theta(0, i), 1e-6 * (1.0 + std::abs(J_theta(0, i)))) << k.paramNames()[i];
+  }
+  const auto objective_x = [&](const VecX& x) {
+    MatX XX = X1;
+    XX = Eigen::Map<const MatX>(x.data(), X1.rows(), X1.cols());
+    VecX out(1);
+    out[0] = (G.array() * k.cross(XX, X2).array()).sum();
+    return out;
+  };
+  const MatX J_x = test::numericalJacobian(objective_x, Eigen::Map<const VecX>(X1.data(), X1.size()));
+  const MatX J_x_mat = Eigen::Map<const MatX>(J_x.data(), X1.rows(), X1.cols());
+  EXPECT_LT(test::relativeError(g_X1, J_x_mat), 1e-6);
+}
+
+TEST(AnchorTdoaKernel, GivenTheRbfOutputscaleWhenBuiltThenItIsFixed) {
+  const gp::Kernel k = BiasPreset::byName("anchor-tdoa-pm").kernel();
+  int n_fixed = 0;
+  for (int i = 0; i < k.numParams(); ++i) {
+    if (k.paramNames()[i].find("rbf.sigma2") != std::string::npos) {
+      EXPECT_FALSE(k.trainable()[i]);
+      ++n_fixed;
+    }
+  }
+  EXPECT_EQ(n_fixed, 2);
+  EXPECT_TRUE(BiasPreset::byName("anchor-tdoa-pm").pair_mean);
+  EXPECT_FALSE(BiasPreset::byName("anchor-tdoa").pair_mean);
+  EXPECT_FALSE(BiasPreset::byName("tdoa").pair_mean);
+}
+
+}  // namespace
+}  // namespace uwb
