@@ -41,6 +41,8 @@ struct AccumulatedTransition {
   /// Returns M Φᵀ for a 15×15 M using the block structure, as column operations (contiguous in Eigen's column-major
   /// storage, so each 15×3 · 3×3 block product vectorises along the 15 rows).
   ErrMat rightMultiplyTransposed(const ErrMat& M) const;
+  /// M ← M Φᵀ in place (the same arithmetic as rightMultiplyTransposed, without the 15×15 copy).
+  void rightMultiplyTransposedInPlace(ErrMat& M) const;
   bool empty() const { return T_s == 0.0; }
 };
 
