@@ -1,0 +1,110 @@
+/** @file TakeoffBiasTest.cpp
+ *  @brief The thrust-axis accelerometer bias is re-opened at take-off (docs/math/filter.md F20): on a synthetic
+ *         flight whose accelerometer z reads a different bias once the motors run, the in-flight bias is learned
+ *         within seconds with the default take-off inflation and not without it.
+ */
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "uwb/filter/TdoaLocalizer.h"
+#include "uwb/model/TdoaModel.h"
+
+namespace uwb {
+namespace {
+
+/// 8 anchors alternating low/high on a 7 × 8 × 3 m box (as the UTIL arena).
+AnchorTable arenaAnchors() {
+  AnchorTable t;
+  const Vec3 c[8] = {{-3, -4, 0.2}, {-3, 4, 3.0}, {3.5, 4, 0.2}, {4, -4, 3.0},
+                     {-3, -4.2, 3.0}, {4, -3.8, 0.2}, {4, 4, 3.0}, {-3, 3.5, 0.2}};
+  for (int i = 0; i < 8; ++i) t.set(i, c[i]);
+  return t;
+}
+
+/// Height of the synthetic flight: 2 s on the floor, a 1 m climb (±1 m/s² for 1 s each), then hover.
+struct Vertical {
+  double z, vz, az;
+};
+Vertical vertical(double t) {
+  const double tc = t - 2.0;
+  if (tc <= 0.0) return {0.05, 0.0, 0.0};
+  if (tc <= 1.0) return {0.05 + 0.5 * tc * tc, tc, 1.0};
+  if (tc <= 2.0) {
+    const double s = tc - 1.0;
+    return {0.55 + s - 0.5 * s * s, 1.0 - s, -1.0};
+  }
+  return {1.05, 0.0, 0.0};
+}
+
+/// IMU at 1 kHz whose z axis reads bias_ground_mps2 before the climb and bias_flight_mps2 from the climb on
+/// (vibration noise as in flight); TDoA on the neighbour pairs at 400 Hz with white noise.
+SensorLog makeLog(double bias_ground_mps2, double bias_flight_mps2, double duration_s, unsigned seed) {
+  const AnchorTable anchors = arenaAnchors();
+  const Vec3 p0(0.8, -0.5, 0.0);
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  SensorLog log;
+  for (double t = 0.0; t <= duration_s; t += 0.001) {
+    TimedImu s;
+    s.t_s = t;
+    const double bias = t < 1.9 ? bias_ground_mps2 : bias_flight_mps2;
+    s.imu.b_acc_mps2 = Vec3(0, 0, vertical(t).az + kGravity_mps2 + bias) + 0.5 * Vec3(n(rng), n(rng), n(rng));
+    s.imu.b_gyro_radps = 0.08 * Vec3(n(rng), n(rng), n(rng));
+    log.imu.push_back(s);
+  }
+  int k = 0;
+  for (double t = 0.0; t <= duration_s; t += 0.0025, ++k) {
+    const int a = k % 8, b = (k + 1) % 8;
+    const Vec3 p = p0 + Vec3(0, 0, vertical(t).z);
+    const Vec3 p_tag = tagPosition(p, Quat::Identity(), kUtilTagOffset_b);
+    const double z = range(p_tag, anchors.find(b)->m) - range(p_tag, anchors.find(a)->m) + 0.15 * n(rng);
+    log.tdoa.push_back({t, a, b, z});
+  }
+  return log;
+}
+
+/// Mean estimated z accelerometer bias over [t0, t1].
+double meanBiasZ(const LocalizerResult& r, double t0, double t1) {
+  double sum = 0.0;
+  int n = 0;
+  for (const LocalizerEstimate& e : r.estimates)
+    if (e.t_s >= t0 && e.t_s <= t1) {
+      sum += e.x.b_acc_bias.z();
+      ++n;
+    }
+  return n ? sum / n : std::nan("");
+}
+
+TEST(TakeoffBias, InFlightThrustAxisBiasIsLearnedAfterTakeoff) {
+  // GIVEN a flight whose accelerometer z bias steps from +0.02 to −0.08 m/s² when the motors spin up
+  // (the step seen on util-pilot, F20)
+  const SensorLog log = makeLog(0.02, -0.08, 14.0, 11);
+  EkfParams with;  // defaults: takeoff_acc_bias_sigma_mps2 = 0.1
+  ASSERT_GT(with.takeoff_acc_bias_sigma_mps2, 0.0);
+  EkfParams without = with;
+  without.takeoff_acc_bias_sigma_mps2 = 0.0;
+  // WHEN localizing with and without the take-off inflation of the bias variance
+  const LocalizerResult r_with = TdoaLocalizer(with, arenaAnchors()).run(log);
+  const LocalizerResult r_without = TdoaLocalizer(without, arenaAnchors()).run(log);
+  ASSERT_FALSE(std::isnan(r_with.summary.takeoff_t_s));
+  // THEN the ground estimate is near the ground bias (1.5 s of ZUPTs under 0.5 m/s² vibration: ±0.04) ...
+  EXPECT_NEAR(meanBiasZ(r_with, 1.0, 1.8), 0.02, 0.04);
+  // ... and in the hover 8–14 s only the inflated filter has followed the step to −0.08 m/s²
+  const double b_with = meanBiasZ(r_with, 8.0, 14.0);
+  const double b_without = meanBiasZ(r_without, 8.0, 14.0);
+  EXPECT_NEAR(b_with, -0.08, 0.03);
+  EXPECT_LT(std::abs(b_with + 0.08), std::abs(b_without + 0.08)) << "with " << b_with << ", without " << b_without;
+}
+
+TEST(TakeoffBias, ZeroSigmaIsAllowedAndNegativeRejected) {
+  EkfParams p;
+  p.takeoff_acc_bias_sigma_mps2 = 0.0;
+  EXPECT_NO_THROW(p.validate());
+  p.takeoff_acc_bias_sigma_mps2 = -0.1;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace uwb
