@@ -3,10 +3,12 @@
  *  trained bias models (BiasModel), localization of a flight with or without a bias model, trajectory metrics.
  *
  *  Feature dicts (one row per measurement), as returned by make_tdoa_features / BiasDataset.arrays():
- *    id_a, id_b (int32), yaw_a, yaw_b [rad], b_p_a, b_p_b (N, 3) [m, body frame], w_p_b (N, 3) [m, world].
+ *    id_a, id_b (int32), yaw_a, yaw_b [rad], b_p_a, b_p_b (N, 3) [m, body frame], w_p_b (N, 3) [m, world],
+ *    w_p_anchor_a, w_p_anchor_b (N, 3) [m, world]. A key that the model's feature map reads must be present.
  */
 #include <functional>
 #include <map>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "bindings.h"
@@ -21,7 +23,27 @@ namespace uwb::python {
 namespace {
 
 // ---------------------------------------------------------------------------------------------- features
-std::vector<TdoaFeature> featuresFromDict(const py::dict& d) {
+/// The feature-dict keys that the GP inputs of `map` read (featureRow): a missing one is an error, not zeros.
+std::vector<const char*> requiredFeatureKeys(FeatureMap map) {
+  switch (map) {
+    case FeatureMap::kYawAngles: return {"yaw_a", "yaw_b"};
+    case FeatureMap::kBodyPositions: return {"b_p_a", "b_p_b"};
+    case FeatureMap::kWorldPosition: return {"w_p_b"};
+    case FeatureMap::kBodyPositionsAnchors: return {"b_p_a", "b_p_b", "w_p_anchor_a", "w_p_anchor_b"};
+  }
+  return {};
+}
+
+/// Feature dict → TdoaFeature rows. Keys other than id_a/id_b are optional (zeros) unless `map` reads them.
+std::vector<TdoaFeature> featuresFromDict(const py::dict& d, std::optional<FeatureMap> map) {
+  if (map) {
+    for (const char* key : requiredFeatureKeys(*map)) {
+      if (!d.contains(key)) {
+        throw std::invalid_argument(std::string("features: key '") + key + "' is missing; the feature map '" +
+                                    toString(*map) + "' reads it");
+      }
+    }
+  }
   const Eigen::VectorXi ia = toIntVector(requireKey(d, "id_a", "features"), "features['id_a']");
   const auto n = ia.size();
   const Eigen::VectorXi ib = toIntVector(requireKey(d, "id_b", "features"), "features['id_b']");
@@ -36,34 +58,41 @@ std::vector<TdoaFeature> featuresFromDict(const py::dict& d) {
   };
   if (ib.size() != n) throw std::invalid_argument("features['id_b']: length differs from id_a");
   const RowMat ya = opt("yaw_a", 0), yb = opt("yaw_b", 0), pa = opt("b_p_a", 3), pb = opt("b_p_b", 3),
-               wp = opt("w_p_b", 3);
+               wp = opt("w_p_b", 3), wa = opt("w_p_anchor_a", 3), wb = opt("w_p_anchor_b", 3);
   const auto r = [](const RowMat& m, Eigen::Index i) { return m.rows() == 1 ? 0 : i; };
   std::vector<TdoaFeature> out(static_cast<std::size_t>(n));
   for (Eigen::Index i = 0; i < n; ++i) {
     TdoaFeature& f = out[i];
     f.id_a = ia(i), f.id_b = ib(i);
     f.yaw_a_rad = ya(r(ya, i), 0), f.yaw_b_rad = yb(r(yb, i), 0);
-    f.b_p_a = row3(pa, i), f.b_p_b = row3(pb, i), f.w_p_b = row3(wp, i);
+    f.b_p_a = row3(pa, r(pa, i)), f.b_p_b = row3(pb, r(pb, i)), f.w_p_b = row3(wp, r(wp, i));
+    f.w_p_anchor_a = row3(wa, r(wa, i)), f.w_p_anchor_b = row3(wb, r(wb, i));
   }
   return out;
 }
+
+}  // namespace
 
 py::dict featuresToDict(const std::vector<const TdoaFeature*>& fs) {
   const auto n = static_cast<Eigen::Index>(fs.size());
   auto ia = newIntArray(n), ib = newIntArray(n);
   auto ma = ia.mutable_unchecked<1>(), mb = ib.mutable_unchecked<1>();
-  RowMat yaw(n, 2), pa(n, 3), pb(n, 3), wp(n, 3);
+  RowMat yaw(n, 2), pa(n, 3), pb(n, 3), wp(n, 3), wa(n, 3), wb(n, 3);
   for (Eigen::Index i = 0; i < n; ++i) {
     const TdoaFeature& f = *fs[i];
     ma(i) = f.id_a, mb(i) = f.id_b;
     yaw.row(i) << f.yaw_a_rad, f.yaw_b_rad;
     pa.row(i) = f.b_p_a.transpose(), pb.row(i) = f.b_p_b.transpose(), wp.row(i) = f.w_p_b.transpose();
+    wa.row(i) = f.w_p_anchor_a.transpose(), wb.row(i) = f.w_p_anchor_b.transpose();
   }
   py::dict d;
   d["id_a"] = ia, d["id_b"] = ib, d["yaw_a"] = toNumpy(yaw.col(0), true), d["yaw_b"] = toNumpy(yaw.col(1), true);
   d["b_p_a"] = toNumpy(pa), d["b_p_b"] = toNumpy(pb), d["w_p_b"] = toNumpy(wp);
+  d["w_p_anchor_a"] = toNumpy(wa), d["w_p_anchor_b"] = toNumpy(wb);
   return d;
 }
+
+namespace {
 
 // ------------------------------------------------------------------------------------------- parameters
 const Setters<EkfParams>& ekfSetters() {
@@ -274,11 +303,13 @@ void bindEval(py::module_& m) {
   m.def(
       "feature_matrix",
       [](const std::string& feature_map, const py::dict& features) {
-        return toNumpy(featureMatrix(featureMapFromString(feature_map), featuresFromDict(features)));
+        const FeatureMap map = featureMapFromString(feature_map);
+        return toNumpy(featureMatrix(map, featuresFromDict(features, map)));
       },
       py::arg("feature_map"), py::arg("features"),
       "GP input rows (N, D) of a feature dict for a feature map ('yaw_angles' → [yaw_a, yaw_b], 'body_positions' →\n"
-      "[b_p_a, b_p_b], 'world_position' → [w_p_b]).");
+      "[b_p_a, b_p_b], 'world_position' → [w_p_b], 'body_positions_anchors' → [b_p_a, b_p_b, w_p_anchor_a,\n"
+      "w_p_anchor_b]).");
 
   // ---------------------------------------------------------------------------------------- bias model
   py::class_<BiasModel>(m, "BiasModel",
@@ -304,7 +335,7 @@ void bindEval(py::module_& m) {
       .def(
           "predict",
           [](const BiasModel& b, const py::dict& features) {
-            const std::vector<TdoaFeature> fs = featuresFromDict(features);
+            const std::vector<TdoaFeature> fs = featuresFromDict(features, b.features());
             Eigen::VectorXd mean(static_cast<Eigen::Index>(fs.size())), var(mean.size());
             {
               py::gil_scoped_release release;

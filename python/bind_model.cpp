@@ -14,21 +14,15 @@ namespace {
 
 py::dict featuresDict(const Eigen::VectorXi& id_a, const Eigen::VectorXi& id_b, const RowMat& p, const RowMat& q,
                       const RowMat& pa, const RowMat& pb, Eigen::Index n) {
-  RowMat b_p_a(n, 3), b_p_b(n, 3), w_p_b(n, 3);
-  Eigen::VectorXd yaw_a(n), yaw_b(n);
+  std::vector<TdoaFeature> fs;
+  fs.reserve(static_cast<std::size_t>(n));
   for (Eigen::Index i = 0; i < n; ++i) {
-    const TdoaFeature f = makeTdoaFeature(id_a(id_a.size() == 1 ? 0 : i), id_b(id_b.size() == 1 ? 0 : i), row3(p, i),
-                                          rowQuat(q, i), row3(pa, i), row3(pb, i));
-    b_p_a.row(i) = f.b_p_a, b_p_b.row(i) = f.b_p_b, w_p_b.row(i) = f.w_p_b;
-    yaw_a(i) = f.yaw_a_rad, yaw_b(i) = f.yaw_b_rad;
+    fs.push_back(makeTdoaFeature(id_a(id_a.size() == 1 ? 0 : i), id_b(id_b.size() == 1 ? 0 : i), row3(p, i),
+                                 rowQuat(q, i), row3(pa, i), row3(pb, i)));
   }
-  auto ia = newIntArray(n), ib = newIntArray(n);
-  auto ma = ia.mutable_unchecked<1>(), mb = ib.mutable_unchecked<1>();
-  for (Eigen::Index i = 0; i < n; ++i) ma(i) = id_a(id_a.size() == 1 ? 0 : i), mb(i) = id_b(id_b.size() == 1 ? 0 : i);
-  py::dict d;
-  d["id_a"] = ia, d["id_b"] = ib, d["b_p_a"] = toNumpy(b_p_a), d["b_p_b"] = toNumpy(b_p_b);
-  d["yaw_a"] = toNumpy(yaw_a, true), d["yaw_b"] = toNumpy(yaw_b, true), d["w_p_b"] = toNumpy(w_p_b);
-  return d;
+  std::vector<const TdoaFeature*> ptrs;
+  for (const TdoaFeature& f : fs) ptrs.push_back(&f);
+  return featuresToDict(ptrs);
 }
 
 }  // namespace
@@ -65,7 +59,8 @@ void bindModel(py::module_& m) {
       py::arg("id_a"), py::arg("id_b"), py::arg("w_p_b"), py::arg("w_q_b"), py::arg("anchor_a"), py::arg("anchor_b"),
       "GP inputs (TdoaFeature) of N measurements from poses and anchor positions. Returns a dict of arrays:\n"
       "id_a, id_b, b_p_a (N, 3), b_p_b (N, 3) [anchor relative to the body, body frame, m], yaw_a, yaw_b [rad]\n"
-      "(azimuth of each anchor in the body frame, the paper's α), w_p_b (N, 3).");
+      "(azimuth of each anchor in the body frame, the paper's α), w_p_b (N, 3), w_p_anchor_a, w_p_anchor_b (N, 3)\n"
+      "[anchor positions, world frame, m].");
   m.def(
       "tdoa_features",
       [](const AnchorSurvey& survey, const py::handle& id_a, const py::handle& id_b, const py::handle& w_p_b,

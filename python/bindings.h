@@ -20,6 +20,7 @@
 #include "uwb/core/Types.h"
 #include "uwb/io/Flight.h"
 #include "uwb/io/TrajectoryCsv.h"
+#include "uwb/model/TdoaFeature.h"
 
 namespace uwb::python {
 
@@ -143,6 +144,10 @@ void bindGp(py::module_& m);
 void bindSim(py::module_& m);
 void bindGpTrain(py::module_& m);
 void bindEval(py::module_& m);
+
+/// Feature dict (one row per measurement: id_a, id_b, yaw_a, yaw_b, b_p_a, b_p_b, w_p_b, w_p_anchor_a, w_p_anchor_b)
+/// of TdoaFeature rows; bind_eval.cpp.
+py::dict featuresToDict(const std::vector<const TdoaFeature*>& fs);
 
 // ------------------------------------------------------------------------------- parameter structs from dicts
 /// name → setter for one field of a parameter struct (EkfParams, SimParams, ...).

@@ -92,6 +92,14 @@ def test_eval_errors_are_value_and_os_errors(flights, trained, tmp_path):
         u.BiasModel.load(str(tmp_path / "absent.json"))
     with pytest.raises(ValueError, match="unknown feature map"):
         u.feature_matrix("angles", data.arrays())
+    # a key that the feature map reads must be there (no silent zeros)
+    a = data.arrays()
+    X = u.feature_matrix("body_positions_anchors", a)
+    assert X.shape == (len(a["id_a"]), 12) and np.all(np.linalg.norm(X[:, 6:9], axis=1) > 0.5)
+    del a["w_p_anchor_b"]
+    with pytest.raises(ValueError, match="'w_p_anchor_b' is missing; the feature map 'body_positions_anchors'"):
+        u.feature_matrix("body_positions_anchors", a)
+    assert u.feature_matrix("yaw_angles", a).shape[1] == 2
 
 
 def test_run_evaluation_writes_the_report_and_renders_its_figures(flights, tmp_path):
