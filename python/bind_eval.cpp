@@ -118,11 +118,14 @@ const Setters<EkfParams>& ekfSetters() {
              {"takeoff_climb_mps", &P::takeoff_climb_mps}, {"takeoff_acc_mps2", &P::takeoff_acc_mps2},
              {"landing_height_m", &P::landing_height_m}, {"landing_hold_s", &P::landing_hold_s},
              {"acquisition_s", &P::acquisition_s}, {"acquisition_tdoa_sigma_m", &P::acquisition_tdoa_sigma_m},
-             {"ground_z_m", &P::ground_z_m}}) {
+             {"ground_z_m", &P::ground_z_m}, {"tof_sigma_m", &P::tof_sigma_m}, {"tof_offset_m", &P::tof_offset_m},
+             {"floor_z_m", &P::floor_z_m}, {"tof_max_range_m", &P::tof_max_range_m},
+             {"tof_gate_sigma", &P::tof_gate_sigma}}) {
       addField(out, n, f);
     }
     out["robust_iterations"] = [](P& p, const py::handle& v) { p.robust_iterations = py::cast<int>(v); };
     out["has_start_position"] = [](P& p, const py::handle& v) { p.has_start_position = py::cast<bool>(v); };
+    out["fuse_tof"] = [](P& p, const py::handle& v) { p.fuse_tof = py::cast<bool>(v); };
     out["start_w_p_b"] = [](P& p, const py::handle& v) {
       p.start_w_p_b = row3(toMatrix(v, 3, "start_w_p_b"), 0);
       p.has_start_position = true;

@@ -91,6 +91,14 @@ void applyConfig(const json& j, uwb::EkfParams& p) {
       p.start_w_p_b = vec();
       p.has_start_position = true;
     } else if (key == "ground_z_m") p.ground_z_m = num();
+    else if (key == "fuse_tof") {
+      if (!value.is_boolean()) throw std::invalid_argument("config: 'fuse_tof' must be true or false");
+      p.fuse_tof = value.get<bool>();
+    } else if (key == "tof_sigma_m") p.tof_sigma_m = num();
+    else if (key == "tof_offset_m") p.tof_offset_m = num();
+    else if (key == "floor_z_m") p.floor_z_m = num();
+    else if (key == "tof_max_range_m") p.tof_max_range_m = num();
+    else if (key == "tof_gate_sigma") p.tof_gate_sigma = num();
     else throw std::invalid_argument("config: unknown key '" + key + "'");
   }
 }
@@ -110,7 +118,7 @@ json statsJson(const uwb::PositionErrorStats& s) {
 
 struct LocalizeArgs {
   std::string flight, anchors, out, config, bias_model;
-  bool json_out = false, tdoa_only = false, no_ground_detect = false;
+  bool json_out = false, tdoa_only = false, no_ground_detect = false, fuse_tof = false;
   std::optional<double> tdoa_sigma, gate, robust_k, acc_noise, lateral_acc_noise, gyro_noise, acc_bias_rw,
       gyro_bias_rw, cov_period;
   std::string robust_loss, accel_model, process_model, tag_offset, start;
@@ -148,6 +156,7 @@ void runLocalize(const LocalizeArgs& a) {
     params.has_start_position = true;
   }
   if (a.no_ground_detect) params.ground_phase = uwb::GroundPhase::kNone;
+  if (a.fuse_tof) params.fuse_tof = true;
   params.validate();
   // issue 5: the GP bias model as a plain BiasPredictor (the filter knows nothing of GPs)
   uwb::BiasPredictor bias;
@@ -185,6 +194,13 @@ void runLocalize(const LocalizeArgs& a) {
   j["n_tdoa_not_used_ground"] = s.n_tdoa_ground;
   j["n_tdoa_degenerate"] = s.n_tdoa_degenerate;
   j["n_reacquisitions"] = s.n_reacquisitions;
+  j["fuse_tof"] = params.fuse_tof;
+  j["n_tof"] = s.n_tof_total;
+  j["n_tof_used"] = s.n_tof_used;
+  j["n_tof_rejected"] = s.n_tof_rejected;
+  j["n_tof_invalid"] = s.n_tof_invalid;
+  j["n_tof_tilted"] = s.n_tof_tilted;
+  j["n_tof_not_airborne"] = s.n_tof_not_airborne;
   j["takeoff_t_s"] = std::isnan(s.takeoff_t_s) ? json(nullptr) : json(s.takeoff_t_s);
   j["landing_t_s"] = std::isnan(s.landing_t_s) ? json(nullptr) : json(s.landing_t_s);
   j["start_position_m"] = {s.start_w_p_b.x(), s.start_w_p_b.y(), s.start_w_p_b.z()};
@@ -253,6 +269,7 @@ const bool kRegistered = uwb::app::registerCommand(
        sub.add_option("--start", a->start, "Start position of the body x,y,z [m] (default: multilateration)");
        sub.add_flag("--tdoa-only", a->tdoa_only, "Ignore the IMU: constant-velocity model");
        sub.add_flag("--no-ground-detect", a->no_ground_detect, "Use TDoA from the start (no take-off detection)");
+       sub.add_flag("--fuse-tof", a->fuse_tof, "Fuse the downward ToF range as a height update (F21)");
        sub.add_option("--output-period", a->output_period, "Trajectory sample spacing [s]");
        sub.add_option("--bias-model", a->bias_model, "Bias model JSON (GP) to correct the TDoA");
        sub.callback([a] { runLocalize(*a); });

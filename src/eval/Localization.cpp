@@ -7,7 +7,7 @@
 
 namespace uwb {
 
-SensorLog sensorLogFromFlight(const Flight& flight, MergeReport* report) {
+SensorLog sensorLogFromFlight(const Flight& flight, MergeReport* report, bool with_tof) {
   SensorLog log;
   if (flight.hasImu()) {
     std::vector<TimedVec3> acc, gyro;
@@ -19,6 +19,10 @@ SensorLog sensorLogFromFlight(const Flight& flight, MergeReport* report) {
   }
   log.tdoa.reserve(flight.tdoa.size());
   for (const TdoaMeasurement& m : flight.tdoa) log.tdoa.push_back({m.t_s, m.id_a, m.id_b, m.tdoa_m});
+  if (with_tof) {
+    log.tof.reserve(flight.tof.size());
+    for (const ScalarSample& s : flight.tof) log.tof.push_back({s.t_s, s.value});
+  }
   return log;
 }
 
@@ -49,7 +53,7 @@ LocalizationRun localizeFlight(const Flight& flight, const AnchorSurvey& survey,
   if (options.tdoa_only && params.process_model == ProcessModel::kImu)
     params.process_model = ProcessModel::kConstantVelocity;
   MergeReport pair_report;
-  SensorLog log = sensorLogFromFlight(flight, &pair_report);
+  SensorLog log = sensorLogFromFlight(flight, &pair_report, params.fuse_tof);
   const TdoaLocalizer localizer(params, anchorTableFromSurvey(survey, params.anchor_sigma_m), bias);
   LocalizerResult res = localizer.run(std::move(log), options.output_period_s);
   res.summary.merge.n_imu_unpaired = pair_report.n_imu_unpaired;

@@ -53,6 +53,11 @@ void EkfParams::validate() const {
   requirePositive(acquisition_tdoa_sigma_m, "acquisition_tdoa_sigma_m");
   if (!start_w_p_b.allFinite()) throw std::invalid_argument("EkfParams.start_w_p_b must be finite");
   if (!std::isfinite(ground_z_m)) throw std::invalid_argument("EkfParams.ground_z_m must be finite");
+  requirePositive(tof_sigma_m, "tof_sigma_m");
+  if (!std::isfinite(tof_offset_m)) throw std::invalid_argument("EkfParams.tof_offset_m must be finite");
+  if (!std::isfinite(floor_z_m)) throw std::invalid_argument("EkfParams.floor_z_m must be finite");
+  requirePositive(tof_max_range_m, "tof_max_range_m");
+  if (!std::isfinite(tof_gate_sigma)) throw std::invalid_argument("EkfParams.tof_gate_sigma must be finite");
 }
 
 EkfParams EkfParams::crazyflieLike() {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 namespace uwb {
 
@@ -17,6 +18,7 @@ std::vector<std::string> MergeReport::notes() const {
   add(n_tdoa_duplicate, "duplicate TDoA samples dropped");
   add(n_imu_out_of_order, "out-of-order IMU samples re-sorted");
   add(n_tdoa_out_of_order, "out-of-order TDoA samples re-sorted");
+  add(n_tof_out_of_order, "out-of-order ToF samples re-sorted");
   add(n_nonfinite, "non-finite samples dropped");
   add(n_imu_gaps, "IMU gaps longer than the limit");
   add(n_tdoa_gaps, "TDoA gaps longer than the limit");
@@ -54,6 +56,7 @@ std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, Me
   MergeReport rep;
   rep.n_imu_in = log.imu.size();
   rep.n_tdoa_in = log.tdoa.size();
+  rep.n_tof_in = log.tof.size();
   // drop non-finite samples
   const auto imu_bad = [](const TimedImu& s) {
     return !std::isfinite(s.t_s) || !s.imu.b_acc_mps2.allFinite() || !s.imu.b_gyro_radps.allFinite();
@@ -63,6 +66,16 @@ std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, Me
   std::erase_if(log.imu, imu_bad);
   std::erase_if(log.tdoa, tdoa_bad);
   rep.n_nonfinite = n0 - log.imu.size() - log.tdoa.size();
+  if (!log.tof.empty()) {
+    // (F21) ToF: only a non-finite stamp is dropped here; invalid ranges are counted by the filter
+    const std::size_t nf = log.tof.size();
+    std::erase_if(log.tof, [](const TofObservation& z) { return !std::isfinite(z.t_s); });
+    rep.n_nonfinite += nf - log.tof.size();
+    for (std::size_t i = 1; i < log.tof.size(); ++i) rep.n_tof_out_of_order += log.tof[i].t_s < log.tof[i - 1].t_s;
+    if (rep.n_tof_out_of_order)
+      std::stable_sort(log.tof.begin(), log.tof.end(),
+                       [](const TofObservation& a, const TofObservation& b) { return a.t_s < b.t_s; });
+  }
   // count out-of-order stamps, then sort stably
   for (std::size_t i = 1; i < log.imu.size(); ++i) rep.n_imu_out_of_order += log.imu[i].t_s < log.imu[i - 1].t_s;
   for (std::size_t i = 1; i < log.tdoa.size(); ++i)
@@ -109,6 +122,18 @@ std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, Me
       events.push_back({log.tdoa[j].t_s, SensorEvent::Kind::kTdoa, static_cast<unsigned>(j)});
       ++j;
     }
+  }
+  if (!log.tof.empty()) {
+    // ToF (≈25 Hz) merged into the IMU/TDoA sequence; std::merge is stable, so ToF goes last at equal stamps
+    std::vector<SensorEvent> tof_events;
+    tof_events.reserve(log.tof.size());
+    for (std::size_t k = 0; k < log.tof.size(); ++k)
+      tof_events.push_back({log.tof[k].t_s, SensorEvent::Kind::kTof, static_cast<unsigned>(k)});
+    std::vector<SensorEvent> merged;
+    merged.reserve(events.size() + tof_events.size());
+    std::merge(events.begin(), events.end(), tof_events.begin(), tof_events.end(), std::back_inserter(merged),
+               [](const SensorEvent& a, const SensorEvent& b) { return a.t_s < b.t_s; });
+    events = std::move(merged);
   }
   if (report) {
     rep.n_imu_unpaired = report->n_imu_unpaired;

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "uwb/filter/Multilateration.h"
+#include "uwb/filter/TofUpdate.h"
 
 namespace uwb {
 namespace {
@@ -79,6 +80,13 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
   acq_opt.sigma_m = p.acquisition_tdoa_sigma_m;
   acq_opt.gate_sigma = 0.0;  // (F16) no gate while acquiring; the robust loss limits outliers
   if (acq_opt.loss == RobustLoss::kNone) acq_opt.loss = RobustLoss::kHuber;
+  // (F21) optional ToF height updates
+  TofUpdateOptions tof_opt;
+  tof_opt.sigma_m = p.tof_sigma_m;
+  tof_opt.offset_m = p.tof_offset_m;
+  tof_opt.floor_z_m = p.floor_z_m;
+  tof_opt.max_range_m = p.tof_max_range_m;
+  double t_last_tof_accept = -1e300;
 
   // Anchor centroid: the starting guesses for multilateration.
   Vec3 centroid = Vec3::Zero();
@@ -379,6 +387,37 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
         }
       }
       emit(t);
+      continue;
+    }
+
+    if (ev.kind == SensorEvent::Kind::kTof) {
+      // ---- ToF event (F21) ----
+      ++sum.n_tof_total;
+      if (!p.fuse_tof) continue;
+      const double range_m = log.tof[ev.index].range_m;
+      if (!(std::isfinite(range_m) && range_m > 0.0 && range_m <= p.tof_max_range_m)) {
+        ++sum.n_tof_invalid;
+        continue;
+      }
+      if (!initialized || !position_known || !std::isnan(t_mlat_start) || phase == FlightPhase::kGround ||
+          phase == FlightPhase::kLanded) {
+        ++sum.n_tof_not_airborne;
+        continue;
+      }
+      if (!imu_mode || t - t_pred >= p.update_predict_dt_s) predictTo(t);
+      propagate(!imu_mode);
+      // the gate opens when no ToF was accepted for max_lost_s (start, or a height that drifted off under TDoA)
+      tof_opt.gate_sigma = t - t_last_tof_accept > p.max_lost_s ? 0.0 : p.tof_gate_sigma;
+      const TofUpdateResult r = updateTof(ekf, range_m, tof_opt);
+      switch (r.outcome) {
+        case UpdateOutcome::kApplied:
+          ++sum.n_tof_used;
+          t_last_tof_accept = t;
+          break;
+        case UpdateOutcome::kRejectedOutlier: ++sum.n_tof_rejected; break;
+        case UpdateOutcome::kDegenerate: ++sum.n_tof_tilted; break;
+        default: ++sum.n_tof_invalid; break;
+      }
       continue;
     }
 

@@ -39,8 +39,9 @@ struct LocalizationRun {
   std::size_t n_truth_glitches = 0;          ///< ground-truth samples rejected as glitches
 };
 
-/// The flight's IMU (paired acc/gyro) and TDoA streams as the filter consumes them.
-SensorLog sensorLogFromFlight(const Flight& flight, MergeReport* report = nullptr);
+/// The flight's IMU (paired acc/gyro) and TDoA streams as the filter consumes them; with_tof also copies the
+/// downward ToF range (docs/math/filter.md F21), which the filter uses only with EkfParams::fuse_tof.
+SensorLog sensorLogFromFlight(const Flight& flight, MergeReport* report = nullptr, bool with_tof = false);
 /// Anchor beliefs from a survey; every coordinate with std anchor_sigma_m.
 AnchorTable anchorTableFromSurvey(const AnchorSurvey& survey, double anchor_sigma_m = 0.0);
 /// Filter output → trajectory samples (position, attitude, velocity, position std).

@@ -106,6 +106,15 @@ struct EkfParams {
   Vec3 start_w_p_b = Vec3::Zero();       ///< user-given start (body origin, world) [m]
   double ground_z_m = 0.0;               ///< floor height for the pre-take-off height prior [m]
 
+  // --- downward ToF range (Flow deck VL53L1x), docs/math/filter.md F21 ---
+  /// Fuse the ToF range as a height update while airborne (off by default: the published numbers are without).
+  bool fuse_tof = false;
+  double tof_sigma_m = 0.03;             ///< ToF range noise std [m] (0425: 7–10 mm spread about the Vicon height)
+  double tof_offset_m = 0.037;           ///< sensor below the body origin along body z [m] (0425: ToF − z = −0.037)
+  double floor_z_m = 0.0;                ///< height of the flat floor the ToF sees, world z [m]
+  double tof_max_range_m = 3.5;          ///< readings above this (VL53L1x limit), ≤ 0 or non-finite are ignored [m]
+  double tof_gate_sigma = 4.0;           ///< Mahalanobis gate on the ToF innovation (F11); ≤ 0 disables
+
   /// Throws std::invalid_argument naming the first field that is out of range.
   void validate() const;
 

@@ -1,5 +1,5 @@
 /** @file SensorEvents.h
- *  @brief Merging the IMU and TDoA streams into one time-ordered event sequence, with duplicates,
+ *  @brief Merging the IMU, TDoA and (optional) ToF streams into one time-ordered event sequence, with duplicates,
  *         out-of-order stamps, non-finite values and gaps counted (docs/math/filter.md F17).
  */
 #pragma once
@@ -10,6 +10,7 @@
 
 #include "uwb/filter/NavState.h"
 #include "uwb/filter/TdoaUpdate.h"
+#include "uwb/filter/TofUpdate.h"
 
 namespace uwb {
 
@@ -29,16 +30,19 @@ struct TimedImu {
 struct SensorLog {
   std::vector<TimedImu> imu;
   std::vector<TdoaObservation> tdoa;
+  std::vector<TofObservation> tof;  ///< optional downward range (F21); empty unless ToF fusion is wanted
 };
 
 /// What merging found; nothing is dropped silently.
 struct MergeReport {
-  std::size_t n_imu_in = 0, n_tdoa_in = 0;
+  std::size_t n_imu_in = 0, n_tdoa_in = 0, n_tof_in = 0;
   std::size_t n_imu_duplicate = 0;      ///< identical stamp as the previous IMU sample (later one dropped)
   std::size_t n_tdoa_duplicate = 0;     ///< identical stamp, pair and value (later one dropped)
   std::size_t n_imu_out_of_order = 0;   ///< stamp earlier than its predecessor in the file (re-sorted)
   std::size_t n_tdoa_out_of_order = 0;
-  std::size_t n_nonfinite = 0;          ///< samples with a non-finite stamp or value (dropped)
+  std::size_t n_tof_out_of_order = 0;
+  std::size_t n_nonfinite = 0;          ///< samples with a non-finite stamp or value (dropped; ToF: stamp only,
+                                        ///< a non-finite ToF range is left to the filter, which counts it)
   std::size_t n_imu_gaps = 0;           ///< gaps longer than max_gap_s between consecutive IMU samples
   std::size_t n_tdoa_gaps = 0;
   double max_imu_gap_s = 0.0;
@@ -53,16 +57,16 @@ struct MergeReport {
 std::vector<TimedImu> pairImuStreams(const std::vector<TimedVec3>& acc, const std::vector<TimedVec3>& gyro,
                                      MergeReport* report = nullptr);
 
-/// One event of the merged sequence: an index into SensorLog::imu or SensorLog::tdoa.
+/// One event of the merged sequence: an index into SensorLog::imu, SensorLog::tdoa or SensorLog::tof.
 struct SensorEvent {
-  enum class Kind : unsigned char { kImu, kTdoa };
+  enum class Kind : unsigned char { kImu, kTdoa, kTof };
   double t_s = 0.0;
   Kind kind = Kind::kImu;
   unsigned index = 0;
 };
 
 /// Cleans `log` in place (drops non-finite samples and duplicates, stably sorts each stream by time) and returns
-/// the merged event sequence, ordered by time; at equal stamps IMU comes before TDoA.
+/// the merged event sequence, ordered by time; at equal stamps IMU comes before TDoA, and both before ToF.
 std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, MergeReport* report = nullptr);
 
 }  // namespace uwb

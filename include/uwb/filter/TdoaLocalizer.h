@@ -43,6 +43,13 @@ struct LocalizerSummary {
   std::size_t n_tdoa_ground = 0;       ///< not used: on the ground / waiting for the start
   std::size_t n_tdoa_degenerate = 0;
   std::size_t n_tdoa_unknown_anchor = 0;
+  // ToF height updates (F21; only with EkfParams::fuse_tof and a ToF stream in the log)
+  std::size_t n_tof_total = 0;
+  std::size_t n_tof_used = 0;
+  std::size_t n_tof_rejected = 0;      ///< χ² gate
+  std::size_t n_tof_invalid = 0;       ///< non-finite, ≤ 0 or above tof_max_range_m (ignored)
+  std::size_t n_tof_tilted = 0;        ///< cos(tilt) ≤ kTofMinCosTilt (ignored)
+  std::size_t n_tof_not_airborne = 0;  ///< on the ground, landed, or before the start position is known
   std::size_t n_predictions = 0;
   std::size_t n_covariance_propagations = 0;
   std::size_t n_reacquisitions = 0;
