@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Runs `uwbtdoa localize` with default parameters on the 16 UTIL pilot TDoA2 flights (IMU-driven ESKF) and the
-# 6 util-final-extract flights (no IMU → TDoA-only constant-velocity mode) and prints a table of RMSEs.
+# 6 util-final-extract flights (no IMU → TDoA-only constant-velocity mode) and prints a table of RMSEs
+# (rtf_cpu: flight duration / CPU time of the filter run, including interpolation and metrics).
 # Usage: scripts/localize_all.sh [BUILD_DIR] [extra localize flags...]   (data: $UWBTDOA_DATA or ../shared/data)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,7 +23,7 @@ for t in trial1 trial2; do for j in 1 2 3; do
   runs+=("$EXTRACT/const4-$t-tdoa2-traj$j.csv|$EXTRACT/survey/anchor_const4_survey.txt")
 done; done
 
-printf "%-28s %-5s %8s %8s %7s %7s %7s %7s %7s %8s %8s %7s\n" flight model air_rmse rmse air_x air_y air_z air_p50 air_p90 used rejected rtf
+printf "%-28s %-5s %8s %8s %7s %7s %7s %7s %7s %8s %8s %7s\n" flight model air_rmse rmse air_x air_y air_z air_p50 air_p90 used rejected rtf_cpu
 for r in "${runs[@]}"; do
   f="${r%%|*}"; s="${r##*|}"
   [ -f "$f" ] || { echo "missing $f" >&2; continue; }
@@ -32,7 +33,7 @@ j = json.load(sys.stdin)
 a = j["airborne"]
 print("%-28s %-5s %8.3f %8.3f %7.3f %7.3f %7.3f %7.3f %7.3f %8d %8d %7.0f" % (os.path.basename(j["flight"]), j["process_model"],
       j["rmse_airborne_m"], j["rmse_m"], a["rmse_x_m"], a["rmse_y_m"], a["rmse_z_m"], a["p50_m"], a["p90_m"],
-      j["n_tdoa_used"], j["n_tdoa_rejected"], j["real_time_factor"]))'
+      j["n_tdoa_used"], j["n_tdoa_rejected"], j["real_time_factor_cpu"]))'
 done > "$TMP"
 cat "$TMP"
 /usr/bin/python3 -c '
