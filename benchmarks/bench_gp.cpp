@@ -18,6 +18,8 @@
  *                      predict 10k (mean+var) M=30 3.9 ms, M=170 35 ms, mean only 14 ms; one point 0.54/6.6 µs
  *      -march=native:  epoch (Adam) M=30 22 ms, M=170 0.38–0.43 s; natgrad M=30 24 ms, M=170 0.42 s;
  *                      predict 10k (mean+var) M=30 1.7 ms, M=170 17 ms, mean only 4.9 ms; one point 0.32/3.6 µs
+ *    session 2 (machine nearly idle, native): predict 10k M=170 one thread 17.6–18.7 ms, two threads 10.8–11.4 ms
+ *      wall (the two vCPUs share resources: 1.6×); mean only 5.0 ms; one point 0.36/4.4 µs.
  *    GEMM calibration: 15 GFlop/s (default), 27–30 GFlop/s (native). The 10k/M=170 variance needs 0.29 GFlop
  *    (M² per point, already halved by the triangular Q_u), so < 10 ms is not reachable on one float64 core here.
  */
