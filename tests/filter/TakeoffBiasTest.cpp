@@ -8,35 +8,15 @@
 #include <cmath>
 #include <random>
 
+#include "FilterTestUtil.h"
 #include "uwb/filter/TdoaLocalizer.h"
 #include "uwb/model/TdoaModel.h"
 
 namespace uwb {
 namespace {
 
-/// 8 anchors alternating low/high on a 7 × 8 × 3 m box (as the UTIL arena).
-AnchorTable arenaAnchors() {
-  AnchorTable t;
-  const Vec3 c[8] = {{-3, -4, 0.2}, {-3, 4, 3.0}, {3.5, 4, 0.2}, {4, -4, 3.0},
-                     {-3, -4.2, 3.0}, {4, -3.8, 0.2}, {4, 4, 3.0}, {-3, 3.5, 0.2}};
-  for (int i = 0; i < 8; ++i) t.set(i, c[i]);
-  return t;
-}
-
-/// Height of the synthetic flight: 2 s on the floor, a 1 m climb (±1 m/s² for 1 s each), then hover.
-struct Vertical {
-  double z, vz, az;
-};
-Vertical vertical(double t) {
-  const double tc = t - 2.0;
-  if (tc <= 0.0) return {0.05, 0.0, 0.0};
-  if (tc <= 1.0) return {0.05 + 0.5 * tc * tc, tc, 1.0};
-  if (tc <= 2.0) {
-    const double s = tc - 1.0;
-    return {0.55 + s - 0.5 * s * s, 1.0 - s, -1.0};
-  }
-  return {1.05, 0.0, 0.0};
-}
+using filtertest::arenaAnchors;
+const auto vertical = filtertest::takeoffProfile;
 
 /// IMU at 1 kHz whose z axis reads bias_ground_mps2 before the climb and bias_flight_mps2 from the climb on
 /// (vibration noise as in flight); TDoA on the neighbour pairs at 400 Hz with white noise.

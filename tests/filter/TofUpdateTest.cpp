@@ -13,6 +13,7 @@
 
 #include "support/TestSupport.h"
 #include "uwb/filter/QuadImuProcess.h"
+#include "FilterTestUtil.h"
 #include "uwb/filter/TdoaLocalizer.h"
 #include "uwb/filter/TofUpdate.h"
 #include "uwb/model/TdoaModel.h"
@@ -123,28 +124,8 @@ TEST(SensorEvents, TofStreamIsMergedAfterImuAndTdoaAtEqualStamps) {
 }
 
 // ----------------------------------------------------------------------------- synthetic flight
-AnchorTable arenaAnchors() {
-  AnchorTable t;
-  const Vec3 c[8] = {{-3, -4, 0.2}, {-3, 4, 3.0}, {3.5, 4, 0.2}, {4, -4, 3.0},
-                     {-3, -4.2, 3.0}, {4, -3.8, 0.2}, {4, 4, 3.0}, {-3, 3.5, 0.2}};
-  for (int i = 0; i < 8; ++i) t.set(i, c[i]);
-  return t;
-}
-
-/// Height: 2 s on the floor at 0.05 m, a 1 m climb (±1 m/s² for 1 s each), then hover at 1.05 m.
-struct Vertical {
-  double z, az;
-};
-Vertical vertical(double t) {
-  const double tc = t - 2.0;
-  if (tc <= 0.0) return {0.05, 0.0};
-  if (tc <= 1.0) return {0.05 + 0.5 * tc * tc, 1.0};
-  if (tc <= 2.0) {
-    const double s = tc - 1.0;
-    return {0.55 + s - 0.5 * s * s, -1.0};
-  }
-  return {1.05, 0.0};
-}
+using filtertest::arenaAnchors;
+const auto vertical = filtertest::takeoffProfile;
 
 constexpr double kTofOffset_m = 0.037;
 
