@@ -211,6 +211,9 @@ py::dict summaryDict(const LocalizerSummary& s) {
   d["n_reacquisitions"] = s.n_reacquisitions, d["takeoff_t_s"] = s.takeoff_t_s, d["landing_t_s"] = s.landing_t_s;
   d["start_t_s"] = s.start_t_s, d["end_t_s"] = s.end_t_s, d["process_model"] = toString(s.process_model);
   d["start_w_p_b"] = toNumpy(s.start_w_p_b, true), d["start_rms_residual_m"] = s.start_rms_residual_m;
+  d["n_tof_total"] = s.n_tof_total, d["n_tof_used"] = s.n_tof_used, d["n_tof_rejected"] = s.n_tof_rejected;
+  d["n_tof_invalid"] = s.n_tof_invalid, d["n_tof_tilted"] = s.n_tof_tilted;
+  d["n_tof_not_airborne"] = s.n_tof_not_airborne;
   return d;
 }
 

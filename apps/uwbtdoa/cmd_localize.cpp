@@ -228,6 +228,11 @@ void runLocalize(const LocalizeArgs& a) {
   std::cout << "flight " << a.flight << ": " << run.duration_s << " s, model " << uwb::toString(s.process_model)
             << ", TDoA used " << s.n_tdoa_used << " / rejected " << s.n_tdoa_rejected << " / not used on ground "
             << s.n_tdoa_ground << " of " << s.n_tdoa_total << "\n";
+  if (params.fuse_tof) {
+    std::cout << "ToF used " << s.n_tof_used << " / rejected " << s.n_tof_rejected << " / invalid " << s.n_tof_invalid
+              << " / tilted " << s.n_tof_tilted << " / not airborne " << s.n_tof_not_airborne << " of "
+              << s.n_tof_total << (s.n_tof_total == 0 ? " (the flight has no ToF stream)" : "") << "\n";
+  }
   if (!std::isnan(s.takeoff_t_s)) std::cout << "take-off detected at " << s.takeoff_t_s << " s\n";
   for (const std::string& n : s.merge.notes()) std::cout << "note: " << n << "\n";
   if (run.metrics) {

@@ -77,6 +77,11 @@ def test_a_gp_trained_in_python_drives_the_filter(flights, trained):
     np.testing.assert_allclose(model.predict(a)["mean"][:50], gp.predict(X[:50])["mean"], rtol=1e-9, atol=1e-12)
     run = u.localize_flight(test["flight"], test["survey"], bias_model=model, params={"tdoa_sigma_m": 0.3})
     assert run["metrics"]["airborne"]["n"] > 100
+    # the ToF fields are accepted; a simulated flight has no ToF stream, so nothing is fused and nothing changes
+    tof = u.localize_flight(test["flight"], test["survey"], bias_model=model,
+                            params={"tdoa_sigma_m": 0.3, "fuse_tof": True, "tof_sigma_m": 0.05})
+    assert tof["summary"]["n_tof_total"] == 0 and tof["summary"]["n_tof_used"] == 0
+    np.testing.assert_array_equal(tof["trajectory"]["p"], run["trajectory"]["p"])
 
 
 def test_eval_errors_are_value_and_os_errors(flights, trained, tmp_path):

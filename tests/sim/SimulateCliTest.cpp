@@ -3,14 +3,11 @@
  */
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "support/TestSupport.h"
@@ -18,22 +15,8 @@
 
 namespace {
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out;
-};
-
-RunResult run(const std::string& args) {
-  RunResult r;
-  const std::string cmd = uwb::test::cliPath() + " " + args + " 2>/dev/null";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (pipe == nullptr) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), static_cast<int>(buf.size()), pipe) != nullptr) r.out += buf.data();
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using RunResult = uwb::test::CliResult;
+RunResult run(const std::string& args) { return uwb::test::runCli(args); }
 
 class SimulateCli : public ::testing::Test {
  protected:

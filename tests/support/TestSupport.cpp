@@ -2,8 +2,15 @@
 #include "TestSupport.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
+
+#include <sys/wait.h>
+#include <unistd.h>
 
 namespace uwb::test {
 
@@ -24,6 +31,22 @@ std::filesystem::path pilotSurvey(const std::string& session) {
 }
 
 std::string cliPath() { return UWB_CLI_PATH; }
+
+CliResult runCli(const std::string& args) {
+  CliResult r;
+  const auto err_file = std::filesystem::temp_directory_path() / ("uwb_cli_err_" + std::to_string(::getpid()));
+  const std::string cmd = cliPath() + " " + args + " 2>" + err_file.string();
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (pipe == nullptr) return r;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), static_cast<int>(buf.size()), pipe) != nullptr) r.out += buf.data();
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(err_file);
+  r.err.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  std::filesystem::remove(err_file);
+  return r;
+}
 
 MatX numericalJacobian(const std::function<VecX(const VecX&)>& f, const VecX& x, double h) {
   const VecX f0 = f(x);

@@ -21,6 +21,15 @@ std::filesystem::path pilotSurvey(const std::string& session);
 /// Path of the `uwbtdoa` executable under test.
 std::string cliPath();
 
+/// Exit code (−1: did not exit normally) and stdout of one `uwbtdoa` run; stderr goes to `err` when asked.
+struct CliResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+/// Runs `uwbtdoa <args>` through the shell (args are not quoted).
+CliResult runCli(const std::string& args);
+
 /// Skips the current test with a clear message when the real data is absent.
 #define UWB_REQUIRE_REAL_DATA(path_opt)                                                           \
   do {                                                                                           \
