@@ -227,6 +227,16 @@ std::optional<InnovationStats> Ekf::correctPositionAttitude(const ScalarLinearMe
   return st;
 }
 
+std::optional<InnovationStats> Ekf::correctPositionAttitude(const ScalarLinearMessage<kDim>& message,
+                                                            const ErrVec& P_a, double a_P_a) {
+  // The equality node (G18) from u = P aᵀ and a u; a m = 0 since the prior error state m is zero.
+  ErrVec dx = ErrVec::Zero();
+  const std::optional<InnovationStats> st = detail::applyRankOneGain<kDim>(dx, P_, message, P_a, 0.0, a_P_a);
+  if (!st) return std::nullopt;
+  inject(dx);  // (F8)
+  return st;
+}
+
 void Ekf::zeroVelocityUpdate(double sigma_mps) {
   // (F14) v = 0 observed per world axis.
   for (int i = 0; i < 3; ++i) {

@@ -27,7 +27,9 @@ double robustUpdateWeight(RobustLoss loss, double k, double innovation_m, double
     // (F13) posterior residual of the linearised problem with the current weight
     const double var_w = var_m2 / w;
     const double r_post = innovation_m * var_w / (hph_m2 + var_w);
-    w = std::max(robustWeight(loss, r_post / sigma, k), 1e-6);
+    const double w_next = std::max(robustWeight(loss, r_post / sigma, k), 1e-6);
+    if (w_next == w) break;  // fixed point reached: further iterations repeat the same arithmetic
+    w = w_next;
   }
   return w;
 }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <limits>
 
 namespace uwb {
 
@@ -52,19 +53,98 @@ std::vector<TimedImu> pairImuStreams(const std::vector<TimedVec3>& acc_in, const
   return out;
 }
 
+namespace {
+
+bool imuBad(const TimedImu& s) {
+  // 0·x is ±0 for a finite x and NaN for ±∞ or NaN: the sum is zero iff all seven values are finite
+  return 0.0 * s.t_s + (0.0 * s.imu.b_acc_mps2 + 0.0 * s.imu.b_gyro_radps).sum() != 0.0;
+}
+bool tdoaBad(const TdoaObservation& z) { return !std::isfinite(z.t_s) || !std::isfinite(z.tdoa_m); }
+/// The TDoA duplicate rule: same stamp, pair and value (same stamp, other pair is legal).
+bool tdoaSame(const TdoaObservation& a, const TdoaObservation& b) {
+  return a.t_s == b.t_s && a.id_a == b.id_a && a.id_b == b.id_b && a.tdoa_m == b.tdoa_m;
+}
+
+/// Largest gap between consecutive stamps of a time-ordered stream, and the number of gaps above max_gap_s.
+template <class Sample>
+void countGaps(const std::vector<Sample>& v, double max_gap_s, double& max_gap, std::size_t& n_gaps) {
+  for (std::size_t i = 1; i < v.size(); ++i) {
+    const double gap = v[i].t_s - v[i - 1].t_s;
+    max_gap = std::max(max_gap, gap);
+    n_gaps += gap > max_gap_s;
+  }
+}
+
+/// Gap statistics and the merged event sequence of a clean (time-ordered, duplicate-free, finite) log.
+std::vector<SensorEvent> mergeOrderedStreams(const SensorLog& log, double max_gap_s, MergeReport& rep) {
+  countGaps(log.imu, max_gap_s, rep.max_imu_gap_s, rep.n_imu_gaps);
+  countGaps(log.tdoa, max_gap_s, rep.max_tdoa_gap_s, rep.n_tdoa_gaps);
+  // linear merge, IMU first at equal stamps; an exhausted stream reads as +∞. The next event is selected without
+  // a branch (which stream comes next is irregular, so a branch on it would be mispredicted often).
+  const std::size_t n_imu = log.imu.size(), n_tdoa = log.tdoa.size();
+  constexpr double kNever = std::numeric_limits<double>::infinity();
+  std::vector<SensorEvent> events;
+  events.reserve(n_imu + n_tdoa);
+  for (std::size_t i = 0, j = 0; i + j < n_imu + n_tdoa;) {
+    const double t_imu = i < n_imu ? log.imu[i].t_s : kNever;
+    const double t_tdoa = j < n_tdoa ? log.tdoa[j].t_s : kNever;
+    const bool take_imu = t_imu <= t_tdoa;
+    events.push_back(take_imu ? SensorEvent{t_imu, SensorEvent::Kind::kImu, static_cast<unsigned>(i)}
+                              : SensorEvent{t_tdoa, SensorEvent::Kind::kTdoa, static_cast<unsigned>(j)});
+    i += take_imu;
+    j += !take_imu;
+  }
+  if (!log.tof.empty()) {
+    // ToF (≈25 Hz) merged into the IMU/TDoA sequence; std::merge is stable, so ToF goes last at equal stamps
+    std::vector<SensorEvent> tof_events;
+    tof_events.reserve(log.tof.size());
+    for (std::size_t k = 0; k < log.tof.size(); ++k)
+      tof_events.push_back({log.tof[k].t_s, SensorEvent::Kind::kTof, static_cast<unsigned>(k)});
+    std::vector<SensorEvent> merged;
+    merged.reserve(events.size() + tof_events.size());
+    std::merge(events.begin(), events.end(), tof_events.begin(), tof_events.end(), std::back_inserter(merged),
+               [](const SensorEvent& a, const SensorEvent& b) { return a.t_s < b.t_s; });
+    events = std::move(merged);
+  }
+  return events;
+}
+
+}  // namespace
+
+bool sensorLogIsClean(const SensorLog& log) {
+  for (std::size_t i = 0; i < log.imu.size(); ++i)
+    if (imuBad(log.imu[i]) || (i > 0 && !(log.imu[i].t_s > log.imu[i - 1].t_s))) return false;
+  for (std::size_t i = 0; i < log.tdoa.size(); ++i)
+    if (tdoaBad(log.tdoa[i]) ||
+        (i > 0 && (log.tdoa[i].t_s < log.tdoa[i - 1].t_s || tdoaSame(log.tdoa[i], log.tdoa[i - 1]))))
+      return false;
+  for (std::size_t i = 0; i < log.tof.size(); ++i)
+    if (!std::isfinite(log.tof[i].t_s) || (i > 0 && log.tof[i].t_s < log.tof[i - 1].t_s)) return false;
+  return true;
+}
+
+std::vector<SensorEvent> mergeCleanSensorStreams(const SensorLog& log, double max_gap_s, MergeReport* report) {
+  MergeReport rep;
+  rep.n_imu_in = log.imu.size();
+  rep.n_tdoa_in = log.tdoa.size();
+  rep.n_tof_in = log.tof.size();
+  std::vector<SensorEvent> events = mergeOrderedStreams(log, max_gap_s, rep);
+  if (report) {
+    rep.n_imu_unpaired = report->n_imu_unpaired;
+    *report = rep;
+  }
+  return events;
+}
+
 std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, MergeReport* report) {
   MergeReport rep;
   rep.n_imu_in = log.imu.size();
   rep.n_tdoa_in = log.tdoa.size();
   rep.n_tof_in = log.tof.size();
   // drop non-finite samples
-  const auto imu_bad = [](const TimedImu& s) {
-    return !std::isfinite(s.t_s) || !s.imu.b_acc_mps2.allFinite() || !s.imu.b_gyro_radps.allFinite();
-  };
-  const auto tdoa_bad = [](const TdoaObservation& z) { return !std::isfinite(z.t_s) || !std::isfinite(z.tdoa_m); };
   const std::size_t n0 = log.imu.size() + log.tdoa.size();
-  std::erase_if(log.imu, imu_bad);
-  std::erase_if(log.tdoa, tdoa_bad);
+  std::erase_if(log.imu, imuBad);
+  std::erase_if(log.tdoa, tdoaBad);
   rep.n_nonfinite = n0 - log.imu.size() - log.tdoa.size();
   if (!log.tof.empty()) {
     // (F21) ToF: only a non-finite stamp is dropped here; invalid ranges are counted by the filter
@@ -92,49 +172,9 @@ std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, Me
                 log.imu.end());
   rep.n_imu_duplicate = ni - log.imu.size();
   const std::size_t nt = log.tdoa.size();
-  log.tdoa.erase(std::unique(log.tdoa.begin(), log.tdoa.end(),
-                             [](const TdoaObservation& a, const TdoaObservation& b) {
-                               return a.t_s == b.t_s && a.id_a == b.id_a && a.id_b == b.id_b && a.tdoa_m == b.tdoa_m;
-                             }),
-                 log.tdoa.end());
+  log.tdoa.erase(std::unique(log.tdoa.begin(), log.tdoa.end(), tdoaSame), log.tdoa.end());
   rep.n_tdoa_duplicate = nt - log.tdoa.size();
-  // gaps
-  for (std::size_t i = 1; i < log.imu.size(); ++i) {
-    const double gap = log.imu[i].t_s - log.imu[i - 1].t_s;
-    rep.max_imu_gap_s = std::max(rep.max_imu_gap_s, gap);
-    rep.n_imu_gaps += gap > max_gap_s;
-  }
-  for (std::size_t i = 1; i < log.tdoa.size(); ++i) {
-    const double gap = log.tdoa[i].t_s - log.tdoa[i - 1].t_s;
-    rep.max_tdoa_gap_s = std::max(rep.max_tdoa_gap_s, gap);
-    rep.n_tdoa_gaps += gap > max_gap_s;
-  }
-  // linear merge
-  std::vector<SensorEvent> events;
-  events.reserve(log.imu.size() + log.tdoa.size());
-  std::size_t i = 0, j = 0;
-  while (i < log.imu.size() || j < log.tdoa.size()) {
-    const bool take_imu = j >= log.tdoa.size() || (i < log.imu.size() && log.imu[i].t_s <= log.tdoa[j].t_s);
-    if (take_imu) {
-      events.push_back({log.imu[i].t_s, SensorEvent::Kind::kImu, static_cast<unsigned>(i)});
-      ++i;
-    } else {
-      events.push_back({log.tdoa[j].t_s, SensorEvent::Kind::kTdoa, static_cast<unsigned>(j)});
-      ++j;
-    }
-  }
-  if (!log.tof.empty()) {
-    // ToF (≈25 Hz) merged into the IMU/TDoA sequence; std::merge is stable, so ToF goes last at equal stamps
-    std::vector<SensorEvent> tof_events;
-    tof_events.reserve(log.tof.size());
-    for (std::size_t k = 0; k < log.tof.size(); ++k)
-      tof_events.push_back({log.tof[k].t_s, SensorEvent::Kind::kTof, static_cast<unsigned>(k)});
-    std::vector<SensorEvent> merged;
-    merged.reserve(events.size() + tof_events.size());
-    std::merge(events.begin(), events.end(), tof_events.begin(), tof_events.end(), std::back_inserter(merged),
-               [](const SensorEvent& a, const SensorEvent& b) { return a.t_s < b.t_s; });
-    events = std::move(merged);
-  }
+  std::vector<SensorEvent> events = mergeOrderedStreams(log, max_gap_s, rep);
   if (report) {
     rep.n_imu_unpaired = report->n_imu_unpaired;
     *report = rep;

@@ -21,6 +21,16 @@ Quat levelFromGravity(const Vec3& b_acc) {
   return Quat(Eigen::AngleAxisd(pitch, Vec3::UnitY()) * Eigen::AngleAxisd(roll, Vec3::UnitX()));
 }
 
+/// exp(−x) for x ≥ 0, the per-IMU-sample decay factors exp(−Δt/τ) of the stillness EMA (F18) and the take-off leak
+/// (F15). Below 0.1 (every IMU step: Δt/τ ≤ 0.02 at 1 kHz) a Taylor series in Horner form, truncated after the x⁹
+/// term, whose successor is below 3e-17, under double rounding (1.1e-16): std::exp's value to rounding at a fraction
+/// of its cost (the IMU Δt jitters, so caching the factor per Δt rarely hits).
+double expNegative(double x) {
+  if (!(x < 0.1)) return std::exp(-x);
+  return 1.0 + x * (-1.0 + x * (1.0 / 2.0 + x * (-1.0 / 6.0 + x * (1.0 / 24.0 + x * (-1.0 / 120.0 + x * (1.0 / 720.0 +
+         x * (-1.0 / 5040.0 + x * (1.0 / 40320.0 + x * (-1.0 / 362880.0)))))))));
+}
+
 Vec3 sqrtDiag(const ErrMat& P) { return P.diagonal().segment<3>(kPos).cwiseMax(0.0).cwiseSqrt(); }
 
 /// Constant time of the take-off detector's leaky vertical-velocity integrator [s] (F15).
@@ -36,8 +46,14 @@ constexpr double kMlatMaxWindow_s = 3.0;
 constexpr double kStillAccStd_mps2 = 0.12;
 constexpr double kStillGyro_radps = 0.03;
 constexpr double kStillTau_s = 0.1;
+/// The stillness thresholds compared with the EMA statistics as squares (acc variance, gyro mean square): no sqrt.
+constexpr double kStillAccVar_m2ps4 = kStillAccStd_mps2 * kStillAccStd_mps2;
+constexpr double kStillGyroMs_rad2ps2 = kStillGyro_radps * kStillGyro_radps;
 /// Touchdown: high-passed gyro rms above this [rad/s] (≈40 °/s; flight vibration is 3–10 °/s) (F18).
 constexpr double kTouchdownGyro_radps = 0.45;
+constexpr double kTouchdownGyroMs_rad2ps2 = kTouchdownGyro_radps * kTouchdownGyro_radps;
+/// Landing "slow" test (F18): |v| below this [m/s], compared as a square.
+constexpr double kLandingSpeed_mps = 0.25;
 /// Touchdown: the height test uses the lowest estimate of this recent window [s], sampled every 10 ms (F18):
 /// on ground contact the estimate can run away upwards (biased TDoA are gated, the thrust model integrates the
 /// contact force) before the vibration burst is seen.
@@ -52,10 +68,17 @@ TdoaLocalizer::TdoaLocalizer(const EkfParams& params, AnchorTable anchors, BiasP
   if (anchors_.size() < 4) throw std::invalid_argument("TdoaLocalizer: at least 4 anchors are needed");
 }
 
-LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const {
+LocalizerResult TdoaLocalizer::run(const SensorLog& input, double output_period_s) const {
   LocalizerResult result;
   LocalizerSummary& sum = result.summary;
-  const std::vector<SensorEvent> events = mergeSensorStreams(log, params_.max_gap_s, &sum.merge);
+  // (F17) streams cleaned and merged; the input is copied only when it needs cleaning
+  SensorLog cleaned;
+  const bool input_clean = sensorLogIsClean(input);
+  if (!input_clean) cleaned = input;
+  const SensorLog& log = input_clean ? input : cleaned;
+  const std::vector<SensorEvent> events = input_clean
+                                              ? mergeCleanSensorStreams(input, params_.max_gap_s, &sum.merge)
+                                              : mergeSensorStreams(cleaned, params_.max_gap_s, &sum.merge);
   if (events.empty()) return result;
 
   EkfParams p = params_;
@@ -68,6 +91,11 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
   sum.start_t_s = events.front().t_s;
   sum.end_t_s = events.back().t_s;
   const BiasPredictor* bias = bias_ ? &bias_ : nullptr;
+  // emit() spaces the outputs by output_period_s (plus one forced at the end): reserve once, no regrowth
+  const double n_out_max = output_period_s > 0.0 ? (sum.end_t_s - sum.start_t_s) / output_period_s + 2.0 : 0.0;
+  result.estimates.reserve(output_period_s > 0.0 && n_out_max < static_cast<double>(events.size())
+                               ? static_cast<std::size_t>(n_out_max)
+                               : events.size() + 1);
 
   TdoaUpdateOptions track_opt;
   track_opt.sigma_m = p.tdoa_sigma_m;
@@ -113,7 +141,7 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
   // IMU averaging (F17)
   Vec3 acc_sum = Vec3::Zero(), gyro_sum = Vec3::Zero();
   int n_imu_acc = 0;
-  ImuReading last_imu;
+  const ImuReading* last_imu = nullptr;  // the latest IMU sample (in `log`, not copied per sample)
   // initialisation window for levelling
   Vec3 init_acc_sum = Vec3::Zero(), init_gyro_sum = Vec3::Zero();
   int n_init = 0;
@@ -124,7 +152,7 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
   double t_last_imu = std::numeric_limits<double>::quiet_NaN();
   double acc_mean = kGravity_mps2, acc_var = 1.0, gyro_ms = 1.0, gyro_hp_ms = 0.0;
   Vec3 gyro_mean = Vec3::Zero();
-  double last_dt_imu = -1.0, ema_factor = 0.0;
+
   double z_takeoff = p.ground_z_m;
   double t_low_slow = std::numeric_limits<double>::quiet_NaN();
   // recent estimates (F18 touchdown): ring buffer of (t, p) every 10 ms while tracking
@@ -161,7 +189,7 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
     const double dt = t - t_pred;
     if (!(dt > 0.0)) return;
     if (imu_mode) {
-      ImuReading m = last_imu;
+      ImuReading m = last_imu ? *last_imu : ImuReading{};
       if (n_imu_acc > 0) {
         m.b_acc_mps2 = acc_sum / n_imu_acc;
         m.b_gyro_radps = gyro_sum / n_imu_acc;
@@ -290,23 +318,19 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
         init_gyro_sum += imu.b_gyro_radps;
         ++n_init;
         if (t - t_first_imu >= 0.1 || n_init >= 100) initialize(t, init_acc_sum / n_init, init_gyro_sum / n_init);
-        last_imu = imu;
+        last_imu = &imu;
         t_last_imu = t;
         continue;
       }
       const double dt_imu = std::isnan(t_last_imu) ? 0.0 : std::min(t - t_last_imu, 0.05);
       t_last_imu = t;
-      last_imu = imu;
+      last_imu = &imu;
       acc_sum += imu.b_acc_mps2;
       gyro_sum += imu.b_gyro_radps;
       ++n_imu_acc;
       // stillness statistics (F18)
       if (dt_imu > 0.0) {
-        if (dt_imu != last_dt_imu) {  // the IMU period is nearly constant: cache the EMA factor
-          last_dt_imu = dt_imu;
-          ema_factor = std::exp(-dt_imu / kStillTau_s);
-        }
-        const double a = ema_factor;
+        const double a = expNegative(dt_imu / kStillTau_s);
         const double an = imu.b_acc_mps2.norm();
         acc_mean = a * acc_mean + (1 - a) * an;
         acc_var = a * acc_var + (1 - a) * (an - acc_mean) * (an - acc_mean);
@@ -314,12 +338,12 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
         gyro_mean = a * gyro_mean + (1 - a) * imu.b_gyro_radps;
         gyro_hp_ms = a * gyro_hp_ms + (1 - a) * (imu.b_gyro_radps - gyro_mean).squaredNorm();
       }
-      const bool still = std::sqrt(acc_var) < kStillAccStd_mps2 && std::sqrt(gyro_ms) < kStillGyro_radps;
+      const bool still = acc_var < kStillAccVar_m2ps4 && gyro_ms < kStillGyroMs_rad2ps2;
       if (phase == FlightPhase::kGround || phase == FlightPhase::kLanded) {
         // (F15) take-off detector: leaky integral of the vertical specific-force excess
         const double a_up = (ekf.state().w_q_b * imu.b_acc_mps2).z();
         if (dt_imu > 0.0) {
-          v_det = std::exp(-dt_imu / kTakeoffLeak_s) * v_det + dt_imu * (a_up - g_ref);
+          v_det = expNegative(dt_imu / kTakeoffLeak_s) * v_det + dt_imu * (a_up - g_ref);
           if (still || v_det < 0.05) g_ref += (dt_imu / 2.0) * (a_up - g_ref);
         }
         // after a landing, a new take-off must climb twice as fast (touchdown bounces and spin-down are not flight)
@@ -349,12 +373,13 @@ LocalizerResult TdoaLocalizer::run(SensorLog log, double output_period_s) const 
           n_recent = std::min(n_recent + 1, kTouchdownHistory);
           t_last_recent = t;
         }
-        const bool low_slow = x.w_p_b.z() - z_takeoff < p.landing_height_m && x.w_v_b.norm() < 0.25;
+        const bool low_slow = x.w_p_b.z() - z_takeoff < p.landing_height_m &&
+                              x.w_v_b.squaredNorm() < kLandingSpeed_mps * kLandingSpeed_mps;
         // touchdown: the vibration burst of ground contact near the take-off height (F18); the height test uses
         // the lowest recent estimate, since on contact the estimate can already have run away upwards
         bool touchdown = false;
         int i_low = -1;
-        if (std::sqrt(gyro_hp_ms) > kTouchdownGyro_radps) {
+        if (gyro_hp_ms > kTouchdownGyroMs_rad2ps2) {
           for (int k = 0; k < n_recent; ++k)
             if (i_low < 0 || recent[k].w_p_b.z() < recent[i_low].w_p_b.z()) i_low = k;
           touchdown = i_low >= 0 && recent[i_low].w_p_b.z() - z_takeoff < 0.8;

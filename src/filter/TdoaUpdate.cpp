@@ -5,6 +5,7 @@
 #include "uwb/filter/TdoaUpdate.h"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "uwb/model/TdoaLinearization.h"
 #include "uwb/model/TdoaModel.h"
@@ -44,6 +45,23 @@ ScalarLinearMessage<kDim> tdoaMessageOnPositionAttitude(const TdoaNodeMessages& 
   return out;
 }
 
+TdoaNodeMessages tdoaNodeForwardToTag(const TdoaLinearization& lin, const Moments3& x_i, const Moments3& x_j,
+                                      double z_m, double var_m2) {
+  if (!(var_m2 > 0.0) || !std::isfinite(var_m2))
+    throw std::invalid_argument("TDoA node: measurement variance must be finite and > 0");
+  TdoaNodeMessages msg;
+  // (G11) µ3 = N(−B1 m1, B1 Σ1 B1ᵀ), µ4 = N(B2 m2, B2 Σ2 B2ᵀ); B Σ Bᵀ = 0 for an exact (zero-covariance) anchor
+  msg.mu3.m = -lin.B1.dot(x_i.m);
+  msg.mu4.m = lin.B2.dot(x_j.m);
+  // (a covariance with a zero diagonal is zero: |Σ_ij| ≤ √(Σ_ii Σ_jj))
+  if (!x_i.V.diagonal().isZero(0.0)) msg.mu3.V = lin.B1 * x_i.V * lin.B1.transpose();
+  if (!x_j.V.diagonal().isZero(0.0)) msg.mu4.V = lin.B2 * x_j.V * lin.B2.transpose();
+  // (G12) µ7 = N(m6 − m3 − m4 − D, Σ6 + Σ3 + Σ4)
+  msg.mu7 = {z_m - msg.mu3.m - msg.mu4.m - lin.D, var_m2 + msg.mu3.V + msg.mu4.V};
+  msg.B12 = lin.B12();
+  return msg;
+}
+
 std::optional<ScalarLinearMessage<kDim>> tdoaMessage(const NavState& x, const AnchorTable& anchors,
                                                      const TdoaObservation& z, double z_corrected_m, double var_m2,
                                                      const Vec3& b_t_tag) {
@@ -56,11 +74,18 @@ std::optional<ScalarLinearMessage<kDim>> tdoaMessage(const NavState& x, const An
   const Vec3 w_p_tag = x.w_p_b + w_R_b * b_t_tag;
   const std::optional<TdoaLinearization> lin = linearizeTdoa(w_p_tag, anchor_b->m, anchor_a->m);
   if (!lin) return std::nullopt;
-  // Paper Fig. 2: the TDoA node's forward pass (G11–G13) …
-  const TdoaNodeMessages node = tdoaNodeForward(*lin, *anchor_b, *anchor_a, z_corrected_m, var_m2);
-  // … and the message on δx through x_k = x̃_k + C δx, C = [I 0 −R[b_t]× 0 0] (G16; model M4).
-  const Mat3 J_tag_att = -(w_R_b * skew(b_t_tag));  // = tagPositionJacobianAttitude(w_q_b, b_t_tag) (M4)
-  return tdoaMessageOnPositionAttitude(node, J_tag_att, w_p_tag);
+  // Paper Fig. 2: the TDoA node's forward pass (G11–G12; the filter needs µ7 and B12 only) …
+  const TdoaNodeMessages node = tdoaNodeForwardToTag(*lin, *anchor_b, *anchor_a, z_corrected_m, var_m2);
+  // … and the message on δx through x_k = x̃_k + C δx, C = [I 0 −R[b_t]× 0 0] (G16; model M4), as in
+  // tdoaMessageOnPositionAttitude but without forming C's attitude block: a_θ = −B12 R [b_t]× = (b_t × Rᵀ B12ᵀ)ᵀ.
+  ScalarLinearMessage<kDim> out;
+  out.a.setZero();
+  out.a.segment<3>(kPos) = node.B12;
+  const Vec3 R_B12 = w_R_b.transpose() * node.B12.transpose();
+  out.a.segment<3>(kAtt) = b_t_tag.cross(R_B12).transpose();
+  out.y = node.mu7.m - node.B12.dot(w_p_tag);
+  out.var = node.mu7.V;
+  return out;
 }
 
 TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObservation& z,
@@ -91,16 +116,18 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
     return res;
   }
   // (F11) χ² gate on the unweighted innovation
-  // The message row a = B12 C is non-zero only in the position and attitude blocks, so a P aᵀ needs only the
-  // 6×6 sub-block of P (F11; the same value as innovationOf, G17, at a sixth of the cost), read in place by blocks.
+  // The message row a = B12 C is non-zero only in the position and attitude blocks, so u = P aᵀ needs only those
+  // 6 columns of P (G17). u is formed once, in full, for both the gate (a u) and the equality node (G18).
   const ErrMat& P = ekf.covariance();
   const Vec3 a_p = msg->a.segment<3>(kPos).transpose();
   const Vec3 a_att = msg->a.segment<3>(kAtt).transpose();
-  const Vec3 Pa_p = P.block<3, 3>(kPos, kPos) * a_p + P.block<3, 3>(kPos, kAtt) * a_att;
-  const Vec3 Pa_att = P.block<3, 3>(kAtt, kPos) * a_p + P.block<3, 3>(kAtt, kAtt) * a_att;
+  ErrVec P_a;
+  P_a.noalias() = P.middleCols<3>(kPos) * a_p;
+  P_a.noalias() += P.middleCols<3>(kAtt) * a_att;
+  const double a_P_a = a_p.dot(P_a.segment<3>(kPos)) + a_att.dot(P_a.segment<3>(kAtt));
   InnovationStats st;
   st.innovation_m = msg->y;  // prior error state is zero
-  st.innovation_var_m2 = a_p.dot(Pa_p) + a_att.dot(Pa_att) + msg->var;
+  st.innovation_var_m2 = a_P_a + msg->var;
   st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
   res.innovation_m = st.innovation_m;
   res.nis = st.nis;
@@ -113,7 +140,7 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
   res.weight = robustUpdateWeight(options.loss, options.robust_k, st.innovation_m, hph, msg->var,
                                   options.robust_iterations);
   msg->var /= res.weight;
-  if (!ekf.correctPositionAttitude(*msg)) {  // the TDoA row touches only δp and δθ (G16)
+  if (!ekf.correctPositionAttitude(*msg, P_a, a_P_a)) {  // the TDoA row touches only δp and δθ (G16)
     res.outcome = UpdateOutcome::kDegenerate;
     return res;
   }

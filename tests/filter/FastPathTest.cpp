@@ -1,18 +1,22 @@
 /** @file FastPathTest.cpp
  *  @brief The structure-exploiting fast paths of the filter (issue 3) against their dense references:
  *         Taylor-series SO(3) Exp and right Jacobian (F6, F8), column-block covariance fold (F7), the TDoA message
- *         built from C's two blocks (G16), and the two-block equality node (G18).
+ *         built from C's two blocks (G16), and the two-block equality node (G18); the filter's part of the TDoA node
+ *         (G11–G12), its attitude row without C, and the equality node given the gate's P aᵀ.
  */
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include "support/TestSupport.h"
 #include "uwb/filter/Ekf.h"
 #include "uwb/filter/QuadImuProcess.h"
 #include "uwb/filter/TdoaUpdate.h"
 #include "uwb/graph/TdoaCorrection.h"
+#include "uwb/graph/TdoaNode.h"
 #include "uwb/model/TdoaModel.h"
 
 namespace uwb {
@@ -168,6 +172,81 @@ TEST(TdoaFastPath, TwoBlockEqualityNodeRefusesExactPriorAndMessage) {
   EXPECT_FALSE(equalityRankOneTwoBlocksInPlace<kDim>(m, P, msg, kPos, kAtt));
   EXPECT_EQ((P - P0).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_EQ(m.norm(), 0.0);
+}
+
+TEST(TdoaFastPath, NodeForwardToTagEqualsFullForwardPass) {
+  for (double anchor_sigma : {0.0, 0.05}) {
+    SCOPED_TRACE("anchor sigma " + std::to_string(anchor_sigma));
+    // GIVEN a linearization at a tag position and two anchors, exact or uncertain
+    const Moments3 anchor_a{Vec3(-3.0, -4.0, 0.2), Mat3::Identity() * anchor_sigma * anchor_sigma};
+    const Moments3 anchor_b{Vec3(3.5, 4.0, 2.8), Mat3::Identity() * 2.0 * anchor_sigma * anchor_sigma};
+    const TdoaLinearization lin = *linearizeTdoa(Vec3(0.4, -0.7, 1.2), anchor_b.m, anchor_a.m);
+    // WHEN running the full forward pass (G11–G13) and the filter's part of it
+    const TdoaNodeMessages full = tdoaNodeForward(lin, anchor_b, anchor_a, 1.3, 0.1);
+    const TdoaNodeMessages tag = tdoaNodeForwardToTag(lin, anchor_b, anchor_a, 1.3, 0.1);
+    // THEN µ3, µ4, µ7 and B12 are the same (the anchor terms are exactly 0 for exact anchors)
+    EXPECT_NEAR(tag.mu3.m, full.mu3.m, 1e-15);
+    EXPECT_NEAR(tag.mu4.m, full.mu4.m, 1e-15);
+    EXPECT_NEAR(tag.mu3.V, full.mu3.V, 1e-18);
+    EXPECT_NEAR(tag.mu4.V, full.mu4.V, 1e-18);
+    EXPECT_NEAR(tag.mu7.m, full.mu7.m, 1e-15);
+    EXPECT_NEAR(tag.mu7.V, full.mu7.V, 1e-17);
+    EXPECT_EQ(tag.B12, full.B12);
+    if (anchor_sigma == 0.0) EXPECT_EQ(tag.mu7.V, 0.1);
+    else EXPECT_GT(tag.mu7.V, 0.1);
+  }
+  EXPECT_THROW(tdoaNodeForwardToTag(TdoaLinearization{}, Moments3{}, Moments3{}, 0.0, 0.0), std::invalid_argument);
+}
+
+TEST(TdoaFastPath, MessageAttitudeRowEqualsJacobianProduct) {
+  // GIVEN a tilted pose and two exact anchors
+  AnchorTable anchors;
+  anchors.set(0, Vec3(-3.0, -4.0, 0.2));
+  anchors.set(1, Vec3(3.5, 4.0, 2.8));
+  NavState x;
+  x.w_p_b = Vec3(0.4, -0.7, 1.2);
+  x.w_q_b = Quat(Eigen::AngleAxisd(0.5, Vec3(0.3, 0.2, 1.0).normalized()));
+  // WHEN building the filter's TDoA message and the reference from the node and J_tag_att = −R[b_t]× (G16, M4)
+  const std::optional<ScalarLinearMessage<kDim>> msg =
+      tdoaMessage(x, anchors, TdoaObservation{0.0, 0, 1, 1.3}, 1.3, 0.1, kUtilTagOffset_b);
+  const Vec3 w_p_tag = tagPosition(x.w_p_b, x.w_q_b, kUtilTagOffset_b);
+  const TdoaLinearization lin = *linearizeTdoa(w_p_tag, anchors.find(1)->m, anchors.find(0)->m);
+  const ScalarLinearMessage<kDim> ref = tdoaMessageOnPositionAttitude(
+      tdoaNodeForward(lin, *anchors.find(1), *anchors.find(0), 1.3, 0.1),
+      tagPositionJacobianAttitude(x.w_q_b, kUtilTagOffset_b), w_p_tag);
+  // THEN they agree to rounding
+  ASSERT_TRUE(msg);
+  EXPECT_LT((msg->a - ref.a).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_NEAR(msg->y, ref.y, 1e-14);
+  EXPECT_DOUBLE_EQ(msg->var, ref.var);
+}
+
+TEST(TdoaFastPath, EqualityNodeWithCallersPaEqualsTwoBlockNode) {
+  // GIVEN a filter with a random covariance and a position/attitude message
+  std::mt19937 rng(7);
+  std::normal_distribution<double> n(0.0, 1.0);
+  Ekf a(EkfParams{}), b(EkfParams{});
+  NavState x;
+  x.w_p_b = Vec3(0.3, -0.2, 1.5);
+  const ErrMat P = randomCovariance(rng);
+  a.initialize(x, P);
+  b.initialize(x, P);
+  ScalarLinearMessage<kDim> msg;
+  msg.a.setZero();
+  msg.a.segment<3>(kPos) = Vec3(n(rng), n(rng), n(rng)).transpose();
+  msg.a.segment<3>(kAtt) = 0.1 * Vec3(n(rng), n(rng), n(rng)).transpose();
+  msg.y = 0.2;
+  msg.var = 0.04;
+  // WHEN one update forms P aᵀ itself and the other is given P aᵀ and a P aᵀ (as updateTdoa does for its gate)
+  const ErrVec P_a = a.covariance() * msg.a.transpose();
+  const auto st_a = a.correctPositionAttitude(msg, P_a, msg.a.dot(P_a));
+  const auto st_b = b.correctPositionAttitude(msg);
+  // THEN the posteriors agree to rounding
+  ASSERT_TRUE(st_a && st_b);
+  EXPECT_NEAR(st_a->innovation_var_m2, st_b->innovation_var_m2, 1e-14);
+  EXPECT_LT((a.covariance() - b.covariance()).cwiseAbs().maxCoeff(), 1e-14);
+  EXPECT_LT((a.state().w_p_b - b.state().w_p_b).cwiseAbs().maxCoeff(), 1e-14);
+  EXPECT_EQ((a.covariance() - a.covariance().transpose()).cwiseAbs().maxCoeff(), 0.0);
 }
 
 }  // namespace

@@ -92,5 +92,59 @@ TEST(SensorEvents, PairsAccAndGyroByZeroOrderHold) {
   EXPECT_DOUBLE_EQ(imu[2].imu.b_gyro_radps.x(), 2.0);
 }
 
+TEST(SensorEvents, CleanLogMergesInPlaceLikeTheCleaningMerge) {
+  // GIVEN a clean log with a gap, equal stamps and ToF
+  SensorLog log;
+  for (int i = 0; i < 20; ++i) log.imu.push_back(imuAt(0.001 * i + (i >= 10 ? 0.5 : 0.0)));
+  log.tdoa = {{0.0005, 0, 1, 0.1}, {0.002, 1, 2, 0.2}, {0.002, 2, 3, 0.3}, {0.6, 0, 1, 0.1}};
+  log.tof = {{0.001, 1.0}, {0.51, 1.1}};
+  ASSERT_TRUE(sensorLogIsClean(log));
+  // WHEN merging it in place and through the cleaning merge
+  MergeReport rep_clean, rep;
+  const std::vector<SensorEvent> ev_clean = mergeCleanSensorStreams(log, 0.2, &rep_clean);
+  SensorLog copy = log;
+  const std::vector<SensorEvent> ev = mergeSensorStreams(copy, 0.2, &rep);
+  // THEN the events and reports are the same
+  ASSERT_EQ(ev_clean.size(), ev.size());
+  for (std::size_t i = 0; i < ev.size(); ++i) {
+    EXPECT_EQ(ev_clean[i].t_s, ev[i].t_s);
+    EXPECT_EQ(ev_clean[i].kind, ev[i].kind);
+    EXPECT_EQ(ev_clean[i].index, ev[i].index);
+  }
+  EXPECT_EQ(rep_clean.n_imu_gaps, 1u);
+  EXPECT_EQ(rep_clean.n_imu_gaps, rep.n_imu_gaps);
+  EXPECT_EQ(rep_clean.n_tdoa_gaps, rep.n_tdoa_gaps);
+  EXPECT_EQ(rep_clean.max_imu_gap_s, rep.max_imu_gap_s);
+  EXPECT_EQ(rep_clean.max_tdoa_gap_s, rep.max_tdoa_gap_s);
+  EXPECT_EQ(rep_clean.n_tof_in, rep.n_tof_in);
+  EXPECT_EQ(rep_clean.notes(), rep.notes());
+}
+
+TEST(SensorEvents, LogsThatNeedCleaningAreNotClean) {
+  // GIVEN a clean log, and variants with each defect the cleaning merge repairs
+  SensorLog clean;
+  clean.imu = {imuAt(0.0), imuAt(0.001)};
+  clean.tdoa = {{0.0, 0, 1, 0.1}, {0.0, 1, 2, 0.1}};
+  clean.tof = {{0.0, 1.0}};
+  EXPECT_TRUE(sensorLogIsClean(clean));
+  SensorLog dup_imu = clean;
+  dup_imu.imu[1].t_s = 0.0;
+  SensorLog nan_acc = clean;
+  nan_acc.imu[0].imu.b_acc_mps2.y() = std::nan("");
+  SensorLog inf_gyro = clean;
+  inf_gyro.imu[1].imu.b_gyro_radps.z() = INFINITY;
+  SensorLog dup_tdoa = clean;
+  dup_tdoa.tdoa[1] = dup_tdoa.tdoa[0];
+  SensorLog unordered_tdoa = clean;
+  unordered_tdoa.tdoa[0].t_s = 0.01;
+  SensorLog nan_tdoa = clean;
+  nan_tdoa.tdoa[1].tdoa_m = std::nan("");
+  SensorLog tof_nan_stamp = clean;
+  tof_nan_stamp.tof[0].t_s = std::nan("");
+  // THEN none of them is clean
+  for (const SensorLog* l : {&dup_imu, &nan_acc, &inf_gyro, &dup_tdoa, &unordered_tdoa, &nan_tdoa, &tof_nan_stamp})
+    EXPECT_FALSE(sensorLogIsClean(*l));
+}
+
 }  // namespace
 }  // namespace uwb

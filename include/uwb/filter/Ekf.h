@@ -74,6 +74,10 @@ class Ekf {
   /// correct() for a message whose row is zero outside the position and attitude blocks (a TDoA message,
   /// a = B12 C, G16): the equality node then reads only those 6 columns of P (equalityRankOneTwoBlocksInPlace).
   std::optional<InnovationStats> correctPositionAttitude(const ScalarLinearMessage<kDim>& message);
+  /// correctPositionAttitude() given P_a = P aᵀ and a_P_a = a P aᵀ of the current P, which the caller already
+  /// formed (e.g. for its χ² gate, F11), so the equality node (G18) does not form them again.
+  std::optional<InnovationStats> correctPositionAttitude(const ScalarLinearMessage<kDim>& message, const ErrVec& P_a,
+                                                         double a_P_a);
   /// Innovation statistics of a message without applying it (G17).
   InnovationStats innovation(const ScalarLinearMessage<kDim>& message) const;
 

@@ -69,4 +69,13 @@ struct SensorEvent {
 /// the merged event sequence, ordered by time; at equal stamps IMU comes before TDoA, and both before ToF.
 std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, MergeReport* report = nullptr);
 
+/// True when mergeSensorStreams would leave `log` unchanged: all stamps and values finite, IMU stamps strictly
+/// increasing, TDoA stamps non-decreasing with no duplicate, ToF stamps finite and non-decreasing.
+bool sensorLogIsClean(const SensorLog& log);
+
+/// mergeSensorStreams for a log that is already clean (sensorLogIsClean): the same events and report, without
+/// copying or modifying the log.
+std::vector<SensorEvent> mergeCleanSensorStreams(const SensorLog& log, double max_gap_s,
+                                                 MergeReport* report = nullptr);
+
 }  // namespace uwb

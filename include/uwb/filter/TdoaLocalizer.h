@@ -75,8 +75,9 @@ class TdoaLocalizer {
 
   /// Runs over the whole log (cleaned and merged first, F17). Without IMU samples the TDoA-only model is used
   /// (params.process_model if it is not kImu, else constant velocity). output_period_s: minimum spacing of
-  /// output samples (0: one per event).
-  LocalizerResult run(SensorLog log, double output_period_s = 0.01) const;
+  /// output samples (0: one per event). A clean log (sensorLogIsClean, the usual case) is read in place; otherwise
+  /// a cleaned copy is made.
+  LocalizerResult run(const SensorLog& log, double output_period_s = 0.01) const;
 
  private:
   EkfParams params_;

@@ -11,6 +11,7 @@
 #include "uwb/filter/Ekf.h"
 #include "uwb/filter/OutlierGate.h"
 #include "uwb/graph/GaussianMessage.h"
+#include "uwb/graph/TdoaNode.h"
 #include "uwb/model/TdoaFeature.h"
 
 namespace uwb {
@@ -68,6 +69,14 @@ std::optional<ScalarLinearMessage<kDim>> tdoaMessage(const NavState& x, const An
 /// that dense C, built from C's two non-zero blocks. The returned row is zero outside δp and δθ.
 ScalarLinearMessage<kDim> tdoaMessageOnPositionAttitude(const TdoaNodeMessages& node, const Mat3& J_tag_att,
                                                         const Vec3& w_p_tag);
+
+/// The part of the TDoA node's forward pass (tdoaNodeForward, G11–G13) that the filter's message on δx (G16) uses:
+/// µ3, µ4, µ7 and B12, with the same values; W7, ξ7 and µ8 are left at zero. The anchor terms B Σ Bᵀ of Σ7 are
+/// skipped for anchors with zero covariance (surveyed anchors, EkfParams::anchor_sigma_m = 0), where they are 0;
+/// the anchors' Σ must be covariances (symmetric positive semi-definite), so that a zero diagonal means Σ = 0.
+/// Throws std::invalid_argument if var_m2 is not finite and > 0.
+TdoaNodeMessages tdoaNodeForwardToTag(const TdoaLinearization& lin, const Moments3& x_i, const Moments3& x_j,
+                                      double z_m, double var_m2);
 
 /// Full TDoA update of `ekf` (F10–F13). The covariance should be propagated (Ekf::propagateCovariance) by the
 /// caller according to its schedule. `bias` may be null (no bias correction).
