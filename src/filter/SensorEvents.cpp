@@ -83,14 +83,14 @@ std::vector<SensorEvent> mergeOrderedStreams(const SensorLog& log, double max_ga
   // a branch (which stream comes next is irregular, so a branch on it would be mispredicted often).
   const std::size_t n_imu = log.imu.size(), n_tdoa = log.tdoa.size();
   constexpr double kNever = std::numeric_limits<double>::infinity();
-  std::vector<SensorEvent> events;
-  events.reserve(n_imu + n_tdoa);
-  for (std::size_t i = 0, j = 0; i + j < n_imu + n_tdoa;) {
+  std::vector<SensorEvent> events(n_imu + n_tdoa);
+  std::size_t i = 0, j = 0;
+  for (SensorEvent& e : events) {
     const double t_imu = i < n_imu ? log.imu[i].t_s : kNever;
     const double t_tdoa = j < n_tdoa ? log.tdoa[j].t_s : kNever;
     const bool take_imu = t_imu <= t_tdoa;
-    events.push_back(take_imu ? SensorEvent{t_imu, SensorEvent::Kind::kImu, static_cast<unsigned>(i)}
-                              : SensorEvent{t_tdoa, SensorEvent::Kind::kTdoa, static_cast<unsigned>(j)});
+    e = take_imu ? SensorEvent{t_imu, SensorEvent::Kind::kImu, static_cast<unsigned>(i)}
+                 : SensorEvent{t_tdoa, SensorEvent::Kind::kTdoa, static_cast<unsigned>(j)};
     i += take_imu;
     j += !take_imu;
   }

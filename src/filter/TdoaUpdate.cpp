@@ -62,12 +62,12 @@ TdoaNodeMessages tdoaNodeForwardToTag(const TdoaLinearization& lin, const Moment
   return msg;
 }
 
-std::optional<ScalarLinearMessage<kDim>> tdoaMessage(const NavState& x, const AnchorTable& anchors,
-                                                     const TdoaObservation& z, double z_corrected_m, double var_m2,
-                                                     const Vec3& b_t_tag) {
-  const Moments3* anchor_a = anchors.find(z.id_a);
-  const Moments3* anchor_b = anchors.find(z.id_b);
-  if (!anchor_a || !anchor_b) return std::nullopt;
+namespace {
+
+/// tdoaMessage for anchors already looked up (ids z.id_a, z.id_b; updateTdoa needs them anyway).
+std::optional<ScalarLinearMessage<kDim>> tdoaMessageFromAnchors(const NavState& x, const Moments3* anchor_a,
+                                                                const Moments3* anchor_b, double z_corrected_m,
+                                                                double var_m2, const Vec3& b_t_tag) {
   // (F10) linearise at the tag position x̃_k = p + R b_t; UTIL convention ⇒ x_i = anchor B, x_j = anchor A.
   // One rotation matrix serves the tag position (M2) and its attitude Jacobian −R[b_t]× (M4).
   const Mat3 w_R_b = x.w_q_b.toRotationMatrix();
@@ -86,6 +86,17 @@ std::optional<ScalarLinearMessage<kDim>> tdoaMessage(const NavState& x, const An
   out.y = node.mu7.m - node.B12.dot(w_p_tag);
   out.var = node.mu7.V;
   return out;
+}
+
+}  // namespace
+
+std::optional<ScalarLinearMessage<kDim>> tdoaMessage(const NavState& x, const AnchorTable& anchors,
+                                                     const TdoaObservation& z, double z_corrected_m, double var_m2,
+                                                     const Vec3& b_t_tag) {
+  const Moments3* anchor_a = anchors.find(z.id_a);
+  const Moments3* anchor_b = anchors.find(z.id_b);
+  if (!anchor_a || !anchor_b) return std::nullopt;
+  return tdoaMessageFromAnchors(x, anchor_a, anchor_b, z_corrected_m, var_m2, b_t_tag);
 }
 
 TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObservation& z,
@@ -110,7 +121,8 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
       res.bias_mean_m = b.mean_m;
     }
   }
-  std::optional<ScalarLinearMessage<kDim>> msg = tdoaMessage(x, anchors, z, z_corr, var, options.b_t_tag);
+  std::optional<ScalarLinearMessage<kDim>> msg =
+      tdoaMessageFromAnchors(x, anchor_a, anchor_b, z_corr, var, options.b_t_tag);
   if (!msg) {
     res.outcome = UpdateOutcome::kDegenerate;
     return res;
