@@ -16,11 +16,11 @@ void AnchorTable::set(int id, const Vec3& w_p, double sigma_m) {
   if (id < 0 || id > 4095) throw std::invalid_argument("AnchorTable::set: anchor id must be in [0, 4095]");
   if (static_cast<int>(anchors_.size()) <= id) {
     anchors_.resize(id + 1);
-    known_.resize(id + 1, false);
+    known_.resize(id + 1, 0);
   }
   anchors_[id].m = w_p;
   anchors_[id].V = Mat3::Identity() * (sigma_m * sigma_m);
-  known_[id] = true;
+  known_[id] = 1;
 }
 
 std::vector<int> AnchorTable::ids() const {

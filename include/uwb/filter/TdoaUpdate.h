@@ -30,7 +30,7 @@ class AnchorTable {
 
  private:
   std::vector<Moments3> anchors_;
-  std::vector<bool> known_;
+  std::vector<unsigned char> known_;  ///< 1 where an anchor is set (bytes: find() is on the per-TDoA path)
 };
 
 /// One TDoA as the filter sees it: tdoa_m = |p_tag − a_B| − |p_tag − a_A| (UTIL convention).
