@@ -3,7 +3,12 @@
  */
 #pragma once
 
+#include <functional>
+#include <random>
+
+#include "uwb/filter/SensorEvents.h"
 #include "uwb/filter/TdoaUpdate.h"
+#include "uwb/model/TdoaModel.h"
 
 namespace uwb::filtertest {
 
@@ -31,6 +36,50 @@ inline Vertical takeoffProfile(double t) {
     return {0.55 + s - 0.5 * s * s, 1.0 - s, -1.0};
   }
   return {1.05, 0.0, 0.0};
+}
+
+/// A synthetic take-off flight at (0.8, −0.5) in the arena, level attitude, following takeoffProfile().
+struct TakeoffLogSpec {
+  double duration_s = 10.0;
+  unsigned seed = 1;  ///< used by takeoffLog(spec) without an rng
+  double acc_noise_mps2 = 0.3;      ///< white noise per accelerometer axis and sample
+  double gyro_noise_radps = 0.02;   ///< white noise per gyroscope axis and sample
+  double tdoa_noise_m = 0.1;        ///< white noise per TDoA sample
+  /// Accelerometer z bias [m/s²] at time t (none by default).
+  std::function<double(double)> acc_bias_z = [](double) { return 0.0; };
+  /// Height offset [m] of the position the TDoA are generated from, at time t (a UWB height bias; none by default).
+  std::function<double(double)> tdoa_dz = [](double) { return 0.0; };
+};
+
+/// IMU at 1 kHz and TDoA at 400 Hz on the neighbour pairs (k, k+1 mod 8) of arenaAnchors(); no ToF. The noise
+/// is drawn from `rng` (seeded with spec.seed by the caller), which a caller may go on drawing from.
+inline SensorLog takeoffLog(const TakeoffLogSpec& spec, std::mt19937& rng) {
+  const AnchorTable anchors = arenaAnchors();
+  const Vec3 p0(0.8, -0.5, 0.0);
+  std::normal_distribution<double> n(0.0, 1.0);
+  SensorLog log;
+  for (double t = 0.0; t <= spec.duration_s; t += 0.001) {
+    TimedImu s;
+    s.t_s = t;
+    s.imu.b_acc_mps2 = Vec3(0, 0, takeoffProfile(t).az + kGravity_mps2 + spec.acc_bias_z(t)) +
+                       spec.acc_noise_mps2 * Vec3(n(rng), n(rng), n(rng));
+    s.imu.b_gyro_radps = spec.gyro_noise_radps * Vec3(n(rng), n(rng), n(rng));
+    log.imu.push_back(s);
+  }
+  int k = 0;
+  for (double t = 0.0; t <= spec.duration_s; t += 0.0025, ++k) {
+    const int a = k % 8, b = (k + 1) % 8;
+    const Vec3 p = p0 + Vec3(0, 0, takeoffProfile(t).z + spec.tdoa_dz(t));
+    const Vec3 p_tag = tagPosition(p, Quat::Identity(), kUtilTagOffset_b);
+    const double z = range(p_tag, anchors.find(b)->m) - range(p_tag, anchors.find(a)->m) + spec.tdoa_noise_m * n(rng);
+    log.tdoa.push_back({t, a, b, z});
+  }
+  return log;
+}
+
+inline SensorLog takeoffLog(const TakeoffLogSpec& spec) {
+  std::mt19937 rng(spec.seed);
+  return takeoffLog(spec, rng);
 }
 
 }  // namespace uwb::filtertest

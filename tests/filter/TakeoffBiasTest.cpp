@@ -6,43 +6,26 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <random>
 
 #include "FilterTestUtil.h"
 #include "uwb/filter/TdoaLocalizer.h"
-#include "uwb/model/TdoaModel.h"
 
 namespace uwb {
 namespace {
 
 using filtertest::arenaAnchors;
-const auto vertical = filtertest::takeoffProfile;
 
 /// IMU at 1 kHz whose z axis reads bias_ground_mps2 before the climb and bias_flight_mps2 from the climb on
 /// (vibration noise as in flight); TDoA on the neighbour pairs at 400 Hz with white noise.
 SensorLog makeLog(double bias_ground_mps2, double bias_flight_mps2, double duration_s, unsigned seed) {
-  const AnchorTable anchors = arenaAnchors();
-  const Vec3 p0(0.8, -0.5, 0.0);
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> n(0.0, 1.0);
-  SensorLog log;
-  for (double t = 0.0; t <= duration_s; t += 0.001) {
-    TimedImu s;
-    s.t_s = t;
-    const double bias = t < 1.9 ? bias_ground_mps2 : bias_flight_mps2;
-    s.imu.b_acc_mps2 = Vec3(0, 0, vertical(t).az + kGravity_mps2 + bias) + 0.5 * Vec3(n(rng), n(rng), n(rng));
-    s.imu.b_gyro_radps = 0.08 * Vec3(n(rng), n(rng), n(rng));
-    log.imu.push_back(s);
-  }
-  int k = 0;
-  for (double t = 0.0; t <= duration_s; t += 0.0025, ++k) {
-    const int a = k % 8, b = (k + 1) % 8;
-    const Vec3 p = p0 + Vec3(0, 0, vertical(t).z);
-    const Vec3 p_tag = tagPosition(p, Quat::Identity(), kUtilTagOffset_b);
-    const double z = range(p_tag, anchors.find(b)->m) - range(p_tag, anchors.find(a)->m) + 0.15 * n(rng);
-    log.tdoa.push_back({t, a, b, z});
-  }
-  return log;
+  filtertest::TakeoffLogSpec spec;
+  spec.duration_s = duration_s;
+  spec.seed = seed;
+  spec.acc_noise_mps2 = 0.5;
+  spec.gyro_noise_radps = 0.08;
+  spec.tdoa_noise_m = 0.15;
+  spec.acc_bias_z = [=](double t) { return t < 1.9 ? bias_ground_mps2 : bias_flight_mps2; };
+  return filtertest::takeoffLog(spec);
 }
 
 /// Mean estimated z accelerometer bias over [t0, t1].

@@ -132,26 +132,12 @@ constexpr double kTofOffset_m = 0.037;
 /// IMU 1 kHz, TDoA 400 Hz generated as if the tag were tdoa_dz_m higher than it is (a height bias as the
 /// position-dependent UWB bias produces), ToF 25 Hz with 1 cm noise.
 SensorLog makeLog(double tdoa_dz_m, double duration_s, unsigned seed) {
-  const AnchorTable anchors = arenaAnchors();
-  const Vec3 p0(0.8, -0.5, 0.0);
+  filtertest::TakeoffLogSpec spec;
+  spec.duration_s = duration_s;
+  spec.tdoa_dz = [=](double t) { return t > 2.0 ? tdoa_dz_m : 0.0; };
   std::mt19937 rng(seed);
+  SensorLog log = filtertest::takeoffLog(spec, rng);
   std::normal_distribution<double> n(0.0, 1.0);
-  SensorLog log;
-  for (double t = 0.0; t <= duration_s; t += 0.001) {
-    TimedImu s;
-    s.t_s = t;
-    s.imu.b_acc_mps2 = Vec3(0, 0, vertical(t).az + kGravity_mps2) + 0.3 * Vec3(n(rng), n(rng), n(rng));
-    s.imu.b_gyro_radps = 0.02 * Vec3(n(rng), n(rng), n(rng));
-    log.imu.push_back(s);
-  }
-  int k = 0;
-  for (double t = 0.0; t <= duration_s; t += 0.0025, ++k) {
-    const int a = k % 8, b = (k + 1) % 8;
-    const Vec3 p = p0 + Vec3(0, 0, vertical(t).z + (t > 2.0 ? tdoa_dz_m : 0.0));
-    const Vec3 p_tag = tagPosition(p, Quat::Identity(), kUtilTagOffset_b);
-    const double z = range(p_tag, anchors.find(b)->m) - range(p_tag, anchors.find(a)->m) + 0.1 * n(rng);
-    log.tdoa.push_back({t, a, b, z});
-  }
   // (a real sensor reports no negative range: clamp the noisy 13 mm on the floor)
   for (double t = 0.0; t <= duration_s; t += 0.04)
     log.tof.push_back({t, std::max(0.005, vertical(t).z - kTofOffset_m + 0.01 * n(rng))});
