@@ -96,6 +96,7 @@ Setters<SimParams> simSetters() {
       std::vector<std::pair<std::string, int B::*>>{{"antenna_degree", &B::antenna_degree},
                                                     {"multipath_features", &B::multipath_features}});
   s["b_t_tag"] = [](SimParams& p, const py::handle& v) { p.b_t_tag = row3(toMatrix(v, 3, "b_t_tag"), 0); };
+  s["bias.field_seed"] = [](SimParams& p, const py::handle& v) { p.bias.field_seed = py::cast<std::uint64_t>(v); };
   s["write_full_util_header"] = [](SimParams& p, const py::handle& v) { p.write_full_util_header = py::cast<bool>(v); };
   return s;
 }

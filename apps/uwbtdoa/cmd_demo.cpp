@@ -28,9 +28,11 @@ struct Options {
 /// The demo's measurement errors: dominated by what the paper's GP inputs can explain (antenna pattern and
 /// occlusion by the drone's body as functions of the body-frame anchor directions, paper III-B and Fig. 7), with
 /// smaller unlearnable multipath and noise. The simulator's defaults, tuned to the real util-pilot flights, have a
-/// much smaller learnable share (docs/math/simulation.md).
-sim::SimParams demoSimParams() {
+/// much smaller learnable share (docs/math/simulation.md). All flights share one drone and one room (field_seed):
+/// what the GP learns on the training flight is the same hardware the test flights carry.
+sim::SimParams demoSimParams(std::uint64_t field_seed) {
   sim::SimParams p;
+  p.bias.field_seed = field_seed;
   p.bias.antenna_rms_m = 0.15;
   p.bias.anchor_pattern_rms_m = 0.05;
   p.bias.nlos_bias_m = 0.25;
@@ -40,9 +42,9 @@ sim::SimParams demoSimParams() {
 }
 
 NamedFlight simulate(const std::string& name, sim::TrajectoryShape shape, double duration_s, std::uint64_t seed,
-                     const std::string& dir) {
+                     std::uint64_t field_seed, const std::string& dir) {
   sim::Scenario scenario = sim::makeScenario(sim::paperAnchors(), shape, duration_s);
-  const sim::SimResult sim = sim::simulateFlight(scenario, demoSimParams(), seed);
+  const sim::SimResult sim = sim::simulateFlight(scenario, demoSimParams(field_seed), seed);
   const std::string path = (std::filesystem::path(dir) / (name + ".csv")).string();
   writeFlightCsv(sim.flight, path);
   std::cerr << fmt::format("simulated {} ({:.0f} s, {} TDoA) → {}\n", name, duration_s, sim.flight.tdoa.size(), path);
@@ -54,7 +56,9 @@ void setup(CLI::App& sub) {
   opt->eval.out_dir = "demo-out";
   opt->eval.inducing = {10, 30, 50};
   opt->eval.repeats = 1;
-  sub.add_option("--seed", opt->seed, "Simulation seed")->capture_default_str();
+  sub.add_option("--seed", opt->seed, "Simulation seed (the drone and room of all flights; each flight's noise)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   sub.add_option("--train-duration", opt->train_duration_s, "Zigzag training flight length [s]")->capture_default_str();
   sub.add_option("--test-duration", opt->test_duration_s, "Circular test flight length [s]")->capture_default_str();
   sub.add_option("--test-flights", opt->test_flights, "Number of circular test flights")->capture_default_str();
@@ -65,11 +69,12 @@ void setup(CLI::App& sub) {
     const AnchorSurvey survey = sim::paperAnchors();
     writeAnchorSurvey(survey, (std::filesystem::path(opt->eval.out_dir) / "survey.txt").string());
     const std::vector<NamedFlight> train = {
-        simulate("sim-zigzag", sim::TrajectoryShape::kZigzag, opt->train_duration_s, opt->seed, opt->eval.out_dir)};
+        simulate("sim-zigzag", sim::TrajectoryShape::kZigzag, opt->train_duration_s, opt->seed, opt->seed,
+                 opt->eval.out_dir)};
     std::vector<NamedFlight> test;
     for (int i = 0; i < opt->test_flights; ++i) {
       test.push_back(simulate(fmt::format("sim-circle{}", i + 1), sim::TrajectoryShape::kCircle, opt->test_duration_s,
-                              opt->seed + 100 + static_cast<std::uint64_t>(i), opt->eval.out_dir));
+                              opt->seed + 100 + static_cast<std::uint64_t>(i), opt->seed, opt->eval.out_dir));
     }
     runAndReport(train, test, survey, opt->eval);
   });

@@ -127,6 +127,7 @@ struct Options {
   std::string trajectory = "circle";
   double duration_s = 60.0;
   std::uint64_t seed = 1;
+  std::uint64_t field_seed = 0;
   std::string anchors_preset = "paper";
   std::string anchors_file;
   double yaw_rate_rps = 0.5;
@@ -154,6 +155,7 @@ void run(const Options& o, CLI::App& sub) {
   uwb::sim::fitTrajectoryToAnchors(scenario.survey, &scenario.trajectory);
   scenario.trajectory.yaw_rate_rps = o.yaw_rate_rps;
   if (!o.config.empty()) applyConfig(o.config, &params, &scenario.trajectory);
+  params.bias.field_seed = o.field_seed;
   if (sub.count("--yaw-rate") > 0) scenario.trajectory.yaw_rate_rps = o.yaw_rate_rps;  // the flag wins
   scenario.trajectory.yaw_mode = scenario.trajectory.yaw_rate_rps == 0.0 ? uwb::sim::YawMode::kConstant
                                                                           : uwb::sim::YawMode::kConstantRate;
@@ -196,6 +198,7 @@ void run(const Options& o, CLI::App& sub) {
     j["survey"] = o.survey_out;
     j["trajectory"] = o.trajectory;
     j["seed"] = o.seed;
+    j["field_seed"] = o.field_seed;
     j["duration_s"] = o.duration_s;
     j["anchors"] = result.survey.anchors.size();
     j["anchors_source"] = result.survey.source;
@@ -259,6 +262,10 @@ void setup(CLI::App& sub) {
       ->capture_default_str();
   sub.add_option("--duration", o->duration_s, "Flight duration including ground phases [s]")->capture_default_str();
   sub.add_option("--seed", o->seed, "Random seed (same seed, same flight)")->capture_default_str();
+  sub.add_option("--field-seed", o->field_seed,
+                 "Seed of the drone's and anchors' antenna patterns and the room's multipath; flights with the same "
+                 "field seed share them (train on one, test on another). 0: drawn from --seed")
+      ->capture_default_str();
   auto* preset = sub.add_option("--anchors-preset", o->anchors_preset,
                                 "paper | util-const1..4 | util-pilot-0425 | util-pilot-0426")
                      ->capture_default_str();

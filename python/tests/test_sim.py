@@ -37,6 +37,28 @@ def test_simulation_is_deterministic_per_seed_and_checks_its_parameters():
         u.simulate_flight("square")
 
 
+def test_flights_with_one_field_seed_share_the_learnable_bias():
+    def pattern_mismatch(a, b):
+        """RMS of a's pattern error minus b's, interpolated per anchor pair at a's times (airborne)."""
+        ta, tb = a["flight"].tdoa, b["flight"].tdoa
+        sq = []
+        for pair in set(zip(ta["id_a"].tolist(), ta["id_b"].tolist())):
+            ia = (ta["id_a"] == pair[0]) & (ta["id_b"] == pair[1]) & a["tdoa_truth"]["airborne"]
+            ib = (tb["id_a"] == pair[0]) & (tb["id_b"] == pair[1])
+            other = np.interp(ta["t"][ia], tb["t"][ib], b["tdoa_truth"]["pattern"][ib])
+            sq.append((a["tdoa_truth"]["pattern"][ia] - other) ** 2)
+        return float(np.sqrt(np.mean(np.concatenate(sq))))
+
+    shared = {"bias.field_seed": 42}
+    a = u.simulate_flight("circle", 25.0, seed=3, params=shared)
+    b = u.simulate_flight("circle", 25.0, seed=4, params=shared)
+    c = u.simulate_flight("circle", 25.0, seed=4)
+    # the same drone in the same room: the pattern part is one function of the pose (up to interpolation)
+    assert pattern_mismatch(a, b) < 0.01
+    assert pattern_mismatch(a, c) > 0.03
+    assert not np.array_equal(a["tdoa_truth"]["noise"], b["tdoa_truth"]["noise"][: a["tdoa_truth"]["noise"].size])
+
+
 def test_noise_free_simulation_matches_the_measurement_model(sim):
     r = u.simulate_flight("circle", 22.0, seed=2, noise_free=True)
     f, s = r["flight"], r["survey"]

@@ -122,34 +122,35 @@ std::array<double, 16> realSphericalHarmonics(const Vec3& u) {
           0.5900435899266435 * x * (x * x - 3.0 * y * y)};
 }
 
-BiasModel::BiasModel(const BiasParams& params, const AnchorSurvey& survey, std::mt19937_64& rng)
+BiasModel::BiasModel(const BiasParams& params, const AnchorSurvey& survey, std::mt19937_64& field_rng,
+                     std::mt19937_64& flight_rng)
     : params_(params) {
   params_.validate();
   if (survey.anchors.empty()) throw std::invalid_argument("BiasModel: the survey has no anchors");
   std::normal_distribution<double> normal(0.0, 1.0);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  tag_coeffs_ = drawPattern(params_.antenna_degree, params_.antenna_rms_m, rng);
+  tag_coeffs_ = drawPattern(params_.antenna_degree, params_.antenna_rms_m, field_rng);
   for (const Anchor& anchor : survey.anchors) {
     AnchorTerms t;
     t.id = anchor.id;
     t.w_p = anchor.w_p;
-    t.offset_m = params_.anchor_offset_std_m * normal(rng);
-    t.pattern_coeffs = drawPattern(params_.antenna_degree, params_.anchor_pattern_rms_m, rng);
+    t.offset_m = params_.anchor_offset_std_m * normal(field_rng);
+    t.pattern_coeffs = drawPattern(params_.antenna_degree, params_.anchor_pattern_rms_m, field_rng);
     // (S15) random Fourier features of a squared-exponential field with length ℓ: ω ~ N(0, I/ℓ²).
     const auto k = static_cast<std::size_t>(params_.multipath_features);
     t.mp_freq.resize(k);
     t.mp_phase.resize(k);
     for (std::size_t i = 0; i < k; ++i) {
-      t.mp_freq[i] = Vec3(normal(rng), normal(rng), normal(rng)) / params_.multipath_length_m;
-      t.mp_phase[i] = 2.0 * kPi * uniform(rng);
+      t.mp_freq[i] = Vec3(normal(field_rng), normal(field_rng), normal(field_rng)) / params_.multipath_length_m;
+      t.mp_phase[i] = 2.0 * kPi * uniform(field_rng);
     }
     // (S18) ground range bias: low anchors far off, the others a little.
-    const double g = uniform(rng);
+    const double g = uniform(flight_rng);
     t.ground_m = anchor.w_p.z() < params_.ground_low_anchor_z_m
                      ? params_.ground_low_min_m + (params_.ground_low_max_m - params_.ground_low_min_m) * g
                      : params_.ground_high_abs_m * (2.0 * g - 1.0);
-    t.burst_key = rng();
-    t.burst_phase = uniform(rng);
+    t.burst_key = flight_rng();
+    t.burst_phase = uniform(flight_rng);
     anchors_.push_back(std::move(t));
   }
 }

@@ -55,7 +55,10 @@ SimResult simulateFlight(const Scenario& scenario, const SimParams& params, std:
   if (survey.anchors.size() < 2) throw std::invalid_argument("simulateFlight: the survey needs at least 2 anchors");
 
   Streams rng = makeStreams(seed);
-  const BiasModel bias(params.bias, survey, rng.bias_field);
+  // (S12) the hardware and room from bias.field_seed when set, else from the flight's seed
+  std::mt19937_64 field_rng =
+      params.bias.field_seed != 0 ? makeStreams(params.bias.field_seed).bias_field : std::mt19937_64{};
+  const BiasModel bias(params.bias, survey, params.bias.field_seed != 0 ? field_rng : rng.bias_field, rng.bias_field);
   const double duration = trajectory.duration_s();
   const double ground_z = scenario.trajectory.ground_z_m;
 

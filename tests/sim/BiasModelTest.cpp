@@ -120,6 +120,34 @@ TEST(BiasModel, MultipathFieldHasTheConfiguredSpreadAndLength) {
   EXPECT_GT(near_corr / sq, 0.9);
 }
 
+TEST(BiasModel, SharedFieldGeneratorGivesTheSameHardwareAndRoomButOwnGroundOffsets) {
+  // GIVEN two models whose hardware/room terms come from equally seeded generators, flight terms from different ones
+  const BiasParams p;
+  std::mt19937_64 field_a(5), field_b(5), flight_a(1), flight_b(2);
+  const BiasModel a(p, paperAnchors(), field_a, flight_a);
+  const BiasModel b(p, paperAnchors(), field_b, flight_b);
+  // THEN patterns, offsets and multipath agree everywhere, ground offsets (a per-flight draw) do not
+  std::mt19937_64 dirs(3);
+  for (int k = 0; k < 50; ++k) {
+    const Vec3 u = randomUnit(dirs);
+    const Vec3 x = 2.0 * randomUnit(dirs);
+    for (const Anchor& anchor : paperAnchors().anchors) {
+      EXPECT_EQ(a.patternBias(anchor.id, u), b.patternBias(anchor.id, u));
+      EXPECT_EQ(a.multipathBias(anchor.id, x), b.multipathBias(anchor.id, x));
+    }
+  }
+  int same_ground = 0;
+  for (const Anchor& anchor : paperAnchors().anchors) same_ground += a.groundBias(anchor.id) == b.groundBias(anchor.id);
+  EXPECT_EQ(same_ground, 0);
+  // AND one generator for both reproduces the one-generator constructor exactly
+  std::mt19937_64 one(7), two(7);
+  const BiasModel c(p, paperAnchors(), one);
+  const BiasModel d(p, paperAnchors(), two, two);
+  const Vec3 u = randomUnit(dirs);
+  EXPECT_EQ(c.patternBias(1, u), d.patternBias(1, u));
+  EXPECT_EQ(c.groundBias(2), d.groundBias(2));
+}
+
 TEST(BiasModel, RejectsInvalidParameters) {
   BiasParams p;
   p.antenna_degree = 5;

@@ -28,6 +28,11 @@ namespace uwb::sim {
 /// autocorrelation ≈ 0.6 at 0.1 s); see docs/math/simulation.md, "Calibration".
 struct BiasParams {
   bool enabled = true;                    ///< false: noise-free TDoA (every term below off)
+  /// Seed of the hardware and the room: the tag and anchor antenna patterns, the anchor offsets and the multipath
+  /// fields (S12–S15). 0 (default): drawn from the flight's own seed, so each flight has its own. Flights that share
+  /// a non-zero field_seed share them, as real training and test flights with one drone in one arena do; their
+  /// noise, outliers, bursts and ground offsets still follow the flight seed.
+  std::uint64_t field_seed = 0;
   // learnable part: depends on the body-frame anchor direction only (the paper's GP inputs)
   double antenna_rms_m = 0.07;            ///< RMS over the sphere of the common tag pattern h_tag (S13)
   int antenna_degree = 3;                 ///< highest spherical-harmonic degree, 1..3
@@ -75,11 +80,17 @@ struct TdoaErrorParts {
   double total() const { return pattern_m + multipath_m + noise_m + outlier_m + ground_m; }
 };
 
-/// Per-flight random draw of the bias field (coefficients, offsets, ground offsets); immutable afterwards.
+/// Random draw of the bias field (coefficients, offsets, ground offsets); immutable afterwards.
 class BiasModel {
  public:
   /// Draws all coefficients from `rng` (seeded by the caller). Anchors are addressed by survey id.
-  BiasModel(const BiasParams& params, const AnchorSurvey& survey, std::mt19937_64& rng);
+  BiasModel(const BiasParams& params, const AnchorSurvey& survey, std::mt19937_64& rng)
+      : BiasModel(params, survey, rng, rng) {}
+  /// The hardware and room terms (patterns, offsets, multipath: S12–S15) from `field_rng`, the flight's own terms
+  /// (ground offsets S18, burst schedule S16b) from `flight_rng`. With one generator for both, the draws are those
+  /// of the constructor above.
+  BiasModel(const BiasParams& params, const AnchorSurvey& survey, std::mt19937_64& field_rng,
+            std::mt19937_64& flight_rng);
 
   /// Deterministic range bias part (c_i + h_tag + h_i + n) for anchor id seen along body-frame unit vector
   /// b_u (tag → anchor) (S12–S14).
