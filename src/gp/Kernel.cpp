@@ -4,9 +4,14 @@
 #include "uwb/gp/Kernel.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
+#if defined(__AVX2__) && defined(__FMA__)
+#include <immintrin.h>
+#endif
 
 namespace uwb::gp {
 
@@ -28,6 +33,159 @@ VecX rowNorms(const MatX& A) {
     throw std::invalid_argument("ledergerber kernel: input vector of zero norm (k_L is undefined at x = 0)");
   }
   return n;
+}
+
+// ---- e^x for the batch path: docs/math/gp.md (P32) ----
+// e^x = 2^k e^r, k = round(x log₂e) (by adding 1.5·2⁵², which leaves k in the low mantissa bits), r = x − k ln2 in
+// two FMA steps (fdlibm's split of ln2: k·ln2_hi is exact), e^r by its Taylor polynomial of degree 13 (|r| ≤ ln2/2:
+// truncation < 5e-18 relative), 2^k by writing k + 1023 into the exponent field. x is clamped to ≤ 709 (no
+// overflow); x < −708 (e^x < 3.3e-308) gives 0; NaN stays NaN. The vector and scalar versions perform the same
+// correctly rounded operations, so a value does not depend on which of them computed it.
+constexpr double kLog2e = 1.4426950408889634074;
+constexpr double kLn2Hi = 6.93147180369123816490e-01;
+constexpr double kLn2Lo = 1.90821492927058770002e-10;
+constexpr double kRoundMagic = 6755399441055744.0;  // 1.5 · 2⁵²
+constexpr double kExpHi = 709.0, kExpLo = -708.0;
+constexpr int kExpDegree = 13;
+
+#if defined(__FMA__)
+inline double fmaS(double a, double b, double c) { return std::fma(a, b, c); }
+#else
+inline double fmaS(double a, double b, double c) { return a * b + c; }  // portable build: no FMA instruction
+#endif
+
+/// The Taylor coefficients s/i! of s·e^r, i = 0 … kExpDegree (the outputscale s is folded into the polynomial).
+struct ScaledExpCoefs {
+  double c[kExpDegree + 1];
+  explicit ScaledExpCoefs(double s) {
+    double f = 1.0;
+    for (int i = 0; i <= kExpDegree; ++i) {
+      if (i > 0) f *= i;
+      c[i] = s / f;  // i! is exact in double for i ≤ 18
+    }
+  }
+};
+
+/// s·e^x (P32), scalar.
+inline double scaledExpScalar(double x, const ScaledExpCoefs& cf) {
+  x = x > kExpHi ? kExpHi : x;
+  const double kd = fmaS(x, kLog2e, kRoundMagic);
+  const double k = kd - kRoundMagic;
+  double r = fmaS(-k, kLn2Hi, x);
+  r = fmaS(-k, kLn2Lo, r);
+  double p = cf.c[kExpDegree];
+  for (int i = kExpDegree - 1; i >= 0; --i) p = fmaS(p, r, cf.c[i]);
+  std::uint64_t bits;
+  std::memcpy(&bits, &kd, sizeof bits);
+  bits = (bits + 1023u) << 52;
+  double scale;
+  std::memcpy(&scale, &bits, sizeof scale);
+  const double e = p * scale;
+  return x < kExpLo ? 0.0 : e;
+}
+
+#if defined(__AVX2__) && defined(__FMA__)
+/// s·e^x (P32) for kP packets of 4 lanes, step by step in lockstep (kP independent FMA chains hide the latency of
+/// the degree-13 Horner recurrence); every lane performs the operations of scaledExpScalar.
+template <int kP>
+inline void scaledExpPackets(__m256d* x, const ScaledExpCoefs& cf) {
+  const __m256d magic = _mm256_set1_pd(kRoundMagic), hi = _mm256_set1_pd(kExpHi), log2e = _mm256_set1_pd(kLog2e),
+                ln2hi = _mm256_set1_pd(kLn2Hi), ln2lo = _mm256_set1_pd(kLn2Lo);
+  __m256d kd[kP], r[kP], p[kP];
+  for (int u = 0; u < kP; ++u) {
+    x[u] = _mm256_min_pd(hi, x[u]);  // returns x when x is NaN
+    kd[u] = _mm256_fmadd_pd(x[u], log2e, magic);
+    const __m256d k = _mm256_sub_pd(kd[u], magic);
+    r[u] = _mm256_fnmadd_pd(k, ln2hi, x[u]);
+    r[u] = _mm256_fnmadd_pd(k, ln2lo, r[u]);
+    p[u] = _mm256_set1_pd(cf.c[kExpDegree]);
+  }
+  for (int i = kExpDegree - 1; i >= 0; --i) {
+    const __m256d ci = _mm256_set1_pd(cf.c[i]);
+    for (int u = 0; u < kP; ++u) p[u] = _mm256_fmadd_pd(p[u], r[u], ci);
+  }
+  const __m256i bias = _mm256_set1_epi64x(1023);
+  const __m256d lo = _mm256_set1_pd(kExpLo);
+  for (int u = 0; u < kP; ++u) {
+    const __m256d scale =
+        _mm256_castsi256_pd(_mm256_slli_epi64(_mm256_add_epi64(_mm256_castpd_si256(kd[u]), bias), 52));
+    const __m256d tiny = _mm256_cmp_pd(x[u], lo, _CMP_LT_OQ);
+    x[u] = _mm256_andnot_pd(tiny, _mm256_mul_pd(p[u], scale));
+  }
+}
+#endif
+
+/// v[i] = s · e^{c·v[i]} for i < n, in place (P32).
+void scaledExpInPlace(double* v, Eigen::Index n, double c, double s) {
+  const ScaledExpCoefs cf(s);
+  Eigen::Index i = 0;
+#if defined(__AVX2__) && defined(__FMA__)
+  const __m256d vc = _mm256_set1_pd(c);
+  for (; i + 16 <= n; i += 16) {
+    __m256d x[4];
+    for (int u = 0; u < 4; ++u) x[u] = _mm256_mul_pd(vc, _mm256_loadu_pd(v + i + 4 * u));
+    scaledExpPackets<4>(x, cf);
+    for (int u = 0; u < 4; ++u) _mm256_storeu_pd(v + i + 4 * u, x[u]);
+  }
+  for (; i + 4 <= n; i += 4) {
+    __m256d x = _mm256_mul_pd(vc, _mm256_loadu_pd(v + i));
+    scaledExpPackets<1>(&x, cf);
+    _mm256_storeu_pd(v + i, x);
+  }
+#endif
+  for (; i < n; ++i) v[i] = scaledExpScalar(c * v[i], cf);
+}
+
+/// RBF part column (P3, P32): out[i] = s2 · e^{−ρ²/2}, ρ² = Σ_d (A(i,d) − b_d)² (A, b already divided by l), in
+/// one pass (the distance stays in registers). kNd > 0: number of active dims known at compile time.
+template <int kNd>
+void rbfColumnT(const MatX& A, const double* b, double s2, double* out) {
+  const ScaledExpCoefs cf(s2);
+  const Eigen::Index n = A.rows(), nd = kNd > 0 ? kNd : A.cols();
+  Eigen::Index i = 0;
+#if defined(__AVX2__) && defined(__FMA__)
+  const __m256d mhalf = _mm256_set1_pd(-0.5);
+  auto halfSqDist = [&](Eigen::Index i0) {
+    __m256d diff = _mm256_sub_pd(_mm256_loadu_pd(A.data() + i0), _mm256_set1_pd(b[0]));
+    __m256d r2 = _mm256_mul_pd(diff, diff);
+    for (Eigen::Index d = 1; d < nd; ++d) {
+      diff = _mm256_sub_pd(_mm256_loadu_pd(A.data() + d * n + i0), _mm256_set1_pd(b[d]));
+      r2 = _mm256_fmadd_pd(diff, diff, r2);
+    }
+    return _mm256_mul_pd(mhalf, r2);
+  };
+  constexpr int kP = 4;
+  for (; i + 4 * kP <= n; i += 4 * kP) {
+    __m256d x[kP];
+    for (int u = 0; u < kP; ++u) x[u] = halfSqDist(i + 4 * u);
+    scaledExpPackets<kP>(x, cf);
+    for (int u = 0; u < kP; ++u) _mm256_storeu_pd(out + i + 4 * u, x[u]);
+  }
+  for (; i + 4 <= n; i += 4) {
+    __m256d x = halfSqDist(i);
+    scaledExpPackets<1>(&x, cf);
+    _mm256_storeu_pd(out + i, x);
+  }
+#endif
+  for (; i < n; ++i) {
+    double diff = A(i, 0) - b[0];
+    double r2 = diff * diff;
+    for (Eigen::Index d = 1; d < nd; ++d) {
+      diff = A(i, d) - b[d];
+      r2 = fmaS(diff, diff, r2);
+    }
+    out[i] = scaledExpScalar(-0.5 * r2, cf);
+  }
+}
+
+void rbfColumn(const MatX& A, const double* b, double s2, double* out) {
+  switch (A.cols()) {
+    case 1: return rbfColumnT<1>(A, b, s2, out);
+    case 2: return rbfColumnT<2>(A, b, s2, out);
+    case 3: return rbfColumnT<3>(A, b, s2, out);
+    case 4: return rbfColumnT<4>(A, b, s2, out);
+    default: return rbfColumnT<0>(A, b, s2, out);
+  }
 }
 
 }  // namespace
@@ -323,6 +481,100 @@ MatX Kernel::cross(const MatX& X1, const MatX& X2, std::vector<MatX>* part_block
     K += prod;
   }
   return K;
+}
+
+void Kernel::crossInto(const MatX& X1, const MatX& X2, Eigen::Ref<MatX> K) const {
+  if (X1.cols() < input_dim_ || X2.cols() < input_dim_)
+    throw std::invalid_argument("kernel: inputs have " + std::to_string(std::min(X1.cols(), X2.cols())) +
+                                " columns, the kernel reads " + std::to_string(input_dim_));
+  const Eigen::Index n1 = X1.rows(), n2 = X2.rows();
+  if (K.rows() != n1 || K.cols() != n2) throw std::invalid_argument("kernel crossInto: output has the wrong size");
+  // Per part: the active columns prepared once (P1–P4 in the same operation order as partCross), then one column
+  // of the part per row of X2, vectorized over the rows of X1.
+  struct Prepared {
+    MatX A, B;     // rbf/matern: columns divided by l; periodic: raw; ledergerber: unit vectors
+    MatX Bt;       // rbf: Bᵀ (row j of B contiguous)
+    VecX na, nb;   // ledergerber: norms
+  };
+  std::vector<Prepared> prep(parts_.size());
+  for (std::size_t pi = 0; pi < parts_.size(); ++pi) {
+    const Part& p = parts_[pi];
+    Prepared& q = prep[pi];
+    q.A = activeCols(X1, p.active_dims);
+    q.B = activeCols(X2, p.active_dims);
+    if (p.type == PartType::kRbf || p.type == PartType::kMatern52) {
+      for (Eigen::Index d = 0; d < q.A.cols(); ++d) {
+        const double l = theta_[p.offset + 1 + (p.n_l == 1 ? 0 : d)];
+        q.A.col(d) /= l;
+        q.B.col(d) /= l;
+      }
+      q.Bt = q.B.transpose();
+    } else if (p.type == PartType::kLedergerber) {
+      q.na = rowNorms(q.A);
+      q.nb = rowNorms(q.B);
+      q.A = q.na.cwiseInverse().asDiagonal() * q.A;
+      q.B = q.nb.cwiseInverse().asDiagonal() * q.B;
+    }
+  }
+  Eigen::ArrayXd term(n1), part(n1), scratch(n1);
+  auto evalPart = [&](int pi, Eigen::Index j, Eigen::ArrayXd& out) {
+    const Part& p = parts_[static_cast<std::size_t>(pi)];
+    const Prepared& q = prep[static_cast<std::size_t>(pi)];
+    const double s2 = theta_[p.offset];
+    const Eigen::Index nd = q.A.cols();
+    switch (p.type) {
+      case PartType::kRbf:
+      case PartType::kMatern52: {  // ρ² = Σ_d (a_d/l_d − b_d/l_d)²  (P2, P3)
+        if (p.type == PartType::kMatern52) {
+          out = (q.A.col(0).array() - q.B(j, 0)).square();
+          for (Eigen::Index d = 1; d < nd; ++d) out += (q.A.col(d).array() - q.B(j, d)).square();
+        }
+        if (p.type == PartType::kRbf) {
+          rbfColumn(q.A, q.Bt.col(j).data(), s2, out.data());
+        } else {
+          scratch = out.sqrt() * kSqrt5;  // √5 ρ
+          out = scratch;
+          scaledExpInPlace(out.data(), n1, -1.0, 1.0);
+          out *= s2 * (1.0 + scratch + scratch.square() / 3.0);
+        }
+        break;
+      }
+      case PartType::kPeriodic: {  // Σ_d sin²(π Δ_d / T_d) / l_d²  (P1)
+        out.setZero();
+        for (Eigen::Index d = 0; d < nd; ++d) {
+          const double l = theta_[p.offset + 1 + (p.n_l == 1 ? 0 : d)];
+          const double T = theta_[p.offset + 1 + p.n_l + (p.n_T == 1 ? 0 : d)];
+          const double c = kPi / T, il2 = 1.0 / (l * l);
+          out += il2 * (c * (q.A.col(d).array() - q.B(j, d))).sin().square();
+        }
+        scaledExpInPlace(out.data(), n1, -2.0, s2);
+        break;
+      }
+      case PartType::kLedergerber: {  // θ0 exp(−(1 − γ)/θ1 − (n − n')²/θ2), γ = xᵀx'/(n n')  (P4)
+        const double t1 = theta_[p.offset + 1], t2 = theta_[p.offset + 2];
+        const auto gamma = q.A.col(0).array() * q.B(j, 0) + q.A.col(1).array() * q.B(j, 1) +
+                           q.A.col(2).array() * q.B(j, 2);
+        out = -(1.0 - gamma) / t1 - (q.na.array() - q.nb[j]).square() / t2;
+        scaledExpInPlace(out.data(), n1, 1.0, s2);
+        break;
+      }
+    }
+  };
+  for (Eigen::Index j = 0; j < n2; ++j) {
+    auto Kj = K.col(j).array();
+    for (std::size_t t = 0; t < terms_.size(); ++t) {
+      const auto& tm = terms_[t];
+      evalPart(tm[0], j, term);
+      for (std::size_t i = 1; i < tm.size(); ++i) {
+        evalPart(tm[i], j, part);
+        term *= part;
+      }
+      if (t == 0)
+        Kj = term;
+      else
+        Kj += term;
+    }
+  }
 }
 
 void Kernel::crossColumn(const MatX& X1, const Eigen::Ref<const RowVecX>& x, Eigen::Ref<VecX> out) const {

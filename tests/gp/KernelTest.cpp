@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <random>
 
@@ -97,6 +99,68 @@ TEST(Kernel, CrossColumnEqualsCross) {
     // THEN they agree to rounding
     EXPECT_LT((col - nk.kernel.cross(X, Y).col(0)).cwiseAbs().maxCoeff(), 1e-14);
   }
+}
+
+TEST(Kernel, CrossIntoEqualsCross) {
+  for (const auto& nk : kernelZoo()) {
+    // GIVEN row counts below, between and above the vector widths of the batch path (4 lanes, 4 packets)
+    for (int n1 : {1, 3, 5, 16, 37, 256}) {
+      SCOPED_TRACE(nk.name + " n1 = " + std::to_string(n1));
+      const MatX X = inputsFor(nk, n1, 7), Z = inputsFor(nk, 23, 8);
+      // WHEN we evaluate K(X, Z) by the batch path (P32) and by cross()
+      MatX K(n1, 23);
+      nk.kernel.crossInto(X, Z, K);
+      const MatX ref = nk.kernel.cross(X, Z);
+      // THEN every entry agrees to rounding (the polynomial e^x is within a few ulp)
+      EXPECT_TRUE(((K - ref).array().abs() <= 1e-14 * ref.array().abs()).all())
+          << "max relative difference " << ((K - ref).array().abs() / ref.array().abs()).maxCoeff();
+    }
+  }
+}
+
+TEST(Kernel, CrossIntoRowsDoNotDependOnTheirPosition) {
+  // GIVEN 45 points and the same points shifted by 3 rows inside a larger block
+  PartSpec rbf{PartType::kRbf, {0, 1, 2, 3}, 0.7, {0.8, 1.3, 0.6, 1.0}};
+  const Kernel k = Kernel::sum({rbf});
+  const MatX X = randomInputs(48, 4, 9), Z = randomInputs(11, 4, 10);
+  MatX Kall(48, 11), Kpart(45, 11);
+  // WHEN both are evaluated by the batch path
+  k.crossInto(X, Z, Kall);
+  k.crossInto(X.bottomRows(45), Z, Kpart);
+  // THEN each row is the same bit for bit (vector body and scalar tail do the same operations)
+  EXPECT_EQ(Kpart, Kall.bottomRows(45));
+}
+
+TEST(Kernel, CrossIntoCoversTheWholeExponentRange) {
+  // GIVEN an RBF with a short lengthscale: exponents from 0 down to about −5000 (underflow), plus a NaN input
+  PartSpec rbf{PartType::kRbf, {0}, 1.3, {0.04}};
+  const Kernel k = Kernel::sum({rbf});
+  MatX X(401, 1), Z(2, 1);
+  for (int i = 0; i < 401; ++i) X(i, 0) = -2.0 + 0.01 * i;
+  Z << 0.0, 1.234567;
+  MatX K(401, 2);
+  k.crossInto(X, Z, K);
+  const MatX ref = k.cross(X, Z);
+  // THEN normal results agree to rounding and results below 1e-307 are 0 or subnormal (|error| < 3.3e-308)
+  for (Eigen::Index i = 0; i < K.size(); ++i) {
+    const double a = K.data()[i], b = ref.data()[i];
+    if (std::abs(b) > 1e-300)
+      EXPECT_LE(std::abs(a - b), 1e-14 * std::abs(b)) << i;
+    else
+      EXPECT_LT(std::abs(a - b), 3.3e-308) << i;
+  }
+  // AND NaN inputs give NaN, wrong sizes throw
+  MatX Xn = X.topRows(6);
+  Xn(2, 0) = std::numeric_limits<double>::quiet_NaN();
+  MatX Kn(6, 2);
+  k.crossInto(Xn, Z, Kn);
+  EXPECT_TRUE(std::isnan(Kn(2, 0)) && std::isnan(Kn(2, 1)));
+  EXPECT_FALSE(std::isnan(Kn(1, 0)));
+  MatX wrong(5, 2);
+  EXPECT_THROW(k.crossInto(Xn, Z, wrong), std::invalid_argument);
+  const Kernel kl = Kernel::preset("tdoa");
+  MatX Kl(1, 1);
+  EXPECT_THROW(kl.crossInto(MatX::Zero(1, 6), MatX::Ones(1, 6), Kl), std::invalid_argument);
 }
 
 TEST(Kernel, SumAndProductIdentities) {

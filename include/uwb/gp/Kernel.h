@@ -93,6 +93,11 @@ class Kernel {
   /// k(X1_i, x) for every row i of X1 into out (size X1.rows()): the column K(X1, x) without heap allocation,
   /// vectorized in chunks of 64 rows (stack buffers). Used for single-point predictions.
   void crossColumn(const MatX& X1, const Eigen::Ref<const RowVecX>& x, Eigen::Ref<VecX> out) const;
+  /// K(X1, X2) into a preallocated n1×n2 matrix, one column (row of X2) at a time: the batch-prediction path
+  /// (docs/math/gp.md P32). No per-element calls: e^x by a vectorized polynomial (P32, ≤ 2 ulp), so it agrees with
+  /// cross() to ~1e-15 relative rather than bit for bit; every row of X1 gets the same value wherever it sits in
+  /// X1. Throws like cross() (too few columns, ledergerber input of zero norm).
+  void crossInto(const MatX& X1, const MatX& X2, Eigen::Ref<MatX> K) const;
   /// K(X, X).
   MatX gram(const MatX& X) const { return cross(X, X); }
   /// k(x_n, x_n) for every row (no jitter). Every part type is stationary on its diagonal: k(x,x) = σ².

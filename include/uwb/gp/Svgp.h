@@ -12,6 +12,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -114,9 +115,10 @@ class Svgp {
 
 /// Prediction only, from a fixed Svgp; immutable and thread-compatible.
 /// docs/math/gp.md (P20): precomputes α = Lz⁻ᵀ m and Q = Lz⁻ᵀ (S − I) Lz⁻¹, so that
-///   mean = c + Kxz α,  var_f = k(x,x) + ε + rowsum((Kxz Q) ∘ Kxz)
-/// is one GEMM per block of points instead of two triangular products. Agrees with Svgp::predict (the reference
-/// triangular-solve path) to ~1e-12 relative for well-conditioned Kzz; the error grows with cond(Kzz).
+///   mean = c + Kxz α,  var_f = k(x,x) + ε + kᵀ Q_u k  (Q_u: upper triangle of Q, off-diagonal doubled)
+/// The batch path evaluates the kernel block with Kernel::crossInto (P32) and forms kᵀQ_u k with a fused,
+/// register-blocked kernel over 8 points at a time (P33) that never stores K Q_u. Agrees with Svgp::predict (the
+/// reference triangular-solve path) to ~1e-12 relative for well-conditioned Kzz; the error grows with cond(Kzz).
 class SvgpPredictor {
  public:
   explicit SvgpPredictor(const Svgp& gp);
@@ -134,11 +136,12 @@ class SvgpPredictor {
  private:
   /// Rows [begin, end) of X_raw: mean and, when var_f is non-null, the latent variance (without c, k**, ε).
   void predictRows(const MatX& X_raw, Eigen::Index begin, Eigen::Index end, VecX& mean, VecX* var_f) const;
+  void packQu();  ///< fills qpack_ from Q_ (P33)
 
   Kernel kernel_;
   MatX Z_;     ///< transformed space
   MatX Q_;     ///< Lz⁻ᵀ (S − I) Lz⁻¹, symmetric M×M
-  MatX Qu_;    ///< upper triangle of Q with the off-diagonal doubled: kᵀQk = kᵀ Qu k (half the flops)
+  std::vector<double> qpack_;  ///< Q_u packed in panels of kQuPanel columns for the fused kernel (P33)
   VecX alpha_; ///< Lz⁻ᵀ m
   double c_ = 0.0, noise_ = 0.0, jitter_ = 0.0, kdiag_ = 0.0;
   VecX shift_, scale_;
