@@ -88,7 +88,7 @@ inline double scaledExpScalar(double x, const ScaledExpCoefs& cf) {
 /// s·e^x (P32) for kP packets of 4 lanes, step by step in lockstep (kP independent FMA chains hide the latency of
 /// the degree-13 Horner recurrence); every lane performs the operations of scaledExpScalar.
 template <int kP>
-inline void scaledExpPackets(__m256d* x, const ScaledExpCoefs& cf) {
+__attribute__((always_inline)) inline void scaledExpPackets(__m256d* x, const ScaledExpCoefs& cf) {
   const __m256d magic = _mm256_set1_pd(kRoundMagic), hi = _mm256_set1_pd(kExpHi), log2e = _mm256_set1_pd(kLog2e),
                 ln2hi = _mm256_set1_pd(kLn2Hi), ln2lo = _mm256_set1_pd(kLn2Lo);
   __m256d kd[kP], r[kP], p[kP];
@@ -139,8 +139,7 @@ void scaledExpInPlace(double* v, Eigen::Index n, double c, double s) {
 /// RBF part column (P3, P32): out[i] = s2 · e^{−ρ²/2}, ρ² = Σ_d (A(i,d) − b_d)² (A, b already divided by l), in
 /// one pass (the distance stays in registers). kNd > 0: number of active dims known at compile time.
 template <int kNd>
-void rbfColumnT(const MatX& A, const double* b, double s2, double* out) {
-  const ScaledExpCoefs cf(s2);
+void rbfColumnT(const MatX& A, const double* b, const ScaledExpCoefs& cf, double* out) {
   const Eigen::Index n = A.rows(), nd = kNd > 0 ? kNd : A.cols();
   Eigen::Index i = 0;
 #if defined(__AVX2__) && defined(__FMA__)
@@ -178,13 +177,14 @@ void rbfColumnT(const MatX& A, const double* b, double s2, double* out) {
   }
 }
 
-void rbfColumn(const MatX& A, const double* b, double s2, double* out) {
+/// RBF part column with σ²/i! coefficients `cf` (see rbfColumnT).
+void rbfColumn(const MatX& A, const double* b, const ScaledExpCoefs& cf, double* out) {
   switch (A.cols()) {
-    case 1: return rbfColumnT<1>(A, b, s2, out);
-    case 2: return rbfColumnT<2>(A, b, s2, out);
-    case 3: return rbfColumnT<3>(A, b, s2, out);
-    case 4: return rbfColumnT<4>(A, b, s2, out);
-    default: return rbfColumnT<0>(A, b, s2, out);
+    case 1: return rbfColumnT<1>(A, b, cf, out);
+    case 2: return rbfColumnT<2>(A, b, cf, out);
+    case 3: return rbfColumnT<3>(A, b, cf, out);
+    case 4: return rbfColumnT<4>(A, b, cf, out);
+    default: return rbfColumnT<0>(A, b, cf, out);
   }
 }
 
@@ -494,6 +494,7 @@ void Kernel::crossInto(const MatX& X1, const MatX& X2, Eigen::Ref<MatX> K) const
   struct Prepared {
     MatX A, B;     // rbf/matern: columns divided by l; periodic: raw; ledergerber: unit vectors
     MatX Bt;       // rbf: Bᵀ (row j of B contiguous)
+    ScaledExpCoefs cf{1.0};  // rbf: σ²/i!
     VecX na, nb;   // ledergerber: norms
   };
   std::vector<Prepared> prep(parts_.size());
@@ -509,6 +510,7 @@ void Kernel::crossInto(const MatX& X1, const MatX& X2, Eigen::Ref<MatX> K) const
         q.B.col(d) /= l;
       }
       q.Bt = q.B.transpose();
+      q.cf = ScaledExpCoefs(theta_[p.offset]);
     } else if (p.type == PartType::kLedergerber) {
       q.na = rowNorms(q.A);
       q.nb = rowNorms(q.B);
@@ -517,7 +519,8 @@ void Kernel::crossInto(const MatX& X1, const MatX& X2, Eigen::Ref<MatX> K) const
     }
   }
   Eigen::ArrayXd term(n1), part(n1), scratch(n1);
-  auto evalPart = [&](int pi, Eigen::Index j, Eigen::ArrayXd& out) {
+  auto evalPart = [&](int pi, Eigen::Index j, double* out_data) {
+    Eigen::Map<Eigen::ArrayXd> out(out_data, n1);
     const Part& p = parts_[static_cast<std::size_t>(pi)];
     const Prepared& q = prep[static_cast<std::size_t>(pi)];
     const double s2 = theta_[p.offset];
@@ -530,7 +533,7 @@ void Kernel::crossInto(const MatX& X1, const MatX& X2, Eigen::Ref<MatX> K) const
           for (Eigen::Index d = 1; d < nd; ++d) out += (q.A.col(d).array() - q.B(j, d)).square();
         }
         if (p.type == PartType::kRbf) {
-          rbfColumn(q.A, q.Bt.col(j).data(), s2, out.data());
+          rbfColumn(q.A, q.Bt.col(j).data(), q.cf, out.data());
         } else {
           scratch = out.sqrt() * kSqrt5;  // √5 ρ
           out = scratch;
@@ -561,18 +564,18 @@ void Kernel::crossInto(const MatX& X1, const MatX& X2, Eigen::Ref<MatX> K) const
     }
   };
   for (Eigen::Index j = 0; j < n2; ++j) {
+    // K = Σ_terms Π_parts (P5), summed in the order of cross(); the first term is written into K directly
     auto Kj = K.col(j).array();
     for (std::size_t t = 0; t < terms_.size(); ++t) {
       const auto& tm = terms_[t];
-      evalPart(tm[0], j, term);
+      double* dst = t == 0 ? K.col(j).data() : term.data();
+      evalPart(tm[0], j, dst);
+      Eigen::Map<Eigen::ArrayXd> prod(dst, n1);
       for (std::size_t i = 1; i < tm.size(); ++i) {
-        evalPart(tm[i], j, part);
-        term *= part;
+        evalPart(tm[i], j, part.data());
+        prod *= part;
       }
-      if (t == 0)
-        Kj = term;
-      else
-        Kj += term;
+      if (t > 0) Kj += term;
     }
   }
 }
