@@ -30,6 +30,7 @@ std::vector<const char*> requiredFeatureKeys(FeatureMap map) {
     case FeatureMap::kBodyPositions: return {"b_p_a", "b_p_b"};
     case FeatureMap::kWorldPosition: return {"w_p_b"};
     case FeatureMap::kBodyPositionsAnchors: return {"b_p_a", "b_p_b", "w_p_anchor_a", "w_p_anchor_b"};
+    case FeatureMap::kBodyPositionsWorld: return {"b_p_a", "b_p_b", "w_p_b"};
   }
   return {};
 }
@@ -315,7 +316,7 @@ void bindEval(py::module_& m) {
       py::arg("feature_map"), py::arg("features"),
       "GP input rows (N, D) of a feature dict for a feature map ('yaw_angles' → [yaw_a, yaw_b], 'body_positions' →\n"
       "[b_p_a, b_p_b], 'world_position' → [w_p_b], 'body_positions_anchors' → [b_p_a, b_p_b, w_p_anchor_a,\n"
-      "w_p_anchor_b]).");
+      "w_p_anchor_b], 'body_positions_world' → [b_p_a, b_p_b, w_p_b]).");
 
   // ---------------------------------------------------------------------------------------- bias model
   py::class_<BiasModel>(m, "BiasModel",

@@ -16,7 +16,7 @@
 namespace uwb::app {
 
 void EvaluationCliOptions::addTo(CLI::App& sub) {
-  sub.add_option("--kernels", kernels, "Kernel presets, comma-separated (z1, z2, tdoa, pair-tdoa, pair-pos)")
+  sub.add_option("--kernels", kernels, "Kernel presets, comma-separated (z1, z2, tdoa, pair-tdoa, pair-pos, tdoa-pm, anchor-tdoa, anchor-tdoa-pm, pair-tdoa-pos)")
       ->delimiter(',')
       ->capture_default_str();
   sub.add_option("--inducing", inducing, "Numbers of inducing points, comma-separated")

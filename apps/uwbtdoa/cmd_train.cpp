@@ -139,7 +139,7 @@ void setup(CLI::App& sub) {
   auto o = std::make_shared<TrainOptions>();
   sub.add_option("flights", o->flights, "Training flight CSV files (UTIL layout, with ground-truth pose)")->required()->check(CLI::ExistingFile);
   sub.add_option("--anchors", o->anchors, "Anchor survey (UTIL format)")->required()->check(CLI::ExistingFile);
-  sub.add_option("--kernel", o->kernel, "z1 | z2 | tdoa (paper eq. 7–9), pair-tdoa | pair-pos (one GP per anchor pair), tdoa-pm | anchor-tdoa | anchor-tdoa-pm (per-pair mean / anchor-specific eq. 9, docs/math/gp.md P28–P29)")->capture_default_str();
+  sub.add_option("--kernel", o->kernel, "z1 | z2 | tdoa (paper eq. 7–9), pair-tdoa | pair-pos (one GP per anchor pair), tdoa-pm | anchor-tdoa | anchor-tdoa-pm (per-pair mean / anchor-specific eq. 9, docs/math/gp.md P28–P29), pair-tdoa-pos (per pair, eq. 9 plus a map over the arena, P26b)")->capture_default_str();
   sub.add_option("--inducing", o->inducing, "Number of inducing points M (per GP)")->check(CLI::PositiveNumber)->capture_default_str();
   sub.add_option("--epochs", o->epochs, "Training epochs")->check(CLI::PositiveNumber);
   sub.add_option("--batch", o->batch, "Minibatch size")->check(CLI::PositiveNumber);

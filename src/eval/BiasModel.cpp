@@ -21,6 +21,7 @@ std::string toString(FeatureMap map) {
     case FeatureMap::kBodyPositions: return "body_positions";
     case FeatureMap::kWorldPosition: return "world_position";
     case FeatureMap::kBodyPositionsAnchors: return "body_positions_anchors";
+    case FeatureMap::kBodyPositionsWorld: return "body_positions_world";
   }
   return "unknown";
 }
@@ -30,8 +31,10 @@ FeatureMap featureMapFromString(const std::string& name) {
   if (name == "body_positions") return FeatureMap::kBodyPositions;
   if (name == "world_position") return FeatureMap::kWorldPosition;
   if (name == "body_positions_anchors") return FeatureMap::kBodyPositionsAnchors;
+  if (name == "body_positions_world") return FeatureMap::kBodyPositionsWorld;
   throw std::invalid_argument("unknown feature map '" + name +
-                              "' (yaw_angles, body_positions, world_position, body_positions_anchors)");
+                              "' (yaw_angles, body_positions, world_position, body_positions_anchors, "
+                              "body_positions_world)");
 }
 
 int featureDim(FeatureMap map) {
@@ -40,6 +43,7 @@ int featureDim(FeatureMap map) {
     case FeatureMap::kBodyPositions: return 6;
     case FeatureMap::kWorldPosition: return 3;
     case FeatureMap::kBodyPositionsAnchors: return 12;
+    case FeatureMap::kBodyPositionsWorld: return 9;
   }
   return 0;
 }
@@ -65,6 +69,13 @@ void featureRow(FeatureMap map, const TdoaFeature& f, double* row) {
         row[3 + i] = f.b_p_b[i];
         row[6 + i] = f.w_p_anchor_a[i];
         row[9 + i] = f.w_p_anchor_b[i];
+      }
+      return;
+    case FeatureMap::kBodyPositionsWorld:  // eq. (9) inputs plus the body position (P26b)
+      for (int i = 0; i < 3; ++i) {
+        row[i] = f.b_p_a[i];
+        row[3 + i] = f.b_p_b[i];
+        row[6 + i] = f.w_p_b[i];
       }
       return;
   }
@@ -103,6 +114,15 @@ gp::Kernel BiasPreset::kernel() const {
     gp::PartSpec s{gp::PartType::kRbf, {0, 1, 2}, 0.02, {0.5, 0.5, 0.5}};
     return gp::Kernel::sum({s});
   }
+  if (name == "pair-tdoa-pos") {
+    // docs/math/gp.md (P26b): paper eq. 9 on the body-frame anchor positions plus an RBF-ARD map over the arena
+    // (raw metres: the k_L inputs must not be standardized; 0.5 m start length scale, as pair-pos in its units)
+    const gp::Kernel eq9 = gp::Kernel::preset("tdoa");
+    std::vector<gp::PartSpec> parts;
+    for (int p = 0; p < eq9.numParts(); ++p) parts.push_back(eq9.partSpec(p));
+    parts.push_back(gp::PartSpec{gp::PartType::kRbf, {6, 7, 8}, 0.02, {0.5, 0.5, 0.5}});
+    return gp::Kernel::sum(parts);
+  }
   throw std::invalid_argument("unknown bias-model preset '" + name + "'");
 }
 
@@ -126,15 +146,18 @@ BiasPreset BiasPreset::byName(const std::string& name) {
     p.features = FeatureMap::kWorldPosition;
     p.per_pair = true;
     p.normalization = gp::InputNormalization::kStandardize;
+  } else if (name == "pair-tdoa-pos") {
+    p.features = FeatureMap::kBodyPositionsWorld;
+    p.per_pair = true;
   } else {
     throw std::invalid_argument("unknown bias-model kernel/preset '" + name + "' (expected z1, z2, tdoa, pair-tdoa, pair-pos, tdoa-pm, "
-                                "anchor-tdoa, anchor-tdoa-pm)");
+                                "anchor-tdoa, anchor-tdoa-pm, pair-tdoa-pos)");
   }
   return p;
 }
 
 std::vector<std::string> BiasPreset::names() {
-  return {"z1", "z2", "tdoa", "pair-tdoa", "pair-pos", "tdoa-pm", "anchor-tdoa", "anchor-tdoa-pm"};
+  return {"z1", "z2", "tdoa", "pair-tdoa", "pair-pos", "tdoa-pm", "anchor-tdoa", "anchor-tdoa-pm", "pair-tdoa-pos"};
 }
 
 void BiasTrainParams::validate() const {

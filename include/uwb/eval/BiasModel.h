@@ -14,6 +14,8 @@
  *                      by the anchor's surveyed world position (learned length scale sets how much anchors
  *                      share; docs/math/gp.md P29)
  *   - "anchor-tdoa-pm" "anchor-tdoa" plus the per-pair constant mean
+ *   - "pair-tdoa-pos"  one GP per anchor pair, k_L(b_p_a) + k_L(b_p_b) + k_rbf(w_p_b): the eq. 9 kernel plus a
+ *                      spatial map of the pair's error in the arena (docs/math/gp.md P26b)
  *  A pair without a model predicts {0, 0} (no correction, no added variance).
  *  Model file: JSON, {"format": "uwbtdoa-bias-model", "version": 1, ...}; see toJson().
  */
@@ -39,6 +41,7 @@ enum class FeatureMap {
   kBodyPositions,  ///< [b_p_a (3), b_p_b (3)] [m]
   kWorldPosition,  ///< [w_p_b (3)] [m]
   kBodyPositionsAnchors,  ///< [b_p_a (3), b_p_b (3), w_p_anchor_a (3), w_p_anchor_b (3)] [m]
+  kBodyPositionsWorld,    ///< [b_p_a (3), b_p_b (3), w_p_b (3)] [m]
 };
 constexpr int kMaxFeatureDim = 12;
 std::string toString(FeatureMap map);
