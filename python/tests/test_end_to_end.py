@@ -105,6 +105,10 @@ def test_eval_errors_are_value_and_os_errors(flights, trained, tmp_path):
     with pytest.raises(ValueError, match="'w_p_anchor_b' is missing; the feature map 'body_positions_anchors'"):
         u.feature_matrix("body_positions_anchors", a)
     assert u.feature_matrix("yaw_angles", a).shape[1] == 2
+    # eq. 9 inputs plus the body position (pair-tdoa-pos, P26b)
+    W = u.feature_matrix("body_positions_world", a)
+    np.testing.assert_array_equal(W[:, 6:9], a["w_p_b"])
+    np.testing.assert_array_equal(W[:, :6], X[:, :6])
 
 
 def test_run_evaluation_writes_the_report_and_renders_its_figures(flights, tmp_path):
