@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Bias-RMSE table of the TDoA bias GP (issue 4, "Done means"): for each kernel and number of inducing points,
-# train on one set of real flights and apply the model to other flights (features from ground truth).
+# train on one set of real flights and apply the model to other flights. The GP inputs come from INPUTS: 'estimate'
+# (default: the uncorrected filter's pose, as at run time) or 'truth' (ground-truth pose); predict-bias uses the same.
 #
-#   scripts/train_all.sh [OUT_DIR]            env: UWBTDOA (CLI), DATA, EPOCHS, KERNELS, INDUCING, SEED
+#   scripts/train_all.sh [OUT_DIR]            env: UWBTDOA (CLI), DATA, EPOCHS, KERNELS, INDUCING, SEED, INPUTS
 #
 # Splits (util-pilot SOURCE.md): 0425-traj6..9 -> 0425-traj1..4, and 0426-traj11 -> 0426-traj12.
 # Test metric: bias RMSE over the airborne test samples (gt z > 0.3 m, |eps| <= 1 m), before (raw eps) and after
@@ -14,7 +15,8 @@ UWBTDOA="${UWBTDOA:-$ROOT/build-gp/uwbtdoa}"
 DATA="${DATA:-$ROOT/../shared/data/real/util-pilot}"
 EPOCHS="${EPOCHS:-15}"
 SEED="${SEED:-1}"
-KERNELS="${KERNELS:-z1 z2 tdoa pair-tdoa pair-pos}"
+INPUTS="${INPUTS:-estimate}"
+KERNELS="${KERNELS:-z1 z2 tdoa pair-tdoa pair-pos pair-tdoa-pos}"
 INDUCING="${INDUCING:-10 30 50 100 170}"
 mkdir -p "$OUT"
 [[ -x "$UWBTDOA" ]] || { echo "uwbtdoa not found at $UWBTDOA (build it or set UWBTDOA)" >&2; exit 1; }
@@ -34,7 +36,7 @@ for split in 0425 0426; do
       tag="${split}_${k}_M${m}"
       echo ">> $tag" >&2
       "$UWBTDOA" train "${train_files[@]}" --anchors "$DATA/${SURVEY[$split]}" --kernel "$k" --inducing "$m" \
-        --epochs "$EPOCHS" --seed "$SEED" --out "$OUT/$tag.model.json" --json --quiet > "$OUT/$tag.train.json"
+        --epochs "$EPOCHS" --seed "$SEED" --inputs "$INPUTS" --out "$OUT/$tag.model.json" --json --quiet > "$OUT/$tag.train.json"
       : > "$OUT/$tag.test.jsonl"
       for f in ${TEST[$split]}; do
         "$UWBTDOA" predict-bias "$DATA/$f" --anchors "$DATA/${SURVEY[$split]}" --model "$OUT/$tag.model.json" \
