@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iterator>
 #include <limits>
 
 namespace uwb {
@@ -75,37 +74,17 @@ void countGaps(const std::vector<Sample>& v, double max_gap_s, double& max_gap, 
   }
 }
 
-/// Gap statistics and the merged event sequence of a clean (time-ordered, duplicate-free, finite) log.
-std::vector<SensorEvent> mergeOrderedStreams(const SensorLog& log, double max_gap_s, MergeReport& rep) {
+/// Gap statistics of a clean (time-ordered, duplicate-free, finite) log.
+void countStreamGaps(const SensorLog& log, double max_gap_s, MergeReport& rep) {
   countGaps(log.imu, max_gap_s, rep.max_imu_gap_s, rep.n_imu_gaps);
   countGaps(log.tdoa, max_gap_s, rep.max_tdoa_gap_s, rep.n_tdoa_gaps);
-  // linear merge, IMU first at equal stamps; an exhausted stream reads as +∞. The next event is selected without
-  // a branch (which stream comes next is irregular, so a branch on it would be mispredicted often).
-  const std::size_t n_imu = log.imu.size(), n_tdoa = log.tdoa.size();
-  constexpr double kNever = std::numeric_limits<double>::infinity();
-  std::vector<SensorEvent> events(n_imu + n_tdoa);
-  std::size_t i = 0, j = 0;
-  for (SensorEvent& e : events) {
-    const double t_imu = i < n_imu ? log.imu[i].t_s : kNever;
-    const double t_tdoa = j < n_tdoa ? log.tdoa[j].t_s : kNever;
-    const bool take_imu = t_imu <= t_tdoa;
-    e = take_imu ? SensorEvent{t_imu, SensorEvent::Kind::kImu, static_cast<unsigned>(i)}
-                 : SensorEvent{t_tdoa, SensorEvent::Kind::kTdoa, static_cast<unsigned>(j)};
-    i += take_imu;
-    j += !take_imu;
-  }
-  if (!log.tof.empty()) {
-    // ToF (≈25 Hz) merged into the IMU/TDoA sequence; std::merge is stable, so ToF goes last at equal stamps
-    std::vector<SensorEvent> tof_events;
-    tof_events.reserve(log.tof.size());
-    for (std::size_t k = 0; k < log.tof.size(); ++k)
-      tof_events.push_back({log.tof[k].t_s, SensorEvent::Kind::kTof, static_cast<unsigned>(k)});
-    std::vector<SensorEvent> merged;
-    merged.reserve(events.size() + tof_events.size());
-    std::merge(events.begin(), events.end(), tof_events.begin(), tof_events.end(), std::back_inserter(merged),
-               [](const SensorEvent& a, const SensorEvent& b) { return a.t_s < b.t_s; });
-    events = std::move(merged);
-  }
+}
+
+/// All events of a clean log, in SensorEventCursor's order.
+std::vector<SensorEvent> collectEvents(const SensorLog& log) {
+  SensorEventCursor cursor(log);
+  std::vector<SensorEvent> events(cursor.size());
+  for (SensorEvent& e : events) cursor.next(e);
   return events;
 }
 
@@ -123,20 +102,41 @@ bool sensorLogIsClean(const SensorLog& log) {
   return true;
 }
 
-std::vector<SensorEvent> mergeCleanSensorStreams(const SensorLog& log, double max_gap_s, MergeReport* report) {
+double SensorEventCursor::firstStamp() const {
+  double t = std::numeric_limits<double>::infinity();
+  if (!log_->imu.empty()) t = std::min(t, log_->imu.front().t_s);
+  if (!log_->tdoa.empty()) t = std::min(t, log_->tdoa.front().t_s);
+  if (!log_->tof.empty()) t = std::min(t, log_->tof.front().t_s);
+  return t;
+}
+
+double SensorEventCursor::lastStamp() const {
+  double t = -std::numeric_limits<double>::infinity();
+  if (!log_->imu.empty()) t = std::max(t, log_->imu.back().t_s);
+  if (!log_->tdoa.empty()) t = std::max(t, log_->tdoa.back().t_s);
+  if (!log_->tof.empty()) t = std::max(t, log_->tof.back().t_s);
+  return t;
+}
+
+MergeReport cleanSensorLogReport(const SensorLog& log, double max_gap_s) {
   MergeReport rep;
   rep.n_imu_in = log.imu.size();
   rep.n_tdoa_in = log.tdoa.size();
   rep.n_tof_in = log.tof.size();
-  std::vector<SensorEvent> events = mergeOrderedStreams(log, max_gap_s, rep);
-  if (report) {
-    rep.n_imu_unpaired = report->n_imu_unpaired;
-    *report = rep;
-  }
-  return events;
+  countStreamGaps(log, max_gap_s, rep);
+  return rep;
 }
 
-std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, MergeReport* report) {
+std::vector<SensorEvent> mergeCleanSensorStreams(const SensorLog& log, double max_gap_s, MergeReport* report) {
+  if (report) {
+    const std::size_t n_imu_unpaired = report->n_imu_unpaired;
+    *report = cleanSensorLogReport(log, max_gap_s);
+    report->n_imu_unpaired = n_imu_unpaired;
+  }
+  return collectEvents(log);
+}
+
+MergeReport cleanSensorLog(SensorLog& log, double max_gap_s) {
   MergeReport rep;
   rep.n_imu_in = log.imu.size();
   rep.n_tdoa_in = log.tdoa.size();
@@ -174,12 +174,17 @@ std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, Me
   const std::size_t nt = log.tdoa.size();
   log.tdoa.erase(std::unique(log.tdoa.begin(), log.tdoa.end(), tdoaSame), log.tdoa.end());
   rep.n_tdoa_duplicate = nt - log.tdoa.size();
-  std::vector<SensorEvent> events = mergeOrderedStreams(log, max_gap_s, rep);
+  countStreamGaps(log, max_gap_s, rep);
+  return rep;
+}
+
+std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, MergeReport* report) {
+  MergeReport rep = cleanSensorLog(log, max_gap_s);
   if (report) {
     rep.n_imu_unpaired = report->n_imu_unpaired;
     *report = rep;
   }
-  return events;
+  return collectEvents(log);
 }
 
 }  // namespace uwb

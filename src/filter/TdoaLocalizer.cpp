@@ -71,14 +71,14 @@ TdoaLocalizer::TdoaLocalizer(const EkfParams& params, AnchorTable anchors, BiasP
 LocalizerResult TdoaLocalizer::run(const SensorLog& input, double output_period_s) const {
   LocalizerResult result;
   LocalizerSummary& sum = result.summary;
-  // (F17) streams cleaned and merged; the input is copied only when it needs cleaning
+  // (F17) streams cleaned and merged; the input is copied only when it needs cleaning, and the merged sequence is
+  // walked by a cursor over the clean streams instead of being stored
   SensorLog cleaned;
   const bool input_clean = sensorLogIsClean(input);
   if (!input_clean) cleaned = input;
   const SensorLog& log = input_clean ? input : cleaned;
-  const std::vector<SensorEvent> events = input_clean
-                                              ? mergeCleanSensorStreams(input, params_.max_gap_s, &sum.merge)
-                                              : mergeSensorStreams(cleaned, params_.max_gap_s, &sum.merge);
+  sum.merge = input_clean ? cleanSensorLogReport(input, params_.max_gap_s) : cleanSensorLog(cleaned, params_.max_gap_s);
+  SensorEventCursor events(log);
   if (events.empty()) return result;
 
   EkfParams p = params_;
@@ -88,8 +88,8 @@ LocalizerResult TdoaLocalizer::run(const SensorLog& input, double output_period_
     p.ground_phase = GroundPhase::kNone;
   }
   sum.process_model = p.process_model;
-  sum.start_t_s = events.front().t_s;
-  sum.end_t_s = events.back().t_s;
+  sum.start_t_s = events.firstStamp();
+  sum.end_t_s = events.lastStamp();
   const BiasPredictor* bias = bias_ ? &bias_ : nullptr;
   // emit() spaces the outputs by output_period_s (plus one forced at the end): reserve once, no regrowth
   const double n_out_max = output_period_s > 0.0 ? (sum.end_t_s - sum.start_t_s) / output_period_s + 2.0 : 0.0;
@@ -131,11 +131,11 @@ LocalizerResult TdoaLocalizer::run(const SensorLog& input, double output_period_
   FlightPhase phase = FlightPhase::kAcquisition;
   bool position_known = p.has_start_position;
   bool initialized = false;
-  double t_pred = events.front().t_s;
+  double t_pred = sum.start_t_s;
   double t_last_out = -1e300;
   double t_last_zupt = -1e300;
   double t_acq_end = -1e300;
-  double t_last_accept = events.front().t_s;
+  double t_last_accept = sum.start_t_s;
   std::size_t n_rejected_streak = 0;
 
   // IMU averaging (F17)
@@ -307,7 +307,7 @@ LocalizerResult TdoaLocalizer::run(const SensorLog& input, double output_period_
     }
   };
 
-  for (const SensorEvent& ev : events) {
+  for (SensorEvent ev; events.next(ev);) {
     const double t = ev.t_s;
     if (ev.kind == SensorEvent::Kind::kImu) {
       if (!imu_mode) continue;
@@ -532,7 +532,7 @@ LocalizerResult TdoaLocalizer::run(const SensorLog& input, double output_period_
     }
     emit(t);
   }
-  if (initialized) emit(events.back().t_s, true);
+  if (initialized) emit(sum.end_t_s, true);
   return result;
 }
 

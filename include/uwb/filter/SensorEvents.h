@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -65,8 +66,51 @@ struct SensorEvent {
   unsigned index = 0;
 };
 
-/// Cleans `log` in place (drops non-finite samples and duplicates, stably sorts each stream by time) and returns
-/// the merged event sequence, ordered by time; at equal stamps IMU comes before TDoA, and both before ToF.
+/// The merged event sequence of a clean log (sensorLogIsClean), produced one event at a time without materialising
+/// it (F17): ordered by time; at equal stamps IMU comes before TDoA, and both before ToF. The log must outlive the
+/// cursor and stay unchanged. This is the one definition of the merge order; mergeSensorStreams collects it.
+///   SensorEventCursor cursor(log);
+///   for (SensorEvent ev; cursor.next(ev);) { ... }
+class SensorEventCursor {
+ public:
+  explicit SensorEventCursor(const SensorLog& log) : log_(&log) {}
+  /// Total number of events.
+  std::size_t size() const { return log_->imu.size() + log_->tdoa.size() + log_->tof.size(); }
+  bool empty() const { return size() == 0; }
+  /// Stamp of the first / last event [s]; only for a non-empty log.
+  double firstStamp() const;
+  double lastStamp() const;
+  /// Writes the next event to `ev` and returns true, or returns false when all events were produced.
+  bool next(SensorEvent& ev) {
+    // an exhausted stream reads as +∞; ties go to IMU, then TDoA (≤), so ToF is last at equal stamps
+    const double t_imu = i_imu_ < log_->imu.size() ? log_->imu[i_imu_].t_s : kNever;
+    const double t_tdoa = i_tdoa_ < log_->tdoa.size() ? log_->tdoa[i_tdoa_].t_s : kNever;
+    const double t_tof = i_tof_ < log_->tof.size() ? log_->tof[i_tof_].t_s : kNever;
+    if (t_imu <= t_tdoa && t_imu <= t_tof) {
+      if (i_imu_ == log_->imu.size()) return false;  // t_imu = ∞ ≤ the others (finite stamps): all exhausted
+      ev = {t_imu, SensorEvent::Kind::kImu, static_cast<unsigned>(i_imu_++)};
+    } else if (t_tdoa <= t_tof) {
+      ev = {t_tdoa, SensorEvent::Kind::kTdoa, static_cast<unsigned>(i_tdoa_++)};
+    } else {
+      ev = {t_tof, SensorEvent::Kind::kTof, static_cast<unsigned>(i_tof_++)};
+    }
+    return true;
+  }
+
+ private:
+  static constexpr double kNever = std::numeric_limits<double>::infinity();
+  const SensorLog* log_;
+  std::size_t i_imu_ = 0, i_tdoa_ = 0, i_tof_ = 0;
+};
+
+/// Cleans `log` in place (drops non-finite samples and duplicates, stably sorts each stream by time; afterwards
+/// sensorLogIsClean(log) holds) and returns what it found, with the gap statistics of the cleaned streams.
+MergeReport cleanSensorLog(SensorLog& log, double max_gap_s);
+
+/// cleanSensorLog's report for a log that is already clean (sensorLogIsClean): input counts and gap statistics.
+MergeReport cleanSensorLogReport(const SensorLog& log, double max_gap_s);
+
+/// Cleans `log` in place (cleanSensorLog) and returns the merged event sequence (SensorEventCursor's order).
 std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, MergeReport* report = nullptr);
 
 /// True when mergeSensorStreams would leave `log` unchanged: all stamps and values finite, IMU stamps strictly
