@@ -10,15 +10,18 @@ namespace uwb {
 
 void AccumulatedTransition::accumulate(const ImuStepJacobian& J) {
   // docs/math/filter.md (F7): Φ ← F Φ with F from (F4); only the non-trivial blocks change.
+  // F_pθ = ½dt F_vθ and F_pba = ½dt F_vba (F4), so the position rows reuse the velocity rows' products
+  // F_vθ Φ_θθ and F_vθ Φ_θbg: four 3×3 products per step instead of six.
   const double dt = J.dt_s;
-  const Mat3 F_p_att = 0.5 * dt * J.F_v_att;
-  const Mat3 F_p_ba = 0.5 * dt * J.F_v_accbias;
-  pos_att += dt * vel_att + F_p_att * att_att;
-  pos_accbias += dt * vel_accbias + F_p_ba;
-  pos_gyrobias += dt * vel_gyrobias + F_p_att * att_gyrobias;
-  vel_att += J.F_v_att * att_att;
+  const double half_dt = 0.5 * dt;
+  const Mat3 Fva_att_att = J.F_v_att * att_att;
+  const Mat3 Fva_att_gyrobias = J.F_v_att * att_gyrobias;
+  pos_att += dt * vel_att + half_dt * Fva_att_att;
+  pos_accbias += dt * vel_accbias + half_dt * J.F_v_accbias;
+  pos_gyrobias += dt * vel_gyrobias + half_dt * Fva_att_gyrobias;
+  vel_att += Fva_att_att;
   vel_accbias += J.F_v_accbias;
-  vel_gyrobias += J.F_v_att * att_gyrobias;
+  vel_gyrobias += Fva_att_gyrobias;
   att_gyrobias = J.F_att_att * att_gyrobias + J.F_att_gyrobias;
   att_att = J.F_att_att * att_att;
   T_s += dt;
@@ -271,6 +274,13 @@ void Ekf::resetPosition(const Vec3& w_p_b, double sigma_m) {
   P_.block<3, 3>(kPos, kPos).diagonal().setConstant(sigma_m * sigma_m);
 }
 
-void Ekf::inject(const ErrVec& dx) { x_ = boxPlus(x_, dx); }
+void Ekf::inject(const ErrVec& dx) {
+  // x ← x ⊞ δx (F8), in place: the arithmetic of boxPlus without copying the state twice
+  x_.w_p_b += dx.segment<3>(kPos);
+  x_.w_v_b += dx.segment<3>(kVel);
+  x_.w_q_b = (x_.w_q_b * expQuat(dx.segment<3>(kAtt))).normalized();
+  x_.b_acc_bias += dx.segment<3>(kAccBias);
+  x_.b_gyro_bias += dx.segment<3>(kGyroBias);
+}
 
 }  // namespace uwb
