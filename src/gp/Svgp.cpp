@@ -317,7 +317,7 @@ SvgpPredictor::SvgpPredictor(const Svgp& gp)
 }
 
 namespace {
-constexpr Eigen::Index kPredictBlock = 256;  ///< rows of test points per kernel block (≈ 350 kB at M = 170)
+constexpr Eigen::Index kPredictBlock = 128;  ///< rows of test points per kernel block (≈ 175 kB at M = 170)
 constexpr Eigen::Index kTilePoints = 8;      ///< points per fused quadratic-form tile (P33): two AVX2 registers
 constexpr Eigen::Index kQuPanel = 6;         ///< columns of Q_u per panel (P33): 6 × 2 accumulator registers
 
