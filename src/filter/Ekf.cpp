@@ -58,36 +58,46 @@ ErrMat AccumulatedTransition::leftMultiply(const ErrMat& M) const {
 
 namespace {
 
-/// out.middleCols<3>(j) += cols Bᵀ for a 15×3 block `cols`, as nine 15-long column axpys (contiguous in column-major
-/// storage). Each column is split 12 + 3 rows so that the bulk runs in full 4-wide SIMD packets (Eigen vectorises a
-/// fixed 15-row column only with 2-wide packets). `cols` must not overlap the written columns.
-template <class Columns>
+/// out.middleCols<3>(j) += cols Bᵀ on the first Rows rows, for a block `cols` of 3 columns, as nine Rows-long column
+/// axpys (contiguous in column-major storage). Each column is split into its first 4⌊Rows/4⌋ rows and the rest so
+/// that the bulk runs in full 4-wide SIMD packets (Eigen vectorises a fixed 15-row column only with 2-wide packets).
+/// `cols` must not overlap the written columns.
+template <int Rows, class Columns>
 void addColumnBlockTimesTransposed(ErrMat& out, int j, const Columns& cols, const Mat3& B) {
+  constexpr int kBulk = Rows / 4 * 4;
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) {
-      out.col(j + r).head<12>() += B(r, c) * cols.col(c).template head<12>();
-      out.col(j + r).tail<3>() += B(r, c) * cols.col(c).template tail<3>();
+      out.col(j + r).template head<kBulk>() += B(r, c) * cols.col(c).template head<kBulk>();
+      if constexpr (Rows > kBulk)
+        out.col(j + r).template segment<Rows - kBulk>(kBulk) += B(r, c) * cols.col(c).template segment<Rows - kBulk>(kBulk);
     }
   }
+}
+
+/// The first Rows rows of M ← M Φᵀ in place, using the block structure of Φ (F7).
+template <int Rows>
+void rightMultiplyTransposedTopRows(const AccumulatedTransition& phi, ErrMat& M) {
+  // Column blocks of M Φᵀ = (Φ Mᵀ)ᵀ: column block j of the result is Σ_k M_{:,k} Φ_jkᵀ; bias columns are unchanged.
+  // Written in the order position, velocity, attitude: each block reads only blocks that are still unchanged, except
+  // the attitude block, which reads its own old value (kept in a copy).
+  auto top = [&M](int j) { return M.template block<Rows, 3>(0, j); };
+  top(kPos) += phi.T_s * top(kVel);
+  addColumnBlockTimesTransposed<Rows>(M, kPos, top(kAtt), phi.pos_att);
+  addColumnBlockTimesTransposed<Rows>(M, kPos, top(kAccBias), phi.pos_accbias);
+  addColumnBlockTimesTransposed<Rows>(M, kPos, top(kGyroBias), phi.pos_gyrobias);
+  addColumnBlockTimesTransposed<Rows>(M, kVel, top(kAtt), phi.vel_att);
+  addColumnBlockTimesTransposed<Rows>(M, kVel, top(kAccBias), phi.vel_accbias);
+  addColumnBlockTimesTransposed<Rows>(M, kVel, top(kGyroBias), phi.vel_gyrobias);
+  const Eigen::Matrix<double, Rows, 3> M_att = top(kAtt);
+  top(kAtt).setZero();  // Φ_θθ replaces the identity block
+  addColumnBlockTimesTransposed<Rows>(M, kAtt, M_att, phi.att_att);
+  addColumnBlockTimesTransposed<Rows>(M, kAtt, top(kGyroBias), phi.att_gyrobias);
 }
 
 }  // namespace
 
 void AccumulatedTransition::rightMultiplyTransposedInPlace(ErrMat& M) const {
-  // Column blocks of M Φᵀ = (Φ Mᵀ)ᵀ: column block j of the result is Σ_k M_{:,k} Φ_jkᵀ; bias columns are unchanged.
-  // Written in the order position, velocity, attitude: each block reads only blocks that are still unchanged, except
-  // the attitude block, which reads its own old value (kept in a 15×3 copy).
-  M.middleCols<3>(kPos) += T_s * M.middleCols<3>(kVel);
-  addColumnBlockTimesTransposed(M, kPos, M.middleCols<3>(kAtt), pos_att);
-  addColumnBlockTimesTransposed(M, kPos, M.middleCols<3>(kAccBias), pos_accbias);
-  addColumnBlockTimesTransposed(M, kPos, M.middleCols<3>(kGyroBias), pos_gyrobias);
-  addColumnBlockTimesTransposed(M, kVel, M.middleCols<3>(kAtt), vel_att);
-  addColumnBlockTimesTransposed(M, kVel, M.middleCols<3>(kAccBias), vel_accbias);
-  addColumnBlockTimesTransposed(M, kVel, M.middleCols<3>(kGyroBias), vel_gyrobias);
-  const Eigen::Matrix<double, kDim, 3> M_att = M.middleCols<3>(kAtt);
-  M.middleCols<3>(kAtt).setZero();  // Φ_θθ replaces the identity block
-  addColumnBlockTimesTransposed(M, kAtt, M_att, att_att);
-  addColumnBlockTimesTransposed(M, kAtt, M.middleCols<3>(kGyroBias), att_gyrobias);
+  rightMultiplyTransposedTopRows<kDim>(*this, M);
 }
 
 ErrMat AccumulatedTransition::rightMultiplyTransposed(const ErrMat& M) const {
@@ -191,12 +201,15 @@ void Ekf::propagateTdoaOnlyCovariance() {
 void Ekf::propagateCovariance() {
   if (pending_cv_dt_s_ > 0.0) propagateTdoaOnlyCovariance();
   if (phi_.empty()) return;
-  // docs/math/filter.md (F7): P ← Φ P Φᵀ + Q(T); Φ P Φᵀ = (P Φᵀ)ᵀ Φᵀ since P is symmetric: two block
-  // right-multiplications by Φᵀ (column operations, which vectorise along the 15 rows; the same block sums as
-  // Φ (Φ P)ᵀ with row operations).
-  phi_.rightMultiplyTransposedInPlace(P_);  // P Φᵀ
-  P_.transposeInPlace();                    // Φ P
-  phi_.rightMultiplyTransposedInPlace(P_);  // Φ P Φᵀ
+  // docs/math/filter.md (F7): P ← Φ P Φᵀ + Q(T). With A = (δp, δv, δθ) (rows 0..8) and B = the biases (rows 9..14),
+  // the bias rows of Φ are identity rows, so for Y = P Φᵀ (column operations, vectorised along the columns):
+  //   (Φ P Φᵀ)_{B,:} = Y_{B,:},   (Φ P Φᵀ)_{A,B} = Y_{B,A}ᵀ (symmetry),   (Φ P Φᵀ)_{A,A} = (Y_{:,A})ᵀ_{A-rows} Φᵀ.
+  // The second right-multiplication by Φᵀ therefore runs over the 9 rows of A only (the same block sums as
+  // Φ (Φ P)ᵀ with row operations), and the A/B blocks stay exactly symmetric.
+  phi_.rightMultiplyTransposedInPlace(P_);                           // Y = P Φᵀ; rows B are final
+  P_.topLeftCorner<kAccBias, kAccBias>().transposeInPlace();         // rows A ← (Y_{:,A})ᵀ …
+  P_.topRightCorner<kAccBias, kDim - kAccBias>() = P_.bottomLeftCorner<kDim - kAccBias, kAccBias>().transpose();
+  rightMultiplyTransposedTopRows<kAccBias>(phi_, P_);                // … times Φᵀ: rows A of Φ P Φᵀ
   const double T = phi_.T_s;
   P_.diagonal().segment<3>(kVel) += phi_.q_vel_diag;
   P_.diagonal().segment<3>(kPos).array() += params_.pos_noise_m_sqrts * params_.pos_noise_m_sqrts * T;
