@@ -5,9 +5,11 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <cmath>
 #include <exception>
+#include <memory>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -429,38 +431,33 @@ void SvgpPredictor::packQu() {
 
 namespace {
 
-/// Runs body(begin, end) over [0, n) split into at most `num_threads` contiguous ranges whose bounds are multiples
-/// of kPredictBlock, so every row falls into the same block, and gets the same floating-point result, whatever
-/// the split. num_threads = 0: one per hardware thread. The first range runs on the calling thread.
-template <class Body>
-void parallelRows(Eigen::Index n, int num_threads, const Body& body) {
+/// Runs worker() on min(num_threads, blocks) threads (0: one per hardware thread; the calling thread is one of
+/// them). The workers share the rows by taking kPredictBlock-row blocks from one atomic counter, so a thread slowed
+/// by other load takes fewer blocks. Every row is computed by the same operations wherever it lands (P32, P33), so
+/// the result does not depend on the thread count or on which thread took which block.
+template <class Worker>
+void runWorkers(Eigen::Index n, int num_threads, const Worker& worker) {
   if (num_threads < 0) throw std::invalid_argument("SVGP predict: num_threads must be >= 0");
   if (num_threads == 0) num_threads = std::max(1u, std::thread::hardware_concurrency());
   const Eigen::Index blocks = (n + kPredictBlock - 1) / kPredictBlock;
   const Eigen::Index parts = std::min<Eigen::Index>(num_threads, blocks);
   if (parts <= 1) {
-    body(Eigen::Index{0}, n);
+    worker();
     return;
   }
   std::vector<std::thread> workers;
   std::vector<std::exception_ptr> errors(static_cast<std::size_t>(parts));
-  auto range = [&](Eigen::Index t) {
-    const Eigen::Index b0 = blocks * t / parts, b1 = blocks * (t + 1) / parts;
-    return std::pair{b0 * kPredictBlock, std::min(n, b1 * kPredictBlock)};
-  };
   for (Eigen::Index t = 1; t < parts; ++t) {
     workers.emplace_back([&, t] {
       try {
-        const auto [b, e] = range(t);
-        body(b, e);
+        worker();
       } catch (...) {
         errors[static_cast<std::size_t>(t)] = std::current_exception();
       }
     });
   }
   try {
-    const auto [b, e] = range(0);
-    body(b, e);
+    worker();
   } catch (...) {
     errors[0] = std::current_exception();
   }
@@ -470,19 +467,19 @@ void parallelRows(Eigen::Index n, int num_threads, const Body& body) {
 }
 }  // namespace
 
-void SvgpPredictor::predictRows(const MatX& X_raw, Eigen::Index begin, Eigen::Index end, VecX& mean,
+void SvgpPredictor::predictRows(const MatX& X_raw, std::atomic<Eigen::Index>& next_block, VecX& mean,
                                 VecX* var_f) const {
   const bool tf = shift_.size() > 0;
-  const Eigen::Index M = Z_.rows();
+  const Eigen::Index M = Z_.rows(), N = X_raw.rows();
   // Kernel block: rows padded to a whole number of tiles (copies of the last row, whose results are dropped),
   // column-major with the leading dimension ld, 64-byte aligned so that a tile's column is one cache line.
   MatX Xb(kPredictBlock, X_raw.cols());
-  std::vector<double> kbuf(static_cast<std::size_t>(kPredictBlock * M + 8));
-  double* kdata = kbuf.data();
+  const std::unique_ptr<double[]> kbuf(new double[static_cast<std::size_t>(kPredictBlock * M + 8)]);
+  double* kdata = kbuf.get();
   while (reinterpret_cast<std::uintptr_t>(kdata) % 64 != 0) ++kdata;
   double tmean[kTilePoints], tvar[kTilePoints];
-  for (Eigen::Index start = begin; start < end; start += kPredictBlock) {
-    const Eigen::Index n = std::min(kPredictBlock, end - start);
+  for (Eigen::Index start = next_block++ * kPredictBlock; start < N; start = next_block++ * kPredictBlock) {
+    const Eigen::Index n = std::min(kPredictBlock, N - start);
     const Eigen::Index ld = (n + kTilePoints - 1) / kTilePoints * kTilePoints;
     Xb.resize(ld, X_raw.cols());
     Xb.topRows(n) = X_raw.middleRows(start, n);
@@ -508,7 +505,8 @@ SvgpPrediction SvgpPredictor::predict(const MatX& X_raw, int num_threads) const 
   const Eigen::Index N = X_raw.rows();
   p.mean.resize(N);
   p.var_f.resize(N);
-  parallelRows(N, num_threads, [&](Eigen::Index b, Eigen::Index e) { predictRows(X_raw, b, e, p.mean, &p.var_f); });
+  std::atomic<Eigen::Index> next_block{0};
+  runWorkers(N, num_threads, [&] { predictRows(X_raw, next_block, p.mean, &p.var_f); });
   p.mean.array() += c_;
   p.var_f.array() += kdiag_ + jitter_;
   p.var_y = p.var_f.array() + noise_;
@@ -519,7 +517,8 @@ VecX SvgpPredictor::predictMean(const MatX& X_raw, int num_threads) const {
   if (shift_.size() > 0 && X_raw.cols() != shift_.size())
     throw std::invalid_argument("SVGP: input has the wrong number of columns");
   VecX mean(X_raw.rows());
-  parallelRows(X_raw.rows(), num_threads, [&](Eigen::Index b, Eigen::Index e) { predictRows(X_raw, b, e, mean, nullptr); });
+  std::atomic<Eigen::Index> next_block{0};
+  runWorkers(X_raw.rows(), num_threads, [&] { predictRows(X_raw, next_block, mean, nullptr); });
   mean.array() += c_;
   return mean;
 }

@@ -11,6 +11,7 @@
  */
 #pragma once
 
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -124,9 +125,9 @@ class SvgpPredictor {
   explicit SvgpPredictor(const Svgp& gp);
   /// Latent mean and variance (var_f, with ε) at one raw input row; a few microseconds at M ≈ 170.
   void predictOne(const Eigen::Ref<const RowVecX>& x, double& mean, double& var_f) const;
-  /// Batch prediction (P20). `num_threads` > 1 splits the rows into that many contiguous ranges, one std::thread
-  /// each (0: one per hardware thread); every row is computed the same way whatever the split, so the result
-  /// does not depend on the thread count. One thread is the default: callers that already run in parallel should
+  /// Batch prediction (P20, P32, P33). `num_threads` > 1 runs that many std::threads (0: one per hardware thread)
+  /// that take blocks of rows from a shared counter; every row is computed the same way wherever it lands, so the
+  /// result does not depend on the thread count. One thread is the default: callers that already run in parallel should
   /// not oversubscribe.
   SvgpPrediction predict(const MatX& X, int num_threads = 1) const;
   /// Latent mean only (no variance): O(M) per point after the kernel row, for bulk corrections.
@@ -134,8 +135,9 @@ class SvgpPredictor {
   double noiseVariance() const { return noise_; }
 
  private:
-  /// Rows [begin, end) of X_raw: mean and, when var_f is non-null, the latent variance (without c, k**, ε).
-  void predictRows(const MatX& X_raw, Eigen::Index begin, Eigen::Index end, VecX& mean, VecX* var_f) const;
+  /// Blocks of kPredictBlock rows of X_raw taken from `next_block` until none is left: mean and, when var_f is
+  /// non-null, the latent variance (without c, k**, ε).
+  void predictRows(const MatX& X_raw, std::atomic<Eigen::Index>& next_block, VecX& mean, VecX* var_f) const;
   void packQu();  ///< fills qpack_ from Q_ (P33)
 
   Kernel kernel_;
