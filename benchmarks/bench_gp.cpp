@@ -21,7 +21,19 @@
  *    session 2 (machine nearly idle, native): predict 10k M=170 one thread 17.6–18.7 ms, two threads 10.8–11.4 ms
  *      wall (the two vCPUs share resources: 1.6×); mean only 5.0 ms; one point 0.36/4.4 µs.
  *    GEMM calibration: 15 GFlop/s (default), 27–30 GFlop/s (native). The 10k/M=170 variance needs 0.29 GFlop
- *    (M² per point, already halved by the triangular Q_u), so < 10 ms is not reachable on one float64 core here.
+ *    (M² per point, already halved by the triangular Q_u): ≥ 10 ms at Eigen's GEMM rate on one float64 core.
+ *    session 3 (fused predictor: Kernel::crossInto with a polynomial exp, P32; register-blocked kᵀQ_u k over 8-point
+ *      tiles, P33; threads pull 128-row blocks from a counter), native, medians of 7, wall clock:
+ *      before (c2f16be, uptime load 4.3–4.6, the other developer compiling): M=170 one thread 29.3 ms (CPU 19.3),
+ *        two threads 36.7 ms; mean only 7.9 ms (CPU 5.3); M=30 2.0 ms; one point 0.60/6.8 µs (CPU 0.40/4.5)
+ *      after (uptime load 1.8–2.2: bench_filter at 100 % on the other vCPU; GEMM calibration 25.4 GFlop/s):
+ *        M=170 one thread 10.9–11.0 ms (CPU the same), two threads 10.4–10.7 ms (second thread shares a vCPU
+ *        with bench_filter); mean only 3.4 ms; M=30 0.87–0.93 ms; one point 0.37–0.40/4.3–4.6 µs (path unchanged)
+ *      later rounds (load 1.2–2.3, compiles on the other vCPU): one thread 11.8–11.9 ms, two threads 10.8–11.1 ms,
+ *        mean only 3.2–3.7 ms; GEMM calibration 20.8–26.8 GFlop/s. No quiet window for a clean two-thread figure.
+ *    Where the 11 ms go (one thread): kᵀQ_u k ≈ 7.4 ms = 39 GFlop/s, 80–85 % of the 46–50 GFlop/s this vCPU
+ *    reaches in a register-only FMA loop; the kernel block ≈ 2.4–3.0 ms (1.7 M values, exp by a degree-11
+ *    polynomial, ≈ 1.4 ns each); the mean ≈ 0.3 ms. At 100 % of FMA peak the variance alone would take ≈ 6 ms.
  */
 #include <benchmark/benchmark.h>
 
