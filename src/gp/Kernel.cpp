@@ -179,7 +179,7 @@ void rbfColumnT(const MatX& A, const double* b, const ScaledExpCoefs& cf, double
   }
 }
 
-/// RBF part column with σ²/i! coefficients `cf` (see rbfColumnT).
+/// RBF part column with the σ² p_i coefficients `cf` (see rbfColumnT).
 void rbfColumn(const MatX& A, const double* b, const ScaledExpCoefs& cf, double* out) {
   switch (A.cols()) {
     case 1: return rbfColumnT<1>(A, b, cf, out);
@@ -496,7 +496,7 @@ void Kernel::crossInto(const MatX& X1, const MatX& X2, Eigen::Ref<MatX> K) const
   struct Prepared {
     MatX A, B;     // rbf/matern: columns divided by l; periodic: raw; ledergerber: unit vectors
     MatX Bt;       // rbf: Bᵀ (row j of B contiguous)
-    ScaledExpCoefs cf{1.0};  // rbf: σ²/i!
+    ScaledExpCoefs cf{1.0};  // rbf: σ² p_i (P32)
     VecX na, nb;   // ledergerber: norms
   };
   std::vector<Prepared> prep(parts_.size());
