@@ -104,17 +104,17 @@ bool sensorLogIsClean(const SensorLog& log) {
 
 double SensorEventCursor::firstStamp() const {
   double t = std::numeric_limits<double>::infinity();
-  if (!log_->imu.empty()) t = std::min(t, log_->imu.front().t_s);
-  if (!log_->tdoa.empty()) t = std::min(t, log_->tdoa.front().t_s);
-  if (!log_->tof.empty()) t = std::min(t, log_->tof.front().t_s);
+  if (n_imu_) t = std::min(t, imu_[0].t_s);
+  if (n_tdoa_) t = std::min(t, tdoa_[0].t_s);
+  if (n_tof_) t = std::min(t, tof_[0].t_s);
   return t;
 }
 
 double SensorEventCursor::lastStamp() const {
   double t = -std::numeric_limits<double>::infinity();
-  if (!log_->imu.empty()) t = std::max(t, log_->imu.back().t_s);
-  if (!log_->tdoa.empty()) t = std::max(t, log_->tdoa.back().t_s);
-  if (!log_->tof.empty()) t = std::max(t, log_->tof.back().t_s);
+  if (n_imu_) t = std::max(t, imu_[n_imu_ - 1].t_s);
+  if (n_tdoa_) t = std::max(t, tdoa_[n_tdoa_ - 1].t_s);
+  if (n_tof_) t = std::max(t, tof_[n_tof_ - 1].t_s);
   return t;
 }
 

@@ -73,34 +73,52 @@ struct SensorEvent {
 ///   for (SensorEvent ev; cursor.next(ev);) { ... }
 class SensorEventCursor {
  public:
-  explicit SensorEventCursor(const SensorLog& log) : log_(&log) {}
+  explicit SensorEventCursor(const SensorLog& log)
+      : imu_(log.imu.data()), tdoa_(log.tdoa.data()), tof_(log.tof.data()), n_imu_(log.imu.size()),
+        n_tdoa_(log.tdoa.size()), n_tof_(log.tof.size()) {
+    updateNextOther();
+  }
   /// Total number of events.
-  std::size_t size() const { return log_->imu.size() + log_->tdoa.size() + log_->tof.size(); }
+  std::size_t size() const { return n_imu_ + n_tdoa_ + n_tof_; }
   bool empty() const { return size() == 0; }
   /// Stamp of the first / last event [s]; only for a non-empty log.
   double firstStamp() const;
   double lastStamp() const;
   /// Writes the next event to `ev` and returns true, or returns false when all events were produced.
   bool next(SensorEvent& ev) {
-    // an exhausted stream reads as +∞; ties go to IMU, then TDoA (≤), so ToF is last at equal stamps
-    const double t_imu = i_imu_ < log_->imu.size() ? log_->imu[i_imu_].t_s : kNever;
-    const double t_tdoa = i_tdoa_ < log_->tdoa.size() ? log_->tdoa[i_tdoa_].t_s : kNever;
-    const double t_tof = i_tof_ < log_->tof.size() ? log_->tof[i_tof_].t_s : kNever;
-    if (t_imu <= t_tdoa && t_imu <= t_tof) {
-      if (i_imu_ == log_->imu.size()) return false;  // t_imu = ∞ ≤ the others (finite stamps): all exhausted
-      ev = {t_imu, SensorEvent::Kind::kImu, static_cast<unsigned>(i_imu_++)};
-    } else if (t_tdoa <= t_tof) {
-      ev = {t_tdoa, SensorEvent::Kind::kTdoa, static_cast<unsigned>(i_tdoa_++)};
-    } else {
-      ev = {t_tof, SensorEvent::Kind::kTof, static_cast<unsigned>(i_tof_++)};
+    // IMU (the densest stream) first at equal stamps: one comparison against the earliest pending TDoA/ToF stamp
+    if (i_imu_ < n_imu_ && imu_[i_imu_].t_s <= t_next_other_) {
+      ev = {imu_[i_imu_].t_s, SensorEvent::Kind::kImu, static_cast<unsigned>(i_imu_)};
+      ++i_imu_;
+      return true;
     }
+    if (i_tdoa_ < n_tdoa_ && tdoa_[i_tdoa_].t_s == t_next_other_) {  // TDoA before ToF at equal stamps
+      ev = {t_next_other_, SensorEvent::Kind::kTdoa, static_cast<unsigned>(i_tdoa_)};
+      ++i_tdoa_;
+    } else if (i_tof_ < n_tof_) {
+      ev = {t_next_other_, SensorEvent::Kind::kTof, static_cast<unsigned>(i_tof_)};
+      ++i_tof_;
+    } else {
+      return false;  // all streams exhausted
+    }
+    updateNextOther();
     return true;
   }
 
  private:
-  static constexpr double kNever = std::numeric_limits<double>::infinity();
-  const SensorLog* log_;
+  /// The earliest pending TDoA or ToF stamp; +∞ when both are exhausted.
+  void updateNextOther() {
+    constexpr double kNever = std::numeric_limits<double>::infinity();
+    const double t_tdoa = i_tdoa_ < n_tdoa_ ? tdoa_[i_tdoa_].t_s : kNever;
+    const double t_tof = i_tof_ < n_tof_ ? tof_[i_tof_].t_s : kNever;
+    t_next_other_ = t_tdoa <= t_tof ? t_tdoa : t_tof;
+  }
+  const TimedImu* imu_;
+  const TdoaObservation* tdoa_;
+  const TofObservation* tof_;
+  std::size_t n_imu_, n_tdoa_, n_tof_;
   std::size_t i_imu_ = 0, i_tdoa_ = 0, i_tof_ = 0;
+  double t_next_other_ = 0.0;
 };
 
 /// Cleans `log` in place (drops non-finite samples and duplicates, stably sorts each stream by time; afterwards
