@@ -50,6 +50,9 @@ constexpr double kMlatMaxWindow_s = 3.0;
 constexpr double kStillAccStd_mps2 = 0.12;
 constexpr double kStillGyro_radps = 0.03;
 constexpr double kStillTau_s = 0.1;
+/// 1/τ of the stillness EMA [1/s] (exactly 10 in double): the decay exponent Δt/τ as a product, off the division's
+/// latency on the per-sample chain.
+constexpr double kStillRate_per_s = 1.0 / kStillTau_s;
 /// The stillness thresholds compared with the EMA statistics as squares (acc variance, gyro mean square): no sqrt.
 constexpr double kStillAccVar_m2ps4 = kStillAccStd_mps2 * kStillAccStd_mps2;
 constexpr double kStillGyroMs_rad2ps2 = kStillGyro_radps * kStillGyro_radps;
@@ -334,7 +337,7 @@ LocalizerResult TdoaLocalizer::run(const SensorLog& input, double output_period_
       ++n_imu_acc;
       // stillness statistics (F18)
       if (dt_imu > 0.0) {
-        const double a = expNegative(dt_imu / kStillTau_s);
+        const double a = expNegative(dt_imu * kStillRate_per_s);
         const double an = imu.b_acc_mps2.norm();
         acc_mean = a * acc_mean + (1 - a) * an;
         acc_var = a * acc_var + (1 - a) * (an - acc_mean) * (an - acc_mean);
