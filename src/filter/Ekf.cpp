@@ -254,14 +254,17 @@ std::optional<InnovationStats> Ekf::correctPositionAttitude(const ScalarLinearMe
 }
 
 void Ekf::zeroVelocityUpdate(double sigma_mps) {
-  // (F14) v = 0 observed per world axis.
+  // (F14) v = 0 observed per world axis. The row a = e_{v,i} is a unit vector, so the equality node's u = P aᵀ is
+  // column kVel+i of P and a u its diagonal entry (G18; what correct() sums from the one non-zero entry of a).
   for (int i = 0; i < 3; ++i) {
     ScalarLinearMessage<kDim> m;
     m.a.setZero();
     m.a(kVel + i) = 1.0;
     m.y = -x_.w_v_b(i);
     m.var = sigma_mps * sigma_mps;
-    correct(m);
+    ErrVec dx = ErrVec::Zero();
+    const ErrVec u = P_.col(kVel + i);
+    if (detail::applyRankOneGain<kDim>(dx, P_, m, u, 0.0, u(kVel + i))) inject(dx);  // (F8)
   }
 }
 
