@@ -7,15 +7,14 @@
  *         the timed loop. On a shared machine quote rtf_cpu; rtf_wall also counts time spent waiting for a core.
  *
  *  Session 3 (issue 3), CPU-time medians of --benchmark_repetitions=7, the session-2 binary (c2f16be) and the session-3
- *  one (403043c) run alternately, two rounds each, load 2.05–2.2 (another developer's work on one of the two cores):
- *    IMU prediction                 250–251 ns → 187–202 ns
- *    prediction + covariance        905–911 ns → 654–692 ns
- *    TDoA update                    222–237 ns → 230–238 ns (path unchanged)
- *    whole flight, synthetic 40 s   4 314–4 677× → 5 129–5 180×
- *    whole flight, real 0425-traj2  4 218–4 491× → 4 744–4 901×
- *  callgrind, TdoaLocalizer::run on traj2: 40.0 M → 35.9 M instructions. The spread between runs on this shared
- *  machine (±5 %) is as large as one step of the work; in quieter moments (load 1.5–1.9) the real flight measured
- *  4 900–5 120×.
+ *  one (403043c, then d5c12e9) run alternately, four rounds, load 1.8–2.4 (another developer on one of the two cores):
+ *    IMU prediction                 243–251 ns → 187–203 ns
+ *    prediction + covariance        760–911 ns → 654–814 ns
+ *    TDoA update                    220–237 ns → 227–239 ns (path unchanged)
+ *    whole flight, synthetic 40 s   4 314–4 928× (median 4 545×) → 5 112–5 786× (median 5 155×)
+ *    whole flight, real 0425-traj2  4 218–4 869× (median 4 378×) → 4 744–5 591× (median 4 911×)
+ *  callgrind, TdoaLocalizer::run on traj2: 40.0 M → 35.6 M instructions. The spread between runs on this shared
+ *  machine (±5–10 %) is as large as one step of the work.
  */
 #include <benchmark/benchmark.h>
 
