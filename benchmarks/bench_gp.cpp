@@ -29,8 +29,9 @@
  *      after (uptime load 1.8–2.2: bench_filter at 100 % on the other vCPU; GEMM calibration 25.4 GFlop/s):
  *        M=170 one thread 10.9–11.0 ms (CPU the same), two threads 10.4–10.7 ms (second thread shares a vCPU
  *        with bench_filter); mean only 3.4 ms; M=30 0.87–0.93 ms; one point 0.37–0.40/4.3–4.6 µs (path unchanged)
- *      later rounds (load 1.2–2.3, compiles on the other vCPU): one thread 11.8–11.9 ms, two threads 10.8–11.1 ms,
- *        mean only 3.2–3.7 ms; GEMM calibration 20.8–26.8 GFlop/s. No quiet window for a clean two-thread figure.
+ *      later rounds (load 1.2–2.5, another benchmark or compiler on the other vCPU): one thread 11.0–13.2 ms
+ *        (CPU 9.9–11.9), two threads 9.8–11.1 ms, mean only 3.4–3.7 ms; GEMM calibration 20.8–24.8 GFlop/s.
+ *        No quiet window for a clean two-thread figure.
  *    Where the 11 ms go (one thread): kᵀQ_u k ≈ 7.4 ms = 39 GFlop/s, 80–85 % of the 46–50 GFlop/s this vCPU
  *    reaches in a register-only FMA loop; the kernel block ≈ 2.4–3.0 ms (1.7 M values, exp by a degree-11
  *    polynomial, ≈ 1.4 ns each); the mean ≈ 0.3 ms. At 100 % of FMA peak the variance alone would take ≈ 6 ms.
