@@ -4,6 +4,7 @@
  */
 #include "uwb/filter/Ekf.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace uwb {
@@ -58,19 +59,23 @@ ErrMat AccumulatedTransition::leftMultiply(const ErrMat& M) const {
 
 namespace {
 
-/// out.middleCols<3>(j) += cols Bᵀ on the first Rows rows, for a block `cols` of 3 columns, as nine Rows-long column
-/// axpys (contiguous in column-major storage). Each column is split into its first 4⌊Rows/4⌋ rows and the rest so
-/// that the bulk runs in full 4-wide SIMD packets (Eigen vectorises a fixed 15-row column only with 2-wide packets).
-/// `cols` must not overlap the written columns.
+/// out.middleCols<3>(j) += cols Bᵀ on the first Rows rows, for a block `cols` of 3 columns: per written column, its
+/// rows held in full 4-wide SIMD packets (Eigen vectorises a fixed 15-row column only with 2-wide packets) while the
+/// three axpys B(r, c) cols_c are added in the order c = 0, 1, 2, then stored once. When 4 does not divide Rows the
+/// last packet covers the last 4 rows and overlaps the one before; both give the overlapping rows the same value
+/// (the same additions from the same loaded values), so no row is updated twice. `cols` must not overlap the written
+/// columns.
 template <int Rows, class Columns>
 void addColumnBlockTimesTransposed(ErrMat& out, int j, const Columns& cols, const Mat3& B) {
-  constexpr int kBulk = Rows / 4 * 4;
+  static_assert(Rows >= 4);
+  constexpr int kPackets = (Rows + 3) / 4;
+  constexpr auto start = [](int p) { return std::min(4 * p, Rows - 4); };
   for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) {
-      out.col(j + r).template head<kBulk>() += B(r, c) * cols.col(c).template head<kBulk>();
-      if constexpr (Rows > kBulk)
-        out.col(j + r).template segment<Rows - kBulk>(kBulk) += B(r, c) * cols.col(c).template segment<Rows - kBulk>(kBulk);
-    }
+    Eigen::Matrix<double, 4, kPackets> acc;
+    for (int p = 0; p < kPackets; ++p) acc.col(p) = out.col(j + r).template segment<4>(start(p));
+    for (int c = 0; c < 3; ++c)
+      for (int p = 0; p < kPackets; ++p) acc.col(p) += B(r, c) * cols.col(c).template segment<4>(start(p));
+    for (int p = 0; p < kPackets; ++p) out.col(j + r).template segment<4>(start(p)) = acc.col(p);
   }
 }
 
