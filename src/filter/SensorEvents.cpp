@@ -102,6 +102,33 @@ bool sensorLogIsClean(const SensorLog& log) {
   return true;
 }
 
+std::optional<MergeReport> cleanSensorLogReportIfClean(const SensorLog& log, double max_gap_s) {
+  // sensorLogIsClean's tests and countStreamGaps' statistics, sample by sample
+  MergeReport rep;
+  rep.n_imu_in = log.imu.size();
+  rep.n_tdoa_in = log.tdoa.size();
+  rep.n_tof_in = log.tof.size();
+  for (std::size_t i = 0; i < log.imu.size(); ++i) {
+    if (imuBad(log.imu[i])) return std::nullopt;
+    if (i == 0) continue;
+    if (!(log.imu[i].t_s > log.imu[i - 1].t_s)) return std::nullopt;
+    const double gap = log.imu[i].t_s - log.imu[i - 1].t_s;
+    rep.max_imu_gap_s = std::max(rep.max_imu_gap_s, gap);
+    rep.n_imu_gaps += gap > max_gap_s;
+  }
+  for (std::size_t i = 0; i < log.tdoa.size(); ++i) {
+    if (tdoaBad(log.tdoa[i])) return std::nullopt;
+    if (i == 0) continue;
+    if (log.tdoa[i].t_s < log.tdoa[i - 1].t_s || tdoaSame(log.tdoa[i], log.tdoa[i - 1])) return std::nullopt;
+    const double gap = log.tdoa[i].t_s - log.tdoa[i - 1].t_s;
+    rep.max_tdoa_gap_s = std::max(rep.max_tdoa_gap_s, gap);
+    rep.n_tdoa_gaps += gap > max_gap_s;
+  }
+  for (std::size_t i = 0; i < log.tof.size(); ++i)
+    if (!std::isfinite(log.tof[i].t_s) || (i > 0 && log.tof[i].t_s < log.tof[i - 1].t_s)) return std::nullopt;
+  return rep;
+}
+
 double SensorEventCursor::firstStamp() const {
   double t = std::numeric_limits<double>::infinity();
   if (n_imu_) t = std::min(t, imu_[0].t_s);

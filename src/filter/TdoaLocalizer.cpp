@@ -81,10 +81,11 @@ LocalizerResult TdoaLocalizer::run(const SensorLog& input, double output_period_
   // (F17) streams cleaned and merged; the input is copied only when it needs cleaning, and the merged sequence is
   // walked by a cursor over the clean streams instead of being stored
   SensorLog cleaned;
-  const bool input_clean = sensorLogIsClean(input);
+  const std::optional<MergeReport> clean_report = cleanSensorLogReportIfClean(input, params_.max_gap_s);
+  const bool input_clean = clean_report.has_value();
   if (!input_clean) cleaned = input;
   const SensorLog& log = input_clean ? input : cleaned;
-  sum.merge = input_clean ? cleanSensorLogReport(input, params_.max_gap_s) : cleanSensorLog(cleaned, params_.max_gap_s);
+  sum.merge = input_clean ? *clean_report : cleanSensorLog(cleaned, params_.max_gap_s);
   SensorEventCursor events(log);
   if (events.empty()) return result;
 

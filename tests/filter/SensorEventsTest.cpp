@@ -118,6 +118,17 @@ TEST(SensorEvents, CleanLogMergesInPlaceLikeTheCleaningMerge) {
   EXPECT_EQ(rep_clean.max_tdoa_gap_s, rep.max_tdoa_gap_s);
   EXPECT_EQ(rep_clean.n_tof_in, rep.n_tof_in);
   EXPECT_EQ(rep_clean.notes(), rep.notes());
+  // AND the one-pass check-and-report gives the same report
+  const std::optional<MergeReport> rep_one_pass = cleanSensorLogReportIfClean(log, 0.2);
+  ASSERT_TRUE(rep_one_pass.has_value());
+  EXPECT_EQ(rep_one_pass->n_imu_in, rep.n_imu_in);
+  EXPECT_EQ(rep_one_pass->n_tdoa_in, rep.n_tdoa_in);
+  EXPECT_EQ(rep_one_pass->n_tof_in, rep.n_tof_in);
+  EXPECT_EQ(rep_one_pass->n_imu_gaps, rep.n_imu_gaps);
+  EXPECT_EQ(rep_one_pass->n_tdoa_gaps, rep.n_tdoa_gaps);
+  EXPECT_EQ(rep_one_pass->max_imu_gap_s, rep.max_imu_gap_s);
+  EXPECT_EQ(rep_one_pass->max_tdoa_gap_s, rep.max_tdoa_gap_s);
+  EXPECT_EQ(rep_one_pass->notes(), rep.notes());
 }
 
 TEST(SensorEvents, LogsThatNeedCleaningAreNotClean) {
@@ -127,6 +138,7 @@ TEST(SensorEvents, LogsThatNeedCleaningAreNotClean) {
   clean.tdoa = {{0.0, 0, 1, 0.1}, {0.0, 1, 2, 0.1}};
   clean.tof = {{0.0, 1.0}};
   EXPECT_TRUE(sensorLogIsClean(clean));
+  EXPECT_TRUE(cleanSensorLogReportIfClean(clean, 0.2).has_value());
   SensorLog dup_imu = clean;
   dup_imu.imu[1].t_s = 0.0;
   SensorLog nan_acc = clean;
@@ -143,7 +155,10 @@ TEST(SensorEvents, LogsThatNeedCleaningAreNotClean) {
   tof_nan_stamp.tof[0].t_s = std::nan("");
   // THEN none of them is clean
   for (const SensorLog* l : {&dup_imu, &nan_acc, &inf_gyro, &dup_tdoa, &unordered_tdoa, &nan_tdoa, &tof_nan_stamp})
+  {
     EXPECT_FALSE(sensorLogIsClean(*l));
+    EXPECT_FALSE(cleanSensorLogReportIfClean(*l, 0.2).has_value());
+  }
 }
 
 }  // namespace

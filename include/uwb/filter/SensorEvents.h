@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -134,6 +135,10 @@ std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, Me
 /// True when mergeSensorStreams would leave `log` unchanged: all stamps and values finite, IMU stamps strictly
 /// increasing, TDoA stamps non-decreasing with no duplicate, ToF stamps finite and non-decreasing.
 bool sensorLogIsClean(const SensorLog& log);
+
+/// sensorLogIsClean and cleanSensorLogReport in one pass over the streams: the report when `log` is clean, nullopt
+/// otherwise.
+std::optional<MergeReport> cleanSensorLogReportIfClean(const SensorLog& log, double max_gap_s);
 
 /// mergeSensorStreams for a log that is already clean (sensorLogIsClean): the same events and report, without
 /// copying or modifying the log.
