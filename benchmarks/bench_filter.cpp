@@ -15,6 +15,11 @@
  *    whole flight, real 0425-traj2  4 218–4 869× (median 4 378×) → 4 744–5 591× (median 4 911×)
  *  callgrind, TdoaLocalizer::run on traj2: 40.0 M → 35.6 M instructions. The spread between runs on this shared
  *  machine (±5–10 %) is as large as one step of the work.
+ *  Session 3, second round (f8c2d42, 3eb7bbe, 76f6e69: G18 downdate and F7 fold axpys in full 4-wide packets, one-pass
+ *  clean check): callgrind 35.6 M → 31.6 M instructions, bit-identical results. c87c60b and 76f6e69 alternately at
+ *  load 4.2–5.5 (both vCPUs oversubscribed), CPU-time medians of 7:
+ *    whole flight, synthetic 40 s   4 630–4 851× (median 4 795×) → 4 885–5 316× (median 5 240×)
+ *    whole flight, real 0425-traj2  4 697–4 872× (median 4 785×) → 4 683–5 187× (median 5 126×)
  */
 #include <benchmark/benchmark.h>
 
