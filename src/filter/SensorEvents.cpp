@@ -91,19 +91,11 @@ std::vector<SensorEvent> collectEvents(const SensorLog& log) {
 }  // namespace
 
 bool sensorLogIsClean(const SensorLog& log) {
-  for (std::size_t i = 0; i < log.imu.size(); ++i)
-    if (imuBad(log.imu[i]) || (i > 0 && !(log.imu[i].t_s > log.imu[i - 1].t_s))) return false;
-  for (std::size_t i = 0; i < log.tdoa.size(); ++i)
-    if (tdoaBad(log.tdoa[i]) ||
-        (i > 0 && (log.tdoa[i].t_s < log.tdoa[i - 1].t_s || tdoaSame(log.tdoa[i], log.tdoa[i - 1]))))
-      return false;
-  for (std::size_t i = 0; i < log.tof.size(); ++i)
-    if (!std::isfinite(log.tof[i].t_s) || (i > 0 && log.tof[i].t_s < log.tof[i - 1].t_s)) return false;
-  return true;
+  return cleanSensorLogReportIfClean(log, std::numeric_limits<double>::infinity()).has_value();
 }
 
 std::optional<MergeReport> cleanSensorLogReportIfClean(const SensorLog& log, double max_gap_s) {
-  // sensorLogIsClean's tests and countStreamGaps' statistics, sample by sample
+  // the clean tests (what cleanSensorLog would change) and countStreamGaps' statistics, sample by sample
   MergeReport rep;
   rep.n_imu_in = log.imu.size();
   rep.n_tdoa_in = log.tdoa.size();
@@ -143,24 +135,6 @@ double SensorEventCursor::lastStamp() const {
   if (n_tdoa_) t = std::max(t, tdoa_[n_tdoa_ - 1].t_s);
   if (n_tof_) t = std::max(t, tof_[n_tof_ - 1].t_s);
   return t;
-}
-
-MergeReport cleanSensorLogReport(const SensorLog& log, double max_gap_s) {
-  MergeReport rep;
-  rep.n_imu_in = log.imu.size();
-  rep.n_tdoa_in = log.tdoa.size();
-  rep.n_tof_in = log.tof.size();
-  countStreamGaps(log, max_gap_s, rep);
-  return rep;
-}
-
-std::vector<SensorEvent> mergeCleanSensorStreams(const SensorLog& log, double max_gap_s, MergeReport* report) {
-  if (report) {
-    const std::size_t n_imu_unpaired = report->n_imu_unpaired;
-    *report = cleanSensorLogReport(log, max_gap_s);
-    report->n_imu_unpaired = n_imu_unpaired;
-  }
-  return collectEvents(log);
 }
 
 MergeReport cleanSensorLog(SensorLog& log, double max_gap_s) {

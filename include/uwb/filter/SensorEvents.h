@@ -126,9 +126,6 @@ class SensorEventCursor {
 /// sensorLogIsClean(log) holds) and returns what it found, with the gap statistics of the cleaned streams.
 MergeReport cleanSensorLog(SensorLog& log, double max_gap_s);
 
-/// cleanSensorLog's report for a log that is already clean (sensorLogIsClean): input counts and gap statistics.
-MergeReport cleanSensorLogReport(const SensorLog& log, double max_gap_s);
-
 /// Cleans `log` in place (cleanSensorLog) and returns the merged event sequence (SensorEventCursor's order).
 std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, MergeReport* report = nullptr);
 
@@ -136,13 +133,8 @@ std::vector<SensorEvent> mergeSensorStreams(SensorLog& log, double max_gap_s, Me
 /// increasing, TDoA stamps non-decreasing with no duplicate, ToF stamps finite and non-decreasing.
 bool sensorLogIsClean(const SensorLog& log);
 
-/// sensorLogIsClean and cleanSensorLogReport in one pass over the streams: the report when `log` is clean, nullopt
-/// otherwise.
+/// The clean test and cleanSensorLog's report in one pass over the streams: for a clean log (sensorLogIsClean) the
+/// report cleanSensorLog would return (input counts, gap statistics) without copying or modifying it; nullopt otherwise.
 std::optional<MergeReport> cleanSensorLogReportIfClean(const SensorLog& log, double max_gap_s);
-
-/// mergeSensorStreams for a log that is already clean (sensorLogIsClean): the same events and report, without
-/// copying or modifying the log.
-std::vector<SensorEvent> mergeCleanSensorStreams(const SensorLog& log, double max_gap_s,
-                                                 MergeReport* report = nullptr);
 
 }  // namespace uwb
