@@ -206,7 +206,7 @@ py::dict metricsDict(const TrajectoryMetrics& m) {
 py::dict summaryDict(const LocalizerSummary& s) {
   py::dict d;
   d["n_tdoa_total"] = s.n_tdoa_total, d["n_tdoa_used"] = s.n_tdoa_used, d["n_tdoa_rejected"] = s.n_tdoa_rejected;
-  d["n_tdoa_downweighted"] = s.n_tdoa_downweighted, d["n_tdoa_ground"] = s.n_tdoa_ground;
+  d["n_tdoa_downweighted"] = s.n_tdoa_downweighted, d["n_tdoa_start"] = s.n_tdoa_start, d["n_tdoa_used_at_rest"] = s.n_tdoa_used_at_rest;
   d["n_tdoa_degenerate"] = s.n_tdoa_degenerate, d["n_tdoa_unknown_anchor"] = s.n_tdoa_unknown_anchor;
   d["n_predictions"] = s.n_predictions, d["n_covariance_propagations"] = s.n_covariance_propagations;
   d["n_reacquisitions"] = s.n_reacquisitions, d["takeoff_t_s"] = s.takeoff_t_s, d["landing_t_s"] = s.landing_t_s;
@@ -214,7 +214,7 @@ py::dict summaryDict(const LocalizerSummary& s) {
   d["start_w_p_b"] = toNumpy(s.start_w_p_b, true), d["start_rms_residual_m"] = s.start_rms_residual_m;
   d["n_tof_total"] = s.n_tof_total, d["n_tof_used"] = s.n_tof_used, d["n_tof_rejected"] = s.n_tof_rejected;
   d["n_tof_invalid"] = s.n_tof_invalid, d["n_tof_tilted"] = s.n_tof_tilted;
-  d["n_tof_not_airborne"] = s.n_tof_not_airborne;
+  d["n_tof_not_ready"] = s.n_tof_not_ready;
   return d;
 }
 

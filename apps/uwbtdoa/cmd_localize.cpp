@@ -191,7 +191,16 @@ void runLocalize(const LocalizeArgs& a) {
   j["n_tdoa_used"] = s.n_tdoa_used;
   j["n_tdoa_rejected"] = s.n_tdoa_rejected;
   j["n_tdoa_downweighted"] = s.n_tdoa_downweighted;
-  j["n_tdoa_not_used_ground"] = s.n_tdoa_ground;
+  j["n_tdoa_start"] = s.n_tdoa_start;
+  j["n_tdoa_used_at_rest"] = s.n_tdoa_used_at_rest;
+  j["n_tdoa_before_imu"] = s.n_tdoa_before_imu;
+  j["n_tdoa_out_of_order"] = s.n_tdoa_out_of_order;
+  j["n_zero_velocity_updates"] = s.n_zero_velocity_updates;
+  j["n_floor_updates"] = s.n_floor_updates;
+  j["n_rest_periods"] = s.n_rest_periods;
+  j["n_time_jumps"] = s.n_time_jumps;
+  j["reacquisition_t_s"] = s.reacquisition_t_s;
+  j["ready_t_s"] = std::isnan(s.ready_t_s) ? json(nullptr) : json(s.ready_t_s);
   j["n_tdoa_degenerate"] = s.n_tdoa_degenerate;
   j["n_reacquisitions"] = s.n_reacquisitions;
   j["fuse_tof"] = params.fuse_tof;
@@ -200,7 +209,7 @@ void runLocalize(const LocalizeArgs& a) {
   j["n_tof_rejected"] = s.n_tof_rejected;
   j["n_tof_invalid"] = s.n_tof_invalid;
   j["n_tof_tilted"] = s.n_tof_tilted;
-  j["n_tof_not_airborne"] = s.n_tof_not_airborne;
+  j["n_tof_not_ready"] = s.n_tof_not_ready;
   j["takeoff_t_s"] = std::isnan(s.takeoff_t_s) ? json(nullptr) : json(s.takeoff_t_s);
   j["landing_t_s"] = std::isnan(s.landing_t_s) ? json(nullptr) : json(s.landing_t_s);
   j["start_position_m"] = {s.start_w_p_b.x(), s.start_w_p_b.y(), s.start_w_p_b.z()};
@@ -226,14 +235,16 @@ void runLocalize(const LocalizeArgs& a) {
     return;
   }
   std::cout << "flight " << a.flight << ": " << run.duration_s << " s, model " << uwb::toString(s.process_model)
-            << ", TDoA used " << s.n_tdoa_used << " / rejected " << s.n_tdoa_rejected << " / not used on ground "
-            << s.n_tdoa_ground << " of " << s.n_tdoa_total << "\n";
+            << ", TDoA used " << s.n_tdoa_used << " (at rest " << s.n_tdoa_used_at_rest << ") / rejected "
+            << s.n_tdoa_rejected << " / start-up " << s.n_tdoa_start << " of " << s.n_tdoa_total << "\n";
   if (params.fuse_tof) {
     std::cout << "ToF used " << s.n_tof_used << " / rejected " << s.n_tof_rejected << " / invalid " << s.n_tof_invalid
-              << " / tilted " << s.n_tof_tilted << " / not airborne " << s.n_tof_not_airborne << " of "
+              << " / tilted " << s.n_tof_tilted << " / before the start " << s.n_tof_not_ready << " of "
               << s.n_tof_total << (s.n_tof_total == 0 ? " (the flight has no ToF stream)" : "") << "\n";
   }
-  if (!std::isnan(s.takeoff_t_s)) std::cout << "take-off detected at " << s.takeoff_t_s << " s\n";
+  if (!std::isnan(s.ready_t_s)) std::cout << "position found at " << s.ready_t_s << " s\n";
+  if (!std::isnan(s.takeoff_t_s)) std::cout << "left rest at " << s.takeoff_t_s << " s\n";
+  for (double t_r : s.reacquisition_t_s) std::cout << "note: position re-acquired by multilateration at " << t_r << " s\n";
   for (const std::string& n : s.merge.notes()) std::cout << "note: " << n << "\n";
   if (run.metrics) {
     const auto print = [](const char* name, const uwb::PositionErrorStats& st) {

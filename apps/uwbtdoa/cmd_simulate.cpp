@@ -257,8 +257,8 @@ void run(const Options& o, CLI::App& sub) {
 
 void setup(CLI::App& sub) {
   auto o = std::make_shared<Options>();
-  sub.add_option("--trajectory", o->trajectory, "zigzag | circle | circle-sine | figure8")
-      ->check(CLI::IsMember({"zigzag", "circle", "circle-sine", "figure8"}))
+  sub.add_option("--trajectory", o->trajectory, "zigzag | circle | circle-sine | figure8 | hover")
+      ->check(CLI::IsMember({"zigzag", "circle", "circle-sine", "figure8", "hover"}))
       ->capture_default_str();
   sub.add_option("--duration", o->duration_s, "Flight duration including ground phases [s]")->capture_default_str();
   sub.add_option("--seed", o->seed, "Random seed (same seed, same flight)")->capture_default_str();

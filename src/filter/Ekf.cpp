@@ -288,12 +288,29 @@ void Ekf::inflatePosition(double sigma_m, double vel_sigma_mps) {
   P_.diagonal().segment<3>(kVel).array() += vel_sigma_mps * vel_sigma_mps;
 }
 
+void Ekf::inflateHorizontalPosition(double sigma_m, double vel_sigma_mps) {
+  P_(kPos, kPos) += sigma_m * sigma_m;
+  P_(kPos + 1, kPos + 1) += sigma_m * sigma_m;
+  P_.diagonal().segment<3>(kVel).array() += vel_sigma_mps * vel_sigma_mps;
+}
+
 void Ekf::resetPosition(const Vec3& w_p_b, double sigma_m) {
   x_.w_p_b = w_p_b;
   P_.middleRows<3>(kPos).setZero();
   P_.middleCols<3>(kPos).setZero();
   P_.block<3, 3>(kPos, kPos).diagonal().setConstant(sigma_m * sigma_m);
 }
+
+void Ekf::resetPositionVelocity(const Vec3& w_p_b, const Vec3& w_v_b, const Eigen::Matrix<double, 6, 6>& cov) {
+  static_assert(kVel == kPos + 3, "position and velocity are adjacent in the error state");
+  x_.w_p_b = w_p_b;
+  x_.w_v_b = w_v_b;
+  P_.middleRows<6>(kPos).setZero();
+  P_.middleCols<6>(kPos).setZero();
+  P_.block<6, 6>(kPos, kPos) = 0.5 * (cov + cov.transpose());
+}
+
+void Ekf::inflateThrustBias(double sigma_mps2) { P_(kAccBias + 2, kAccBias + 2) += sigma_mps2 * sigma_mps2; }
 
 void Ekf::inject(const ErrVec& dx) {
   // x ← x ⊞ δx (F8), in place: the arithmetic of boxPlus without copying the state twice

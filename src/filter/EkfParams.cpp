@@ -53,6 +53,13 @@ void EkfParams::validate() const {
   requirePositive(acquisition_tdoa_sigma_m, "acquisition_tdoa_sigma_m");
   if (!start_w_p_b.allFinite()) throw std::invalid_argument("EkfParams.start_w_p_b must be finite");
   if (!std::isfinite(ground_z_m)) throw std::invalid_argument("EkfParams.ground_z_m must be finite");
+  requireNonNegative(floor_margin_m, "floor_margin_m");
+  requirePositive(rest_tdoa_sigma_m, "rest_tdoa_sigma_m");
+  requireNonNegative(leave_rest_pos_sigma_m, "leave_rest_pos_sigma_m");
+  requirePositive(start_window_s, "start_window_s");
+  requirePositive(moving_start_vel_sigma_mps, "moving_start_vel_sigma_mps");
+  requirePositive(moving_start_att_sigma_rad, "moving_start_att_sigma_rad");
+  requireNonNegative(output_bias_sigma_m, "output_bias_sigma_m");
   requirePositive(tof_sigma_m, "tof_sigma_m");
   if (!std::isfinite(tof_offset_m)) throw std::invalid_argument("EkfParams.tof_offset_m must be finite");
   if (!std::isfinite(floor_z_m)) throw std::invalid_argument("EkfParams.floor_z_m must be finite");

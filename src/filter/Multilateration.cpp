@@ -1,31 +1,42 @@
 /** @file Multilateration.cpp
- *  @brief Robust Gauss–Newton TDoA multilateration (docs/math/filter.md F16).
+ *  @brief Robust Gauss–Newton TDoA multilateration (docs/math/filter.md F16, F16b).
  */
 #include "uwb/filter/Multilateration.h"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "uwb/model/TdoaModel.h"
 
 namespace uwb {
+namespace {
 
-std::optional<MultilaterationResult> multilaterate(const std::vector<MultilaterationSample>& samples,
-                                                   const AnchorTable& anchors, const Vec3& b_t_tag,
-                                                   const std::vector<Vec3>& initial_guesses, double huber_k_m,
-                                                   int max_iterations) {
-  if (samples.size() < 4) return std::nullopt;
+/// Huber-IRLS Gauss–Newton over N unknowns: N = 3 solves p0 (F16), N = 6 solves (p0, v0) with the body at
+/// p0 + v0 (t_i − t_ref) + d_i (F16b). The one implementation of both.
+/// fixed_z (N = 3 only): the body origin's height is known (on the floor), the solve is over x and y (F16c).
+template <int N>
+std::optional<MultilaterationResult> solve(const std::vector<MultilaterationSample>& samples, const AnchorTable& anchors,
+                                           const Vec3& b_t_tag, const std::vector<Vec3>& initial_guesses,
+                                           double t_ref_s, double huber_k_m, int max_iterations,
+                                           std::optional<double> fixed_z = std::nullopt) {
+  using MatN = Eigen::Matrix<double, N, N>;
+  using VecN = Eigen::Matrix<double, N, 1>;
+  constexpr std::size_t kMinUsed = N == 3 ? 4 : 8;
+  if (samples.size() < kMinUsed) return std::nullopt;
   std::optional<MultilaterationResult> best;
   double best_cost = std::numeric_limits<double>::infinity();
   for (const Vec3& guess : initial_guesses) {
-    Vec3 p0 = guess;
+    VecN x = VecN::Zero();
+    x.template head<3>() = guess;
+    if (fixed_z) x(2) = *fixed_z;
     MultilaterationResult res;
     double cost = 0.0;
-    Mat3 A = Mat3::Zero();
+    MatN A = MatN::Zero();
     for (int it = 0; it < max_iterations; ++it) {
       A.setZero();
-      Vec3 g = Vec3::Zero();
+      VecN g = VecN::Zero();
       cost = 0.0;
       double wr2 = 0.0, wsum = 0.0;
       std::size_t n = 0;
@@ -33,42 +44,98 @@ std::optional<MultilaterationResult> multilaterate(const std::vector<Multilatera
         const Moments3* a = anchors.find(s.z.id_a);
         const Moments3* b = anchors.find(s.z.id_b);
         if (!a || !b) continue;
+        const double dt = s.z.t_s - t_ref_s;
+        Vec3 w_p = x.template head<3>() + s.w_d_b;
+        if constexpr (N == 6) w_p += dt * x.template tail<3>();
         TdoaJacobians J;
-        const std::optional<double> h = evaluateTdoa(p0 + s.w_d_b, s.w_q_b, a->m, b->m, {b_t_tag, 1e-6}, &J);
+        const std::optional<double> h = evaluateTdoa(w_p, s.w_q_b, a->m, b->m, {b_t_tag, 1e-6}, &J);
         if (!h) continue;
-        // (F16) r = z − h(p0 + d_i); Huber weight on |r|
+        // (F16) r = z − h(p_i); Huber weight on |r|. ∂h/∂v0 = (t_i − t_ref) ∂h/∂p (F16b).
         const double r = s.z.tdoa_m - *h;
         const double ar = std::abs(r);
         const double w = ar <= huber_k_m ? 1.0 : huber_k_m / ar;
         cost += ar <= huber_k_m ? 0.5 * r * r : huber_k_m * (ar - 0.5 * huber_k_m);
-        A.noalias() += w * J.J_z_p_b.transpose() * J.J_z_p_b;
-        g.noalias() += w * J.J_z_p_b.transpose() * r;
+        Eigen::Matrix<double, 1, N> row;
+        row.template head<3>() = J.J_z_p_b;
+        if constexpr (N == 6) row.template tail<3>() = dt * J.J_z_p_b;
+        A.noalias() += w * row.transpose() * row;
+        g.noalias() += w * row.transpose() * r;
         wr2 += w * r * r;
         wsum += w;
         ++n;
       }
-      if (n < 4) break;
-      const Eigen::LDLT<Mat3> ldlt(A + 1e-9 * Mat3::Identity());
-      const Vec3 step = ldlt.solve(g);
+      if (n < kMinUsed) break;
+      if (fixed_z) {
+        // (F16c) z is not an unknown: its row and column become the identity, its step zero
+        A.row(2).setZero();
+        A.col(2).setZero();
+        A(2, 2) = 1.0;
+        g(2) = 0.0;
+      }
+      const Eigen::LDLT<MatN> ldlt(A + 1e-9 * MatN::Identity());
+      VecN step = ldlt.solve(g);
       if (!step.allFinite()) break;
       // limit the step: TDoA geometry can be strongly nonlinear far from the anchors' hull
-      const double sn = step.norm();
-      p0 += sn > 2.0 ? (2.0 / sn) * step : step;
+      const double sn = step.template head<3>().norm();
+      if (sn > 2.0) step.template head<3>() *= 2.0 / sn;
+      if constexpr (N == 6) {
+        const double vn = step.template tail<3>().norm();
+        if (vn > 2.0) step.template tail<3>() *= 2.0 / vn;
+      }
+      x += step;
       res.iterations = it + 1;
       res.n_used = n;
       res.rms_residual_m = std::sqrt(wr2 / std::max(wsum, 1e-12));
-      if (sn < 1e-5) break;
+      if (step.norm() < 1e-5) break;
     }
-    if (res.n_used < 4 || !p0.allFinite()) continue;
+    if (res.n_used < kMinUsed || !x.allFinite()) continue;
     if (cost < best_cost) {
       best_cost = cost;
-      res.w_p0 = p0;
-      const Mat3 Ainv = (A + 1e-9 * Mat3::Identity()).inverse();
-      res.covariance = Ainv * res.rms_residual_m * res.rms_residual_m;
+      res.w_p0 = x.template head<3>();
+      const MatN Ainv = (A + 1e-9 * MatN::Identity()).inverse() * (res.rms_residual_m * res.rms_residual_m);
+      res.covariance = Ainv.template topLeftCorner<3, 3>();
+      if constexpr (N == 6) {
+        res.w_v0 = x.template tail<3>();
+        res.covariance_pv = Ainv;
+      }
       best = res;
     }
   }
   return best;
+}
+
+}  // namespace
+
+std::optional<MultilaterationResult> multilaterate(const std::vector<MultilaterationSample>& samples,
+                                                   const AnchorTable& anchors, const Vec3& b_t_tag,
+                                                   const std::vector<Vec3>& initial_guesses, double huber_k_m,
+                                                   int max_iterations) {
+  return solve<3>(samples, anchors, b_t_tag, initial_guesses, 0.0, huber_k_m, max_iterations);
+}
+
+std::optional<MultilaterationResult> multilaterateOnFloor(const std::vector<MultilaterationSample>& samples,
+                                                          const AnchorTable& anchors, const Vec3& b_t_tag,
+                                                          const std::vector<Vec3>& initial_guesses, double floor_z_m,
+                                                          double huber_k_m, int max_iterations) {
+  std::optional<MultilaterationResult> r =
+      solve<3>(samples, anchors, b_t_tag, initial_guesses, 0.0, huber_k_m, max_iterations, floor_z_m);
+  if (r) {
+    r->covariance.row(2).setZero();
+    r->covariance.col(2).setZero();
+  }
+  return r;
+}
+
+std::optional<MultilaterationResult> multilaterateMoving(const std::vector<MultilaterationSample>& samples,
+                                                         const AnchorTable& anchors, const Vec3& b_t_tag,
+                                                         const std::vector<Vec3>& initial_guesses, double t_ref_s,
+                                                         double huber_k_m, int max_iterations) {
+  if (samples.empty()) return std::nullopt;
+  const auto [lo, hi] = std::minmax_element(samples.begin(), samples.end(), [](const auto& a, const auto& b) {
+    return a.z.t_s < b.z.t_s;
+  });
+  if (hi->z.t_s - lo->z.t_s < 0.1) return std::nullopt;
+  return solve<6>(samples, anchors, b_t_tag, initial_guesses, t_ref_s, huber_k_m, max_iterations);
 }
 
 }  // namespace uwb

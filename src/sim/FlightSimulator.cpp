@@ -86,8 +86,9 @@ SimResult simulateFlight(const Scenario& scenario, const SimParams& params, std:
     for (std::size_t k = 0; k < n; ++k) {
       const double t = static_cast<double>(k) * dt;
       const KinematicState s = kinematicState(trajectory, t);
-      const Vec3 acc_noise = ip.acc_noise_std_mps2 * randn3();
-      const Vec3 gyro_noise = ip.gyro_noise_std_rps * randn3();
+      // (S10) rotor vibration only while flying; the draws are the same either way (one rng sequence)
+      const Vec3 acc_noise = (s.on_ground ? ip.rest_acc_noise_std_mps2 : ip.acc_noise_std_mps2) * randn3();
+      const Vec3 gyro_noise = (s.on_ground ? ip.rest_gyro_noise_std_rps : ip.gyro_noise_std_rps) * randn3();
       flight.acc.push_back({t, s.b_specific_force + b_acc + acc_noise});
       flight.gyro.push_back({t, s.b_omega + b_gyro + gyro_noise});
       out.imu_truth.push_back({s.b_specific_force, s.b_omega, b_acc, b_gyro});

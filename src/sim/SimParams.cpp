@@ -22,6 +22,8 @@ void ImuParams::validate() const {
   require(finiteNonNegative(gyro_noise_std_rps) && finiteNonNegative(gyro_bias_std_rps) &&
               finiteNonNegative(gyro_bias_rw_rps_sqrt_s),
           "imu gyroscope magnitudes must be >= 0");
+  require(finiteNonNegative(rest_acc_noise_std_mps2) && finiteNonNegative(rest_gyro_noise_std_rps),
+          "imu rest noise magnitudes must be >= 0");
 }
 
 void PoseParams::validate() const {
@@ -50,6 +52,8 @@ SimParams SimParams::noiseFree() {
   p.imu.acc_bias_std_mps2 = 0.0;
   p.imu.acc_bias_rw_mps2_sqrt_s = 0.0;
   p.imu.gyro_noise_std_rps = 0.0;
+  p.imu.rest_acc_noise_std_mps2 = 0.0;
+  p.imu.rest_gyro_noise_std_rps = 0.0;
   p.imu.gyro_bias_std_rps = 0.0;
   p.imu.gyro_bias_rw_rps_sqrt_s = 0.0;
   p.pose.position_quantum_m = 0.0;

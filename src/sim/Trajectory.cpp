@@ -32,8 +32,9 @@ TrajectoryShape parseTrajectoryShape(std::string_view name) {
   if (name == "circle") return TrajectoryShape::kCircle;
   if (name == "circle-sine") return TrajectoryShape::kCircleSine;
   if (name == "figure8") return TrajectoryShape::kFigureEight;
+  if (name == "hover") return TrajectoryShape::kHover;
   throw std::invalid_argument("unknown trajectory '" + std::string(name) +
-                              "' (expected zigzag, circle, circle-sine or figure8)");
+                              "' (expected zigzag, circle, circle-sine, figure8 or hover)");
 }
 
 std::string toString(TrajectoryShape shape) {
@@ -42,6 +43,7 @@ std::string toString(TrajectoryShape shape) {
     case TrajectoryShape::kCircle: return "circle";
     case TrajectoryShape::kCircleSine: return "circle-sine";
     case TrajectoryShape::kFigureEight: return "figure8";
+    case TrajectoryShape::kHover: return "hover";
   }
   return "?";
 }
@@ -100,6 +102,9 @@ Trajectory::Trajectory(const TrajectoryParams& params) : params_(params) {
       if (p.shape == TrajectoryShape::kCircleSine) {
         z.terms[0] = {p.sine_amplitude_m, p.sine_omega_ratio * p.omega_rps, 0.0};  // UTIL: 0.5 sin(0.5 ω t)
       }
+      break;
+    case TrajectoryShape::kHover:  // still at (cx, cy, height): every term zero
+      z.offset = p.height_m;
       break;
     case TrajectoryShape::kFigureEight:
       // lemniscate of Gerono: x = L sin(ω s), y = W sin(2 ω s)

@@ -87,11 +87,19 @@ class Ekf {
   void positionUpdate(int axis, double value_m, double sigma_m);
   /// Adds sigma² to the position (and optionally velocity) variances: used on re-acquisition.
   void inflatePosition(double sigma_m, double vel_sigma_mps);
+  /// Adds sigma² to the x and y position variances and vel_sigma² to the velocity variances.
+  void inflateHorizontalPosition(double sigma_m, double vel_sigma_mps);
   /// Overwrites the position; keeps other state; sets the position block of P to sigma² I, clears its correlations.
   void resetPosition(const Vec3& w_p_b, double sigma_m);
 
+  /// Overwrites position and velocity with a joint Gaussian (mean w_p_b, w_v_b; covariance Σ over (δp, δv)); keeps the
+  /// other states and clears the position/velocity correlations with them (F16b).
+  void resetPositionVelocity(const Vec3& w_p_b, const Vec3& w_v_b, const Eigen::Matrix<double, 6, 6>& cov);
   /// Switches how the accelerometer enters the prediction (e.g. full on the ground, thrust-only in flight).
   void setAccelModel(AccelModel model) { params_.accel_model = model; }
+  AccelModel accelModel() const { return params_.accel_model; }
+  /// Adds sigma² to the thrust-axis (body z) accelerometer-bias variance (F20).
+  void inflateThrustBias(double sigma_mps2);
 
   /// Folds an error-state estimate into the nominal state (F8): x ← x ⊞ δx. (P is kept; the first-order
   /// attitude reset Jacobian is the identity up to O(|δθ|).)

@@ -104,7 +104,23 @@ struct EkfParams {
   double acquisition_tdoa_sigma_m = 0.6; ///< TDoA std used during acquisition
   bool has_start_position = false;       ///< true: start at start_w_p_b instead of multilateration
   Vec3 start_w_p_b = Vec3::Zero();       ///< user-given start (body origin, world) [m]
-  double ground_z_m = 0.0;               ///< floor height for the pre-take-off height prior [m]
+  double ground_z_m = 0.0;               ///< floor height (world z of the body origin at rest on the floor) [m]
+  /// The body cannot be below the floor: an estimate with z < ground_z_m − floor_margin_m is pulled back by a
+  /// position update z = ground_z_m (F22). Off for rooms whose floor height in the anchor frame is unknown.
+  bool floor_constraint = true;
+  double floor_margin_m = 0.05;          ///< tolerance below ground_z_m before the floor constraint acts [m]
+  /// TDoA std while the IMU says the body is at rest (F14, F18): near the floor the TDoA bias is large and
+  /// correlated, so rest TDoA keep the position without pinning it; a moving body returns to tdoa_sigma_m at once.
+  double rest_tdoa_sigma_m = 1.0;
+  /// Position std added when the body leaves rest (F20): the floor-level TDoA bias the rest position absorbed is not
+  /// the bias in the air.
+  double leave_rest_pos_sigma_m = 0.2;
+  double start_window_s = 0.6;           ///< multilateration window of the start / re-acquisition [s] (F16)
+  double moving_start_vel_sigma_mps = 1.0;  ///< velocity std when the IMU starts while moving (in the air) [m/s]
+  double moving_start_att_sigma_rad = 0.1;  ///< roll/pitch std when the IMU starts while moving [rad]
+  /// Std of the slowly varying TDoA bias as seen in the position (F23): the reported position covariance is the
+  /// filter's plus this bias term mapped through the current anchor geometry. 0 reports the filter's P alone.
+  double output_bias_sigma_m = 0.2;
 
   // --- downward ToF range (Flow deck VL53L1x), docs/math/filter.md F21 ---
   /// Fuse the ToF range as a height update while airborne (off by default: the published numbers are without).

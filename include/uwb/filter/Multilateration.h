@@ -21,6 +21,8 @@ struct MultilaterationSample {
 
 struct MultilaterationResult {
   Vec3 w_p0 = Vec3::Zero();         ///< body origin at the reference instant [m]
+  Vec3 w_v0 = Vec3::Zero();         ///< body velocity at the reference instant [m/s] (multilaterateMoving only)
+  Eigen::Matrix<double, 6, 6> covariance_pv = Eigen::Matrix<double, 6, 6>::Identity();  ///< joint (p0, v0) covariance [m², m²/s] (multilaterateMoving only)
   Mat3 covariance = Mat3::Identity();  ///< (JᵀWJ)⁻¹ σ̂² [m²]
   double rms_residual_m = 0.0;      ///< robustly weighted RMS residual
   int iterations = 0;
@@ -33,5 +35,21 @@ std::optional<MultilaterationResult> multilaterate(const std::vector<Multilatera
                                                    const AnchorTable& anchors, const Vec3& b_t_tag,
                                                    const std::vector<Vec3>& initial_guesses,
                                                    double huber_k_m = 0.3, int max_iterations = 30);
+
+/// (F16c) multilaterate() for a body known to sit on the floor: the body origin's height is floor_z_m, the solve is
+/// over x and y (the TDoA bias near the floor is largest along z). `covariance` has zero z row and column.
+std::optional<MultilaterationResult> multilaterateOnFloor(const std::vector<MultilaterationSample>& samples,
+                                                          const AnchorTable& anchors, const Vec3& b_t_tag,
+                                                          const std::vector<Vec3>& initial_guesses, double floor_z_m,
+                                                          double huber_k_m = 0.3, int max_iterations = 30);
+
+/// (F16b) The same robust solve for a body that moves at an unknown constant velocity on top of the known displacements:
+/// the body was at p0 + v0 (t_i − t_ref) + d_i. Unknowns p0 and v0 (6), so a start in the air with unknown velocity
+/// needs no ground phase. `covariance` holds the p0 block of covariance_pv. nullopt when fewer than 8 usable samples,
+/// the samples span less than 0.1 s, or no start converges.
+std::optional<MultilaterationResult> multilaterateMoving(const std::vector<MultilaterationSample>& samples,
+                                                         const AnchorTable& anchors, const Vec3& b_t_tag,
+                                                         const std::vector<Vec3>& initial_guesses, double t_ref_s,
+                                                         double huber_k_m = 0.3, int max_iterations = 30);
 
 }  // namespace uwb

@@ -22,6 +22,10 @@ struct ImuParams {
   double gyro_noise_std_rps = 0.005;       ///< white noise per sample [rad/s] (≈ 0.29 deg/s)
   double gyro_bias_std_rps = 0.0087;       ///< turn-on bias per axis [rad/s] (≈ 0.5 deg/s)
   double gyro_bias_rw_rps_sqrt_s = 1e-4;   ///< bias random walk [rad/s / √s]
+  /// White noise while the drone sits on the ground with the motors off (no rotor vibration): the Crazyflie's
+  /// accelerometer then shows ≈ 0.003 g per sample (util-pilot, first second of every flight) [m/s²], [rad/s].
+  double rest_acc_noise_std_mps2 = 0.03;
+  double rest_gyro_noise_std_rps = 0.001;
   void validate() const;
 };
 

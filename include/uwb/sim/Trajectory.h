@@ -16,9 +16,9 @@
 
 namespace uwb::sim {
 
-enum class TrajectoryShape { kZigzag, kCircle, kCircleSine, kFigureEight };
+enum class TrajectoryShape { kZigzag, kCircle, kCircleSine, kFigureEight, kHover };
 
-/// "zigzag" | "circle" | "circle-sine" | "figure8"; throws std::invalid_argument otherwise.
+/// "zigzag" | "circle" | "circle-sine" | "figure8" | "hover" (still at the pattern centre, height_m); throws std::invalid_argument otherwise.
 TrajectoryShape parseTrajectoryShape(std::string_view name);
 std::string toString(TrajectoryShape shape);
 

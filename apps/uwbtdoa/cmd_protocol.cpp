@@ -1,0 +1,390 @@
+/** @file cmd_protocol.cpp
+ *  @brief `uwbtdoa protocol`: the generalization protocol. Every real development flight localized whole and cut
+ *         to start in the air (at 5, 10, 20 s) and to end before landing; simulated scenarios that real data cannot
+ *         show (start in hover, long still hover, two take-offs, fast flight; several seeds, anchor layouts and
+ *         bias fields); per-session medians for leave-one-session-out checks; per-axis σ coverage. Prints Markdown
+ *         tables (or one JSON object with --json).
+ */
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "Command.h"
+#include "ProtocolScenarios.h"
+#include "uwb/core/Error.h"
+#include "uwb/eval/EstimateChecks.h"
+#include "uwb/eval/Localization.h"
+#include "uwb/io/FlightWindow.h"
+#include "uwb/io/PoseTrack.h"
+#include "uwb/io/UtilCsv.h"
+
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+struct ProtocolArgs {
+  std::string data_dir;
+  std::vector<double> cuts{5.0, 10.0, 20.0};
+  std::vector<std::string> sets;
+  bool json_out = false, no_real = false, no_sim = false, no_cuts = false;
+  std::string only;
+};
+
+struct RealFlight {
+  std::string name, session, path, survey;
+};
+
+std::vector<RealFlight> realFlights(const std::string& data_dir) {
+  std::vector<RealFlight> out;
+  const std::string pilot = data_dir + "/real/util-pilot";
+  const std::string extract = data_dir + "/real/util-final-extract";
+  for (int i = 1; i <= 12; ++i)
+    out.push_back({"0425-traj" + std::to_string(i), "0425", pilot + "/0425/0425-traj" + std::to_string(i) + ".csv",
+                   pilot + "/survey/anchor_0425_survey.txt"});
+  for (int i : {1, 2, 11, 12})
+    out.push_back({"0426-traj" + std::to_string(i), "0426", pilot + "/0426/0426-traj" + std::to_string(i) + ".csv",
+                   pilot + "/survey/anchor_0426_survey.txt"});
+  for (const char* trial : {"trial1", "trial2"})
+    for (int j = 1; j <= 3; ++j) {
+      const std::string n = std::string("const4-") + trial + "-tdoa2-traj" + std::to_string(j);
+      out.push_back({n, "const4", extract + "/" + n + ".csv", extract + "/survey/anchor_const4_survey.txt"});
+    }
+  return out;
+}
+
+/// Applies --set name=value overrides (the numeric filter parameters the protocol is used to choose).
+void applySet(const std::string& kv, uwb::EkfParams& p) {
+  const auto eq = kv.find('=');
+  if (eq == std::string::npos) throw std::invalid_argument("--set: expected name=value, got '" + kv + "'");
+  const std::string name = kv.substr(0, eq);
+  double v = 0.0;
+  try {
+    std::size_t used = 0;
+    v = std::stod(kv.substr(eq + 1), &used);
+    if (used != kv.size() - eq - 1) throw std::invalid_argument("trailing characters");
+  } catch (const std::exception&) {
+    throw std::invalid_argument("--set " + name + ": '" + kv.substr(eq + 1) + "' is not a number");
+  }
+  const std::map<std::string, double*> fields = {
+      {"tdoa_sigma_m", &p.tdoa_sigma_m},
+      {"rest_tdoa_sigma_m", &p.rest_tdoa_sigma_m},
+      {"leave_rest_pos_sigma_m", &p.leave_rest_pos_sigma_m},
+      {"output_bias_sigma_m", &p.output_bias_sigma_m},
+      {"acquisition_tdoa_sigma_m", &p.acquisition_tdoa_sigma_m},
+      {"acquisition_s", &p.acquisition_s},
+      {"start_window_s", &p.start_window_s},
+      {"gate_sigma", &p.gate_sigma},
+      {"robust_k", &p.robust_k},
+      {"pos_noise_m_sqrts", &p.pos_noise_m_sqrts},
+      {"acc_noise_mps2_sqrthz", &p.acc_noise_mps2_sqrthz},
+      {"lateral_acc_noise_mps2_sqrthz", &p.lateral_acc_noise_mps2_sqrthz},
+      {"moving_start_vel_sigma_mps", &p.moving_start_vel_sigma_mps},
+      {"moving_start_att_sigma_rad", &p.moving_start_att_sigma_rad},
+      {"takeoff_acc_bias_sigma_mps2", &p.takeoff_acc_bias_sigma_mps2},
+      {"init_yaw_sigma_rad", &p.init_yaw_sigma_rad},
+      {"max_lost_s", &p.max_lost_s},
+  };
+  const auto it = fields.find(name);
+  if (it == fields.end()) throw std::invalid_argument("--set: unknown parameter '" + name + "'");
+  *it->second = v;
+}
+
+double median(std::vector<double> v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+double maxOf(const std::vector<double>& v) {
+  double m = std::nan("");
+  for (double x : v)
+    if (std::isfinite(x)) m = std::isnan(m) ? x : std::max(m, x);
+  return m;
+}
+
+/// RMSE of the airborne samples of `m` within [t0, t1].
+double windowRmse(const uwb::TrajectoryMetrics& m, double t0, double t1, std::size_t* n_out = nullptr) {
+  double s = 0.0;
+  std::size_t n = 0;
+  for (const uwb::PositionErrorSample& e : m.samples)
+    if (e.airborne && e.t_s >= t0 && e.t_s <= t1) {
+      s += e.error_norm_m * e.error_norm_m;
+      ++n;
+    }
+  if (n_out) *n_out = n;
+  return n ? std::sqrt(s / n) : std::nan("");
+}
+
+struct Row {
+  std::string name, session, kind;
+  double t0 = 0.0, t1 = 0.0;
+  double rmse_air = std::nan(""), rmse_ref = std::nan(""), max_err = std::nan(""), max_err_air = std::nan("");
+  double step = std::nan(""), zmin = std::nan(""), zmax = std::nan(""), settle = std::nan(""), err3 = std::nan("");
+  uwb::Vec3 cov1 = uwb::Vec3::Constant(std::nan("")), cov2 = uwb::Vec3::Constant(std::nan(""));
+  double used_frac = std::nan("");
+  bool violated = false;
+  std::size_t reacq = 0;
+};
+
+Row evaluateRun(const uwb::LocalizationRun& run, const std::string& name, const std::string& session,
+                const std::string& kind, const uwb::EstimateCheckParams& cp) {
+  Row r;
+  r.name = name;
+  r.session = session;
+  r.kind = kind;
+  r.reacq = run.summary.n_reacquisitions;
+  const std::size_t n_tdoa = run.summary.n_tdoa_total;
+  r.used_frac = n_tdoa ? static_cast<double>(run.summary.n_tdoa_used + run.summary.n_tdoa_rejected +
+                                             run.summary.n_tdoa_start) /
+                             static_cast<double>(n_tdoa)
+                       : std::nan("");
+  if (!run.metrics) return r;
+  const uwb::TrajectoryMetrics& m = *run.metrics;
+  r.rmse_air = m.airborne.n ? m.airborne.rmse_m : std::nan("");
+  r.max_err = m.whole.max_m;
+  r.max_err_air = m.airborne.max_m;
+  const uwb::EstimateChecks c = uwb::checkEstimate(run.trajectory, m, cp);
+  r.step = c.max_airborne_step_m;
+  r.zmin = c.min_z_on_ground_m;
+  r.zmax = c.max_z_on_ground_m;
+  r.settle = c.settle_time_s;
+  r.err3 = c.max_error_after_3s_m;
+  r.cov1 = c.coverage_1sigma;
+  r.cov2 = c.coverage_2sigma;
+  r.violated = c.floor_or_ceiling_violated;
+  return r;
+}
+
+std::string fmt3(double v) {
+  if (!std::isfinite(v)) return "–";
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3f", v);
+  return b;
+}
+std::string fmt2(double v) {
+  if (!std::isfinite(v)) return "–";
+  char b[32];
+  std::snprintf(b, sizeof b, "%.2f", v);
+  return b;
+}
+std::string pct(double v) {
+  if (!std::isfinite(v)) return "–";
+  char b[32];
+  std::snprintf(b, sizeof b, "%.0f", 100.0 * v);
+  return b;
+}
+
+json rowJson(const Row& r) {
+  auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  return {{"name", r.name},
+          {"session", r.session},
+          {"kind", r.kind},
+          {"t0_s", r.t0},
+          {"t1_s", r.t1},
+          {"rmse_airborne_m", num(r.rmse_air)},
+          {"rmse_full_flight_same_window_m", num(r.rmse_ref)},
+          {"max_error_m", num(r.max_err)},
+          {"max_error_airborne_m", num(r.max_err_air)},
+          {"max_airborne_step_m", num(r.step)},
+          {"min_z_on_ground_m", num(r.zmin)},
+          {"max_z_on_ground_m", num(r.zmax)},
+          {"settle_time_s", num(r.settle)},
+          {"max_error_after_3s_m", num(r.err3)},
+          {"coverage_1sigma_xyz", {num(r.cov1.x()), num(r.cov1.y()), num(r.cov1.z())}},
+          {"coverage_2sigma_xyz", {num(r.cov2.x()), num(r.cov2.y()), num(r.cov2.z())}},
+          {"tdoa_used_or_gated_fraction", num(r.used_frac)},
+          {"floor_or_ceiling_violated", r.violated},
+          {"n_reacquisitions", r.reacq}};
+}
+
+void printTable(const std::string& title, const std::vector<Row>& rows, bool cuts) {
+  std::cout << "\n### " << title << "\n\n";
+  if (cuts) {
+    std::cout << "| flight | kind | window [s] | RMSE air [m] | full flight, same window [m] | max err after 3 s [m] | "
+                 "settle [s] | max step [m] | reacq |\n|---|---|---|---|---|---|---|---|---|\n";
+    for (const Row& r : rows)
+      std::cout << "| " << r.name << " | " << r.kind << " | " << fmt2(r.t0) << "–" << fmt2(r.t1) << " | "
+                << fmt3(r.rmse_air) << " | " << fmt3(r.rmse_ref) << " | " << fmt3(r.err3) << " | " << fmt2(r.settle)
+                << " | " << fmt3(r.step) << " | " << r.reacq << " |\n";
+    return;
+  }
+  std::cout << "| flight | RMSE air [m] | max err [m] | max err air [m] | max step air [m] | z on ground after "
+               "flight [m] | 1σ cov x/y/z [%] | 2σ cov x/y/z [%] | TDoA used+gated [%] | reacq |\n"
+               "|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const Row& r : rows)
+    std::cout << "| " << r.name << " | " << fmt3(r.rmse_air) << " | " << fmt3(r.max_err) << " | "
+              << fmt3(r.max_err_air) << " | " << fmt3(r.step) << " | " << fmt2(r.zmin) << "…" << fmt2(r.zmax)
+              << (r.violated ? " (!)" : "") << " | " << pct(r.cov1.x()) << "/" << pct(r.cov1.y()) << "/"
+              << pct(r.cov1.z()) << " | " << pct(r.cov2.x()) << "/" << pct(r.cov2.y()) << "/" << pct(r.cov2.z())
+              << " | " << pct(r.used_frac) << " | " << r.reacq << " |\n";
+}
+
+json summarize(const std::vector<Row>& rows, const std::string& label, bool print) {
+  std::map<std::string, std::vector<const Row*>> by_session;
+  for (const Row& r : rows) by_session[r.session].push_back(&r);
+  by_session["all"];
+  for (const Row& r : rows) by_session["all"].push_back(&r);
+  json out = json::object();
+  if (print)
+    std::cout << "\n" << label << " — per session: median / worst airborne RMSE [m], worst max step [m], median 1σ "
+              << "coverage x/y/z [%], median 2σ coverage x/y/z [%]\n\n| session | n | median | worst | worst step | "
+              << "1σ cov | 2σ cov |\n|---|---|---|---|---|---|---|\n";
+  for (const auto& [session, rs] : by_session) {
+    std::vector<double> rm, st, c1[3], c2[3];
+    for (const Row* r : rs) {
+      rm.push_back(r->rmse_air);
+      st.push_back(r->step);
+      for (int k = 0; k < 3; ++k) {
+        c1[k].push_back(r->cov1(k));
+        c2[k].push_back(r->cov2(k));
+      }
+    }
+    out[session] = {{"n", rs.size()}, {"median_rmse_m", median(rm)}, {"worst_rmse_m", maxOf(rm)},
+                    {"worst_step_m", maxOf(st)}};
+    if (print)
+      std::cout << "| " << session << " | " << rs.size() << " | " << fmt3(median(rm)) << " | " << fmt3(maxOf(rm))
+                << " | " << fmt3(maxOf(st)) << " | " << pct(median(c1[0])) << "/" << pct(median(c1[1])) << "/"
+                << pct(median(c1[2])) << " | " << pct(median(c2[0])) << "/" << pct(median(c2[1])) << "/"
+                << pct(median(c2[2])) << " |\n";
+  }
+  return out;
+}
+
+void runProtocol(const ProtocolArgs& a) {
+  uwb::EkfParams params;
+  for (const std::string& kv : a.sets) applySet(kv, params);
+  params.validate();
+  uwb::LocalizationOptions opt;
+  opt.params = params;
+  json j;
+  std::vector<Row> full_rows, cut_rows, sim_rows, sim_cut_rows;
+
+  if (!a.no_real) {
+    const std::string data = a.data_dir.empty() ? uwb::app::defaultDataDir() : a.data_dir;
+    if (!fs::is_directory(data + "/real"))
+      throw uwb::FileError("protocol: no real data under '" + data + "/real' (set --data or $UWBTDOA_DATA)");
+    for (const RealFlight& f : realFlights(data)) {
+      if (!a.only.empty() && f.name.find(a.only) == std::string::npos) continue;
+      if (!fs::is_regular_file(f.path)) {
+        std::cerr << "protocol: missing " << f.path << ", skipped\n";
+        continue;
+      }
+      const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(f.survey);
+      uwb::FlightReadOptions ro;
+      ro.required = {uwb::Stream::kTdoa};
+      ro.survey = &survey;
+      const uwb::Flight flight = uwb::readFlightCsv(f.path, ro);
+      uwb::EstimateCheckParams cp;
+      cp.floor_z_m = params.ground_z_m;
+      cp.ceiling_z_m = -1e300;
+      for (const uwb::Anchor& an : survey.anchors) cp.ceiling_z_m = std::max(cp.ceiling_z_m, an.w_p.z());
+      const uwb::LocalizationRun full = uwb::localizeFlight(flight, survey, opt);
+      full_rows.push_back(evaluateRun(full, f.name, f.session, flight.hasImu() ? "full" : "full (TDoA only)", cp));
+      std::cerr << "protocol: " << f.name << " full " << fmt3(full_rows.back().rmse_air) << " m\n";
+      if (a.no_cuts || !full.metrics || !flight.hasImu()) continue;
+      // the airborne span of the truth; cut logs end 1 s before the last airborne instant (mid-air)
+      double t_air_end = -1.0;
+      for (const uwb::PositionErrorSample& s : full.metrics->samples)
+        if (s.airborne) t_air_end = s.t_s;
+      for (double t0 : a.cuts) {
+        const double t1 = t_air_end - 1.0;
+        if (!(t1 > t0 + 5.0)) continue;
+        const uwb::Flight cut = uwb::sliceFlight(flight, t0, t1);
+        const uwb::LocalizationRun run = uwb::localizeFlight(cut, survey, opt);
+        Row r = evaluateRun(run, f.name, f.session, "cut at " + fmt2(t0).substr(0, fmt2(t0).size() - 3) + " s", cp);
+        r.t0 = t0;
+        r.t1 = t1;
+        if (run.metrics) r.rmse_air = windowRmse(*run.metrics, t0, t1);
+        r.rmse_ref = windowRmse(*full.metrics, t0, t1);
+        cut_rows.push_back(r);
+      }
+    }
+  }
+  if (!a.no_sim) {
+    for (const uwb::app::SimScenarioRun& s : uwb::app::protocolSimulations()) {
+      uwb::EstimateCheckParams cp;
+      cp.floor_z_m = params.ground_z_m;
+      cp.ceiling_z_m = -1e300;
+      for (const uwb::Anchor& an : s.survey.anchors) cp.ceiling_z_m = std::max(cp.ceiling_z_m, an.w_p.z());
+      const uwb::LocalizationRun run = uwb::localizeFlight(s.flight, s.survey, opt);
+      Row r = evaluateRun(run, s.name, s.group, s.kind, cp);
+      std::cerr << "protocol: " << s.name << " " << fmt3(r.rmse_air) << " m\n";
+      if (s.cut) {
+        r.t0 = s.flight.timeSpan().first;
+        r.t1 = s.flight.timeSpan().second;
+        sim_cut_rows.push_back(r);
+      } else {
+        sim_rows.push_back(r);
+      }
+    }
+  }
+
+  if (!a.json_out) {
+    std::cout << "## Generalization protocol\n\nFilter parameters: defaults";
+    for (const std::string& kv : a.sets) std::cout << ", " << kv;
+    std::cout << ". Airborne: ground-truth z > 0.3 m. Coverage: fraction of airborne samples whose per-axis error "
+                 "is within the reported 1σ / 2σ.\n";
+    if (!full_rows.empty()) {
+      printTable("Real flights, whole", full_rows, false);
+      summarize(full_rows, "Whole real flights", true);
+    }
+    if (!cut_rows.empty()) {
+      printTable("Real flights cut to start in the air and end before landing", cut_rows, true);
+      for (double t0 : a.cuts) {
+        std::vector<Row> sel;
+        for (const Row& r : cut_rows)
+          if (r.t0 == t0) sel.push_back(r);
+        if (sel.empty()) continue;
+        std::vector<double> rm, ref, e3;
+        for (const Row& r : sel) {
+          rm.push_back(r.rmse_air);
+          ref.push_back(r.rmse_ref);
+          e3.push_back(r.err3);
+        }
+        std::cout << "\ncut at " << t0 << " s: median RMSE " << fmt3(median(rm)) << " m (full flights on the same "
+                  << "windows " << fmt3(median(ref)) << " m), worst " << fmt3(maxOf(rm)) << " m, worst error after "
+                  << "3 s " << fmt3(maxOf(e3)) << " m\n";
+      }
+    }
+    if (!sim_rows.empty()) {
+      printTable("Simulated flights, whole", sim_rows, false);
+      summarize(sim_rows, "Simulated flights", true);
+    }
+    if (!sim_cut_rows.empty()) printTable("Simulated flights that start in the air", sim_cut_rows, true);
+    return;
+  }
+  json rows = json::array();
+  for (const auto* set : {&full_rows, &cut_rows, &sim_rows, &sim_cut_rows})
+    for (const Row& r : *set) rows.push_back(rowJson(r));
+  j["rows"] = rows;
+  j["real_whole_summary"] = summarize(full_rows, "", false);
+  j["sim_whole_summary"] = summarize(sim_rows, "", false);
+  j["parameters_set"] = a.sets;
+  std::cout << j.dump() << '\n';
+}
+
+const bool kRegistered = uwb::app::registerCommand(
+    {"protocol",
+     "Generalization protocol: real flights whole and cut to start in the air, simulated scenarios, coverage",
+     [](CLI::App& sub) {
+       auto a = std::make_shared<ProtocolArgs>();
+       sub.add_option("--data", a->data_dir, "data directory holding real/ (default: $UWBTDOA_DATA or ../shared/data)");
+       sub.add_option("--cuts", a->cuts, "start times [s] of the mid-air cuts")->delimiter(',')->capture_default_str();
+       sub.add_option("--set", a->sets, "override a filter parameter, name=value (repeatable)");
+       sub.add_option("--only", a->only, "only flights/scenarios whose name contains this");
+       sub.add_flag("--no-real", a->no_real, "skip the real flights");
+       sub.add_flag("--no-sim", a->no_sim, "skip the simulated scenarios");
+       sub.add_flag("--no-cuts", a->no_cuts, "skip the mid-air cuts of the real flights");
+       sub.add_flag("--json", a->json_out, "print one JSON object instead of tables");
+       sub.callback([a] { runProtocol(*a); });
+     }});
+
+}  // namespace

@@ -1,0 +1,180 @@
+/** @file Estimator.h
+ *  @brief The online estimator: one sensor event at a time, in time order, the current state and covariance after
+ *         each (docs/math/filter.md F14–F23). The shape of the Crazyflie estimator: a short dispatcher over sensor
+ *         types (addImu, addTdoa, addTof) around the error-state filter core (Ekf), with the start-up
+ *         (StartUp: multilateration of position and velocity), rest detection (RestDetector) and the TDoA update
+ *         through the graph's node (updateTdoa) as components of their own.
+ *
+ *  No look-ahead, bounded memory, nothing given out is rewritten, no allocation per event after the start-up.
+ *  No phase decision drops a measurement: at rest TDoA are down-weighted (F14), while moving they are gated on their
+ *  innovation (F11); being at rest is re-decided from the IMU at every sample (F18).
+ *
+ *  @code
+ *    Estimator est(EkfParams::defaults(), anchors);     // optional 3rd argument: a BiasPredictor
+ *    est.addImu(t, imu);  est.addTdoa(z);  est.addTof(tof);   // in time order
+ *    if (est.ready()) { LocalizerEstimate e = est.estimate(); ... }
+ *  @endcode
+ */
+#pragma once
+
+#include <cstddef>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "uwb/filter/Ekf.h"
+#include "uwb/filter/EkfParams.h"
+#include "uwb/filter/RestDetector.h"
+#include "uwb/filter/SensorEvents.h"
+#include "uwb/filter/StartUp.h"
+#include "uwb/filter/TdoaUpdate.h"
+#include "uwb/filter/TofUpdate.h"
+
+namespace uwb {
+
+/// What the estimator currently believes about the body (reported; no measurement depends on it being right).
+enum class FlightPhase : unsigned char {
+  kGround,       ///< at rest before it first moved
+  kAcquisition,  ///< position being found (start-up or re-acquisition) or just found
+  kTracking,     ///< moving (flying, carried)
+  kLanded,       ///< at rest after it moved
+};
+std::string toString(FlightPhase phase);
+
+/// One output sample of the estimator.
+struct LocalizerEstimate {
+  double t_s = 0.0;
+  NavState x;
+  Vec3 sigma_p_m = Vec3::Zero();  ///< reported 1σ of the position per world axis [m] (F23)
+  /// Reported covariance of (δp, δθ): position [m²] and attitude error [rad²] (F23 on the position block).
+  Eigen::Matrix<double, 6, 6> cov_pose = Eigen::Matrix<double, 6, 6>::Zero();
+  Vec3 sigma_v_mps = Vec3::Zero();  ///< 1σ of the velocity per world axis [m/s]
+  FlightPhase phase = FlightPhase::kGround;
+};
+
+struct LocalizerSummary {
+  std::size_t n_imu_total = 0;
+  std::size_t n_tdoa_total = 0;
+  std::size_t n_tdoa_used = 0;         ///< applied (possibly down-weighted)
+  std::size_t n_tdoa_used_at_rest = 0; ///< of n_tdoa_used: with the rest std (F14)
+  std::size_t n_tdoa_rejected = 0;     ///< χ² gate
+  std::size_t n_tdoa_downweighted = 0; ///< robust weight < 1
+  std::size_t n_tdoa_start = 0;        ///< went into a start-up / re-acquisition multilateration (F16)
+  std::size_t n_tdoa_before_imu = 0;   ///< arrived before the IMU had levelled the attitude (first 0.1 s)
+  std::size_t n_tdoa_degenerate = 0;
+  std::size_t n_tdoa_unknown_anchor = 0;
+  std::size_t n_tdoa_out_of_order = 0; ///< stamp older than the state by more than max_gap_s (ignored)
+  // ToF height updates (F21; only with EkfParams::fuse_tof)
+  std::size_t n_tof_total = 0;
+  std::size_t n_tof_used = 0;
+  std::size_t n_tof_rejected = 0;      ///< χ² gate
+  std::size_t n_tof_invalid = 0;       ///< non-finite, ≤ 0 or above tof_max_range_m (ignored)
+  std::size_t n_tof_tilted = 0;        ///< cos(tilt) ≤ kTofMinCosTilt (ignored)
+  std::size_t n_tof_not_ready = 0;     ///< before the position was known
+  std::size_t n_predictions = 0;
+  std::size_t n_covariance_propagations = 0;
+  std::size_t n_zero_velocity_updates = 0;
+  std::size_t n_floor_updates = 0;     ///< floor constraint applied (F22)
+  std::size_t n_rest_periods = 0;      ///< times the body came to rest
+  std::size_t n_reacquisitions = 0;    ///< lost or diverged → position found again by multilateration (F16)
+  std::size_t n_time_jumps = 0;        ///< sensor-time gaps or backward jumps handled (F17)
+  std::vector<double> reacquisition_t_s;  ///< when each re-acquisition started (first 100)
+  double takeoff_t_s = std::numeric_limits<double>::quiet_NaN();  ///< first time it left rest
+  double landing_t_s = std::numeric_limits<double>::quiet_NaN();  ///< last time it came to rest after moving
+  double ready_t_s = std::numeric_limits<double>::quiet_NaN();    ///< first position fix
+  double start_t_s = 0.0;
+  double end_t_s = 0.0;
+  ProcessModel process_model = ProcessModel::kImu;
+  Vec3 start_w_p_b = Vec3::Zero();     ///< first position found by multilateration (or given)
+  double start_rms_residual_m = 0.0;
+  MergeReport merge;                   ///< batch path only: what cleaning the log found (F17)
+};
+
+class Estimator {
+ public:
+  /// params.validate() is called; throws std::invalid_argument when the params are bad or fewer than 4 anchors are
+  /// given. With params.process_model == kImu the estimator waits for IMU samples; otherwise TDoA alone drive it.
+  Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor bias = {});
+
+  void addImu(double t_s, const ImuReading& imu);
+  void addTdoa(const TdoaObservation& z);
+  void addTof(const TofObservation& tof);
+
+  /// The position is known (after the first multilateration or from a given start).
+  bool ready() const { return ready_; }
+  /// Time of the latest event folded in [s].
+  double time() const { return t_last_event_; }
+  const NavState& state() const { return ekf_.state(); }
+  /// Covariance at the last propagation (Ekf::covariance).
+  const ErrMat& covariance() const { return ekf_.covariance(); }
+  FlightPhase phase() const { return phase_; }
+  /// The current estimate with the reported covariance (F23).
+  LocalizerEstimate estimate() const;
+  const LocalizerSummary& summary() const { return summary_; }
+  const EkfParams& params() const { return params_; }
+
+ private:
+  void initialize(double t_s, const Vec3& acc_mean_b, bool moving);
+  void predictTo(double t_s);
+  void propagate(bool force);
+  void handleTimeJump(double t_s, double gap_s);
+  void leaveGround(double t_s, bool climbing);
+  void enterGround(double t_s);
+  void startAcquisition(double t_s, bool reacquisition);
+  void finishStart(double t_s, const StartFix& fix);
+  void applyFloorConstraint(bool on_ground);
+  bool diverged() const;
+  /// Reported position covariance: the filter's plus the bias floor (F23).
+  Mat3 reportedPositionCovariance() const;
+
+  EkfParams params_;
+  AnchorTable anchors_;
+  BiasPredictor bias_;
+  bool imu_mode_;
+  Ekf ekf_;
+  RestDetector rest_;
+  StartUp start_;
+  TdoaUpdateOptions track_opt_, acq_opt_, rest_opt_;
+  TofUpdateOptions tof_opt_;
+  LocalizerSummary summary_;
+  Vec3 box_min_ = Vec3::Zero(), box_max_ = Vec3::Zero(), centroid_ = Vec3::Zero();
+
+  bool initialized_ = false;
+  bool ready_ = false;
+  bool on_ground_ = false;       ///< at rest or in ground contact (F18)
+  double v_climb_ = 0.0;         ///< take-off detector's vertical velocity (F15) [m/s]
+  double g_ref_ = kGravity_mps2; ///< vertical specific force on the ground [m/s²]
+  double t_last_shake_ = -1e300, t_shake_since_ = 0.0, t_left_ground_ = -1e300;
+  bool moved_ = false;
+  FlightPhase phase_ = FlightPhase::kAcquisition;
+  double t_last_event_ = std::numeric_limits<double>::quiet_NaN();
+  double t_pred_ = 0.0;
+  double t_last_imu_ = std::numeric_limits<double>::quiet_NaN();
+  double t_last_zupt_ = -1e300;
+  double t_acq_end_ = -1e300;
+  double t_last_accept_ = 0.0;
+  double t_last_tof_accept_ = -1e300;
+  std::size_t n_rejected_streak_ = 0;
+  // IMU averaging between predictions (F17) and the levelling window before initialization (F15)
+  Vec3 acc_sum_ = Vec3::Zero(), gyro_sum_ = Vec3::Zero();
+  int n_imu_acc_ = 0;
+  ImuReading last_imu_;
+  Vec3 init_acc_sum_ = Vec3::Zero();
+  double init_acc_sq_sum_ = 0.0;
+  int n_init_ = 0;
+  double t_first_imu_ = std::numeric_limits<double>::quiet_NaN();
+  // per-pair offsets (F19)
+  struct PairOffset {
+    double offset_m = 0.0;
+    double t_last_s = std::numeric_limits<double>::quiet_NaN();
+  };
+  std::vector<PairOffset> pair_offsets_;
+  // anchor pairs seen recently, for the reported bias floor (F23)
+  struct RecentPair {
+    int id_a = -1, id_b = -1;
+    double t_s = -1e300;
+  };
+  std::vector<RecentPair> recent_pairs_;
+};
+
+}  // namespace uwb

@@ -1,0 +1,62 @@
+/** @file StartUp.h
+ *  @brief Finding the position without ground truth, at the start and after a loss: TDoA collected over a short
+ *         window while the filter predicts, then one robust multilateration of the position (at rest) or of position
+ *         and velocity (moving: a start in the air), docs/math/filter.md F16, F16b.
+ */
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "uwb/filter/Multilateration.h"
+#include "uwb/filter/NavState.h"
+
+namespace uwb {
+
+/// The position (and velocity) found, brought to the time of the last sample.
+struct StartFix {
+  Vec3 w_p_b = Vec3::Zero();   ///< body origin now [m]
+  Vec3 w_v_b = Vec3::Zero();   ///< body velocity now [m/s]
+  Eigen::Matrix<double, 6, 6> cov = Eigen::Matrix<double, 6, 6>::Identity();  ///< of (p, v) now
+  Vec3 w_p0 = Vec3::Zero();    ///< body origin at the window's start [m]
+  double rms_residual_m = 0.0;
+  bool with_velocity = false;
+};
+
+struct StartUpParams {
+  double window_s = 0.6;            ///< first solve after this long [s]
+  std::size_t min_samples = 40;     ///< … and at least this many TDoA
+  double max_window_s = 3.0;        ///< keep at most this much history while solves fail [s]
+  double min_pos_sigma_m = 0.2;     ///< the fix's position std is at least this (TDoA bias, F16) [m]
+  double max_pos_sigma_m = 2.0;
+  double min_vel_sigma_mps = 0.15;  ///< the fix's velocity std is at least this [m/s]
+  double box_margin_m = 1.0;        ///< a solution outside the anchors' box grown by this is a failed solve [m]
+};
+
+class StartUp {
+ public:
+  StartUp(const AnchorTable& anchors, const Vec3& b_t_tag, const StartUpParams& params);
+  /// Starts collecting at t_s. x_ref is the predicted state then; `moving` selects the position-and-velocity solve.
+  void begin(double t_s, const NavState& x_ref, bool moving);
+  bool active() const { return active_; }
+  void cancel() { active_ = false; samples_.clear(); }
+  /// Adds a TDoA taken while the filter's predicted state is x_now; returns the fix when a solve succeeds (the
+  /// collection then ends). floor_z_m: the body sits on the floor now (ground evidence, F18) at this height of its
+  /// origin, so the solve is over x and y (F16c).
+  std::optional<StartFix> add(const TdoaObservation& z, const NavState& x_now,
+                              std::optional<double> floor_z_m = std::nullopt);
+
+ private:
+  const AnchorTable& anchors_;
+  Vec3 b_t_tag_;
+  StartUpParams params_;
+  std::vector<Vec3> guesses_;
+  Vec3 box_min_, box_max_;
+  std::vector<MultilaterationSample> samples_;
+  bool active_ = false;
+  bool moving_ = false;
+  double t_ref_ = 0.0, t_try_ = 0.0;
+  NavState x_ref_;
+};
+
+}  // namespace uwb

@@ -1,0 +1,520 @@
+/** @file Estimator.cpp
+ *  @brief The online estimator's dispatcher: docs/math/filter.md F14–F23 (rest, start-up by multilateration,
+ *         acquisition, gated/robust tracking, re-acquisition, floor constraint, reported covariance).
+ */
+#include "uwb/filter/Estimator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace uwb {
+namespace {
+
+/// Roll and pitch from a specific-force reading at rest, yaw = 0 (F15).
+Quat levelFromGravity(const Vec3& b_acc) {
+  const double roll = std::atan2(b_acc.y(), b_acc.z());
+  const double pitch = std::atan2(-b_acc.x(), std::sqrt(b_acc.y() * b_acc.y() + b_acc.z() * b_acc.z()));
+  return Quat(Eigen::AngleAxisd(pitch, Vec3::UnitY()) * Eigen::AngleAxisd(roll, Vec3::UnitX()));
+}
+
+/// Zero-velocity updates at rest at this period [s] and std [m/s] (F14).
+constexpr double kZuptPeriod_s = 0.01;
+constexpr double kZuptSigma_mps = 0.02;
+/// Levelling window before the first prediction [s] / samples (F15).
+constexpr double kLevelWindow_s = 0.1;
+constexpr int kLevelSamples = 100;
+/// Std of |f| over the levelling window below which the IMU starts at rest [m/s²] (F18).
+constexpr double kLevelRestAccStd_mps2 = 0.15;
+/// Lost (F16): nothing accepted for max_lost_s and at least this many rejections in a row.
+constexpr std::size_t kLostMinRejections = 20;
+/// Diverged (F16): the estimate left the anchors' box by this much [m], or moves faster than this [m/s].
+constexpr double kDivergedBoxMargin_m = 3.0;
+constexpr double kDivergedSpeed_mps = 8.0;
+/// A sensor-time gap longer than this is a time jump: the IMU is not integrated across it (F17) [s].
+constexpr double kMaxIntegrationGap_s = 0.25;
+/// Pairs seen within this window enter the reported bias floor (F23) [s].
+constexpr double kRecentPairWindow_s = 0.5;
+constexpr int kMaxPairId = 64;
+/// Floor constraint std [m] (F22).
+constexpr double kFloorSigma_m = 0.02;
+/// Height std of the body on the floor (F22) [m]: the body origin sits a few cm above the floor.
+constexpr double kGroundHeightSigma_m = 0.1;
+/// Ground contact (F18): shaking within this long counts [s]; only below this estimated height above the floor [m];
+/// after leaving the ground, shaking counts again only after this long [s] (the take-off's own transient).
+constexpr double kContactHold_s = 0.3;
+constexpr double kContactMaxHeight_m = 0.5;
+constexpr double kContactRearm_s = 0.5;
+constexpr double kContactSustained_s = 1.5;
+/// Below this estimated height above the floor TDoA are down-weighted as on the ground (F14) [m].
+constexpr double kLowFlight_m = 0.25;
+/// Constant time of the take-off detector's leaky vertical-velocity integrator [s] (F15).
+constexpr double kTakeoffLeak_s = 1.0;
+
+}  // namespace
+
+std::string toString(FlightPhase phase) {
+  switch (phase) {
+    case FlightPhase::kGround: return "ground";
+    case FlightPhase::kAcquisition: return "acquisition";
+    case FlightPhase::kTracking: return "tracking";
+    case FlightPhase::kLanded: return "landed";
+  }
+  return "unknown";
+}
+
+Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor bias)
+    : params_(params),
+      anchors_(std::move(anchors)),
+      bias_(std::move(bias)),
+      imu_mode_(params.process_model == ProcessModel::kImu),
+      ekf_(params),
+      start_(anchors_, params.b_t_tag,
+             StartUpParams{params.start_window_s, 40, 3.0, 0.2, params.init_pos_sigma_m, 0.15, 1.0}) {
+  params_.validate();
+  if (anchors_.size() < 4) throw std::invalid_argument("Estimator: at least 4 anchors are needed");
+  summary_.process_model = params_.process_model;
+  const std::vector<int> ids = anchors_.ids();
+  box_min_ = Vec3::Constant(1e300);
+  box_max_ = Vec3::Constant(-1e300);
+  for (int id : ids) {
+    const Vec3& a = anchors_.find(id)->m;
+    centroid_ += a;
+    box_min_ = box_min_.cwiseMin(a);
+    box_max_ = box_max_.cwiseMax(a);
+  }
+  centroid_ /= static_cast<double>(ids.size());
+
+  track_opt_.sigma_m = params_.tdoa_sigma_m;
+  track_opt_.gate_sigma = params_.gate_sigma;
+  track_opt_.loss = params_.robust_loss;
+  track_opt_.robust_k = params_.robust_k;
+  track_opt_.robust_iterations = params_.robust_iterations;
+  track_opt_.b_t_tag = params_.b_t_tag;
+  acq_opt_ = track_opt_;
+  acq_opt_.sigma_m = params_.acquisition_tdoa_sigma_m;
+  acq_opt_.gate_sigma = 0.0;  // (F16) no gate while acquiring; the robust loss limits outliers
+  if (acq_opt_.loss == RobustLoss::kNone) acq_opt_.loss = RobustLoss::kHuber;
+  rest_opt_ = track_opt_;
+  rest_opt_.sigma_m = params_.rest_tdoa_sigma_m;  // (F14) down-weighted at rest, still gated
+  tof_opt_.sigma_m = params_.tof_sigma_m;
+  tof_opt_.offset_m = params_.tof_offset_m;
+  tof_opt_.floor_z_m = params_.floor_z_m;
+  tof_opt_.max_range_m = params_.tof_max_range_m;
+  if (params_.pair_bias_tau_s > 0.0) pair_offsets_.resize(kMaxPairId * kMaxPairId);
+  recent_pairs_.reserve(64);
+}
+
+void Estimator::initialize(double t_s, const Vec3& acc_mean_b, bool moving) {
+  NavState x0;
+  x0.w_q_b = imu_mode_ ? levelFromGravity(acc_mean_b) : Quat::Identity();
+  x0.w_p_b = params_.has_start_position ? params_.start_w_p_b : Vec3(centroid_.x(), centroid_.y(), params_.ground_z_m);
+  ErrMat P0 = initialCovariance(params_);
+  if (moving) {
+    // (F15) the IMU starts in motion (e.g. in the air): the gravity direction is only approximate and the velocity
+    // is unknown
+    P0.block<2, 2>(kAtt, kAtt) = Eigen::Matrix2d::Identity() * params_.moving_start_att_sigma_rad *
+                                 params_.moving_start_att_sigma_rad;
+    P0.block<3, 3>(kVel, kVel) = Mat3::Identity() * params_.moving_start_vel_sigma_mps *
+                                 params_.moving_start_vel_sigma_mps;
+  }
+  if (params_.has_start_position) P0.block<3, 3>(kPos, kPos) = Mat3::Identity() * 0.05 * 0.05;
+  ekf_.initialize(x0, P0);
+  ekf_.setAccelModel(params_.accel_model);
+  t_pred_ = t_s;
+  t_last_accept_ = t_s;
+  initialized_ = true;
+  if (params_.has_start_position) {
+    ready_ = true;
+    summary_.ready_t_s = t_s;
+    summary_.start_w_p_b = params_.start_w_p_b;
+    phase_ = FlightPhase::kAcquisition;
+    t_acq_end_ = t_s + 0.5 * params_.acquisition_s;
+  } else {
+    startAcquisition(t_s, false);
+  }
+}
+
+void Estimator::startAcquisition(double t_s, bool reacquisition) {
+  phase_ = FlightPhase::kAcquisition;
+  if (reacquisition) {
+    ++summary_.n_reacquisitions;
+    if (summary_.reacquisition_t_s.size() < 100) summary_.reacquisition_t_s.push_back(t_s);
+  }
+  // at rest the body stays where it is: position only; otherwise position and velocity (F16b)
+  start_.begin(t_s, ekf_.state(), !(imu_mode_ && on_ground_));
+}
+
+void Estimator::finishStart(double t_s, const StartFix& fix) {
+  ekf_.resetPositionVelocity(fix.w_p_b, fix.w_v_b, fix.cov);
+  if (!ready_) {
+    summary_.ready_t_s = t_s;
+    summary_.start_w_p_b = fix.w_p0;
+    summary_.start_rms_residual_m = fix.rms_residual_m;
+  }
+  ready_ = true;
+  phase_ = FlightPhase::kAcquisition;
+  t_acq_end_ = t_s + params_.acquisition_s;
+  t_last_accept_ = t_s;
+  n_rejected_streak_ = 0;
+}
+
+void Estimator::predictTo(double t_s) {
+  const double dt = t_s - t_pred_;
+  if (!(dt > 0.0)) return;
+  if (imu_mode_) {
+    ImuReading m = last_imu_;
+    if (n_imu_acc_ > 0) {
+      m.b_acc_mps2 = acc_sum_ / n_imu_acc_;
+      m.b_gyro_radps = gyro_sum_ / n_imu_acc_;
+    }
+    ekf_.predict(m, dt);
+  } else {
+    ekf_.predictTdoaOnly(dt);
+  }
+  acc_sum_.setZero();
+  gyro_sum_.setZero();
+  n_imu_acc_ = 0;
+  t_pred_ = t_s;
+  ++summary_.n_predictions;
+}
+
+void Estimator::propagate(bool force) {
+  if (ekf_.pendingDt() > 0.0 && (force || ekf_.pendingDt() >= params_.cov_period_s)) {
+    ekf_.propagateCovariance();
+    ++summary_.n_covariance_propagations;
+  }
+}
+
+void Estimator::handleTimeJump(double t_s, double gap_s) {
+  // (F17) nothing is integrated across a gap or a backward jump: the covariance grows by what a body could do in it
+  ++summary_.n_time_jumps;
+  propagate(true);
+  acc_sum_.setZero();
+  gyro_sum_.setZero();
+  n_imu_acc_ = 0;
+  t_pred_ = t_s;
+  if (ready_) {
+    const double g = std::min(std::abs(gap_s), 5.0);
+    ekf_.inflatePosition(std::min(1.0 * g, 2.0), std::min(1.0 * g, 1.0));
+    if (std::abs(gap_s) > 1.0 && !start_.active()) startAcquisition(t_s, true);
+  }
+}
+
+void Estimator::leaveGround(double t_s, bool climbing) {
+  on_ground_ = false;
+  t_left_ground_ = t_s;
+  t_last_shake_ = -1e300;
+  if (std::isnan(summary_.takeoff_t_s)) summary_.takeoff_t_s = t_s;
+  moved_ = true;
+  if (imu_mode_) {
+    ekf_.setAccelModel(params_.accel_model);
+    propagate(true);
+    if (climbing) {
+      // (F15) the climb that the detector saw becomes the vertical velocity
+      ErrVec dx = ErrVec::Zero();
+      dx(kVel + 2) = v_climb_ - ekf_.state().w_v_b.z();
+      ekf_.inject(dx);
+    }
+    // (F20) the thrust-axis accelerometer bias with the motors running is not the one learned at rest, and the
+    // position held on the ground absorbed the floor-level TDoA bias
+    if (params_.takeoff_acc_bias_sigma_mps2 > 0.0) ekf_.inflateThrustBias(params_.takeoff_acc_bias_sigma_mps2);
+    // horizontally only: the floor fixed the height (F22)
+    if (ready_) ekf_.inflateHorizontalPosition(params_.leave_rest_pos_sigma_m, 0.3);
+  }
+  v_climb_ = 0.0;
+  if (ready_ && phase_ != FlightPhase::kAcquisition) phase_ = FlightPhase::kTracking;
+}
+
+void Estimator::enterGround(double t_s) {
+  on_ground_ = true;
+  v_climb_ = 0.0;
+  ++summary_.n_rest_periods;
+  if (moved_) summary_.landing_t_s = t_s;
+  if (imu_mode_ && rest_.atRest()) ekf_.setAccelModel(params_.ground_accel_model);  // (F15) levelled from all axes
+  if (ready_ && phase_ != FlightPhase::kAcquisition) phase_ = moved_ ? FlightPhase::kLanded : FlightPhase::kGround;
+}
+
+void Estimator::applyFloorConstraint(bool on_ground) {
+  // (F22) z ≥ floor: a one-sided constraint, applied as a position update only when violated; on the ground (F14)
+  // the body sits on the floor: z = floor ± kGroundHeightSigma_m
+  if (!params_.floor_constraint || !ready_) return;
+  const double z = ekf_.state().w_p_b.z();
+  if (on_ground && start_.active()) return;
+  if (on_ground) {
+    ekf_.positionUpdate(2, params_.ground_z_m, kGroundHeightSigma_m);
+    ++summary_.n_floor_updates;
+    return;
+  }
+  if (z < params_.ground_z_m - params_.floor_margin_m) {
+    propagate(true);
+    ekf_.positionUpdate(2, params_.ground_z_m, kFloorSigma_m);
+    if (ekf_.state().w_v_b.z() < 0.0) {
+      // the body cannot keep sinking into the floor either
+      ErrVec dx = ErrVec::Zero();
+      dx(kVel + 2) = -ekf_.state().w_v_b.z();
+      ekf_.inject(dx);
+    }
+    ++summary_.n_floor_updates;
+  }
+}
+
+bool Estimator::diverged() const {
+  const NavState& x = ekf_.state();
+  if (!x.w_p_b.allFinite() || !x.w_v_b.allFinite()) return true;
+  if ((x.w_p_b.array() < box_min_.array() - kDivergedBoxMargin_m).any() ||
+      (x.w_p_b.array() > box_max_.array() + kDivergedBoxMargin_m).any())
+    return true;
+  return x.w_v_b.squaredNorm() > kDivergedSpeed_mps * kDivergedSpeed_mps;
+}
+
+void Estimator::addImu(double t_s, const ImuReading& imu) {
+  ++summary_.n_imu_total;
+  if (!imu_mode_) return;
+  if (std::isnan(t_last_event_)) summary_.start_t_s = t_s;
+  t_last_event_ = std::isnan(t_last_event_) ? t_s : std::max(t_last_event_, t_s);
+  summary_.end_t_s = t_last_event_;
+  if (!initialized_) {
+    // (F15) levelling window: mean specific force for the attitude, its spread tells rest from motion
+    if (std::isnan(t_first_imu_)) t_first_imu_ = t_s;
+    init_acc_sum_ += imu.b_acc_mps2;
+    init_acc_sq_sum_ += imu.b_acc_mps2.squaredNorm();
+    ++n_init_;
+    last_imu_ = imu;
+    t_last_imu_ = t_s;
+    if (t_s - t_first_imu_ >= kLevelWindow_s || n_init_ >= kLevelSamples) {
+      const Vec3 mean = init_acc_sum_ / n_init_;
+      const double var = std::max(init_acc_sq_sum_ / n_init_ - mean.squaredNorm(), 0.0);
+      const bool moving = var > kLevelRestAccStd_mps2 * kLevelRestAccStd_mps2;
+      rest_.reset(imu);
+      g_ref_ = mean.norm();
+      initialize(t_s, mean, moving);
+    }
+    return;
+  }
+  const double dt_imu = t_s - t_last_imu_;
+  if (dt_imu > kMaxIntegrationGap_s || dt_imu < -params_.max_gap_s) {
+    handleTimeJump(t_s, dt_imu);
+    t_last_imu_ = t_s;
+    last_imu_ = imu;
+    return;
+  }
+  if (dt_imu <= 0.0) return;  // a repeated or slightly older stamp: nothing to integrate
+  t_last_imu_ = t_s;
+  last_imu_ = imu;
+  acc_sum_ += imu.b_acc_mps2;
+  gyro_sum_ += imu.b_gyro_radps;
+  ++n_imu_acc_;
+
+  // (F18) ground evidence is re-decided at every sample: at rest (motors off), or shaking as on the floor with the
+  // motors running while the estimate is near the floor; a climb seen by the accelerometer contradicts both (F15)
+  rest_.update(t_s, imu, dt_imu);
+  if (params_.ground_phase == GroundPhase::kDetectTakeoff) {
+    bool climbing = false;
+    if (on_ground_) {
+      // (F15) take-off detector: leaky integral of the vertical specific-force excess over its level on the ground
+      const double a_up = (ekf_.state().w_q_b * imu.b_acc_mps2).z();
+      v_climb_ = expNegative(dt_imu / kTakeoffLeak_s) * v_climb_ + dt_imu * (a_up - g_ref_);
+      if (rest_.stillNow() || v_climb_ < 0.05) g_ref_ += (dt_imu / 2.0) * (a_up - g_ref_);
+      // a body that shakes is still touching the floor (touchdown bounces, spin-up): no take-off
+      climbing = v_climb_ > params_.takeoff_climb_mps && !rest_.stillNow() && !rest_.shaking();
+    }
+    if (rest_.shaking() && t_s - t_left_ground_ > kContactRearm_s) {
+      if (t_s - t_last_shake_ >= kContactHold_s) t_shake_since_ = t_s;  // a new shaking episode
+      t_last_shake_ = t_s;
+    }
+    // shaking near the floor, or shaking for long wherever the estimate is (flight shakes only briefly)
+    const bool contact = t_s - t_last_shake_ < kContactHold_s &&
+                         (!ready_ || ekf_.state().w_p_b.z() - params_.ground_z_m < kContactMaxHeight_m ||
+                          t_s - t_shake_since_ >= kContactSustained_s);
+    const bool ground_now = (rest_.atRest() || contact) && !climbing;
+    if (ground_now && !on_ground_) {
+      predictTo(t_s);
+      propagate(true);
+      enterGround(t_s);
+    } else if (!ground_now && on_ground_) {
+      predictTo(t_s);
+      leaveGround(t_s, climbing);
+    }
+  }
+
+  if (t_s - t_pred_ >= params_.max_predict_dt_s) {
+    predictTo(t_s);
+    propagate(false);
+  }
+  if (on_ground_ && t_s - t_last_zupt_ >= kZuptPeriod_s) {
+    predictTo(t_s);
+    propagate(true);
+    ekf_.zeroVelocityUpdate(kZuptSigma_mps);  // (F14)
+    ++summary_.n_zero_velocity_updates;
+    t_last_zupt_ = t_s;
+    applyFloorConstraint(true);
+  } else if (t_s - t_last_zupt_ >= kZuptPeriod_s) {
+    t_last_zupt_ = t_s;
+    applyFloorConstraint(false);
+  }
+  if (ready_ && !start_.active() && diverged()) {
+    propagate(true);
+    startAcquisition(t_s, true);
+  }
+}
+
+void Estimator::addTof(const TofObservation& tof) {
+  ++summary_.n_tof_total;
+  if (!params_.fuse_tof) return;
+  const double t = tof.t_s;
+  if (!(std::isfinite(tof.range_m) && tof.range_m > 0.0 && tof.range_m <= params_.tof_max_range_m)) {
+    ++summary_.n_tof_invalid;
+    return;
+  }
+  if (!initialized_ || !ready_ || start_.active()) {
+    ++summary_.n_tof_not_ready;
+    return;
+  }
+  t_last_event_ = std::max(t_last_event_, t);
+  summary_.end_t_s = t_last_event_;
+  if (!imu_mode_ || t - t_pred_ >= params_.update_predict_dt_s) predictTo(t);
+  propagate(!imu_mode_);
+  // the gate opens when no ToF was accepted for max_lost_s (start, or a height that drifted off under TDoA)
+  tof_opt_.gate_sigma = t - t_last_tof_accept_ > params_.max_lost_s ? 0.0 : params_.tof_gate_sigma;
+  const TofUpdateResult r = updateTof(ekf_, tof.range_m, tof_opt_);
+  switch (r.outcome) {
+    case UpdateOutcome::kApplied:
+      ++summary_.n_tof_used;
+      t_last_tof_accept_ = t;
+      break;
+    case UpdateOutcome::kRejectedOutlier: ++summary_.n_tof_rejected; break;
+    case UpdateOutcome::kDegenerate: ++summary_.n_tof_tilted; break;
+    default: ++summary_.n_tof_invalid; break;
+  }
+}
+
+void Estimator::addTdoa(const TdoaObservation& z) {
+  ++summary_.n_tdoa_total;
+  const double t = z.t_s;
+  if (!initialized_) {
+    if (imu_mode_) {
+      ++summary_.n_tdoa_before_imu;
+      return;
+    }
+    summary_.start_t_s = t;
+    t_last_event_ = t;
+    initialize(t, Vec3(0, 0, kGravity_mps2), false);
+  }
+  if (t < t_pred_ - params_.max_gap_s) {
+    if (imu_mode_) {
+      ++summary_.n_tdoa_out_of_order;  // the IMU clock leads; a backward jump of the IMU re-bases the time (F17)
+      return;
+    }
+    handleTimeJump(t, t - t_pred_);
+  }
+  if (!imu_mode_ && t - t_pred_ > kMaxIntegrationGap_s * 4.0) handleTimeJump(t, t - t_pred_);
+  t_last_event_ = std::max(t_last_event_, t);
+  summary_.end_t_s = t_last_event_;
+  // (F17) the nominal state is brought to the measurement time only when it lags by more than update_predict_dt_s
+  if (!imu_mode_ || t - t_pred_ >= params_.update_predict_dt_s) predictTo(t);
+
+  if (start_.active()) {
+    // (F16) collecting the multilateration batch; the displacement comes from the prediction
+    ++summary_.n_tdoa_start;
+    propagate(!imu_mode_);
+    const std::optional<double> floor_z =
+        on_ground_ && params_.floor_constraint ? std::optional<double>(params_.ground_z_m) : std::nullopt;
+    if (const std::optional<StartFix> fix = start_.add(z, ekf_.state(), floor_z)) {
+      propagate(true);
+      finishStart(t, *fix);
+    }
+    return;
+  }
+  if (phase_ == FlightPhase::kAcquisition && t >= t_acq_end_)
+    phase_ = on_ground_ ? (moved_ ? FlightPhase::kLanded : FlightPhase::kGround) : FlightPhase::kTracking;
+  propagate(!imu_mode_);
+  const bool acquiring = phase_ == FlightPhase::kAcquisition;
+  // (F19) optional per-pair offset learned from the innovations while tracking
+  TdoaObservation zc = z;
+  PairOffset* po = nullptr;
+  if (!pair_offsets_.empty() && z.id_a >= 0 && z.id_b >= 0 && z.id_a < kMaxPairId && z.id_b < kMaxPairId) {
+    po = &pair_offsets_[z.id_a * kMaxPairId + z.id_b];
+    zc.tdoa_m -= po->offset_m;
+  }
+  // (F14) TDoA near the floor carry the large floor-level bias: down-weighted on the ground and just above it
+  const bool near_floor = on_ground_ || ekf_.state().w_p_b.z() - params_.ground_z_m < kLowFlight_m;
+  const TdoaUpdateOptions& opt = acquiring ? acq_opt_ : (near_floor ? rest_opt_ : track_opt_);
+  const TdoaUpdateResult r = updateTdoa(ekf_, anchors_, zc, opt, bias_ ? &bias_ : nullptr);
+  if (po && !acquiring && r.outcome == UpdateOutcome::kApplied) {
+    const double dt_pair = std::isnan(po->t_last_s) ? 0.0 : std::min(t - po->t_last_s, 0.2);
+    po->offset_m =
+        std::clamp(po->offset_m + (dt_pair / params_.pair_bias_tau_s) * r.weight * r.innovation_m, -0.5, 0.5);
+    po->t_last_s = t;
+  }
+  switch (r.outcome) {
+    case UpdateOutcome::kApplied:
+      ++summary_.n_tdoa_used;
+      if (near_floor && !acquiring) ++summary_.n_tdoa_used_at_rest;
+      if (r.weight < 1.0) ++summary_.n_tdoa_downweighted;
+      t_last_accept_ = t;
+      n_rejected_streak_ = 0;
+      break;
+    case UpdateOutcome::kRejectedOutlier:
+      ++summary_.n_tdoa_rejected;
+      ++n_rejected_streak_;
+      break;
+    case UpdateOutcome::kUnknownAnchor: ++summary_.n_tdoa_unknown_anchor; break;
+    default: ++summary_.n_tdoa_degenerate; break;
+  }
+  if (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier) {
+    // anchor pairs in view, for the reported bias floor (F23)
+    auto it = std::find_if(recent_pairs_.begin(), recent_pairs_.end(),
+                           [&](const RecentPair& p) { return p.id_a == z.id_a && p.id_b == z.id_b; });
+    if (it != recent_pairs_.end()) it->t_s = t;
+    else if (recent_pairs_.size() < recent_pairs_.capacity()) recent_pairs_.push_back({z.id_a, z.id_b, t});
+  }
+  // (F16) lost: nothing accepted for max_lost_s → find the position again by multilateration from fresh TDoA
+  if (!acquiring && t - t_last_accept_ > params_.max_lost_s && n_rejected_streak_ > kLostMinRejections) {
+    startAcquisition(t, true);
+    t_last_accept_ = t;
+    n_rejected_streak_ = 0;
+  }
+}
+
+Mat3 Estimator::reportedPositionCovariance() const {
+  Mat3 P = ekf_.covariance().block<3, 3>(kPos, kPos);
+  if (!(params_.output_bias_sigma_m > 0.0) || !ready_) return P;
+  // (F23) a slowly varying TDoA bias of std σ_b per pair, common over the pairs in view, moves the position by
+  // (HᵀH)⁻¹Hᵀ b: covariance σ_b² (HᵀH)⁻¹ with H the rows ∂z/∂p of the pairs seen recently
+  const NavState& x = ekf_.state();
+  const Vec3 w_p_tag = x.w_p_b + x.w_q_b * params_.b_t_tag;
+  Mat3 HtH = Mat3::Zero();
+  int n = 0;
+  for (const RecentPair& rp : recent_pairs_) {
+    if (t_last_event_ - rp.t_s > kRecentPairWindow_s) continue;
+    const Moments3* a = anchors_.find(rp.id_a);
+    const Moments3* b = anchors_.find(rp.id_b);
+    if (!a || !b) continue;
+    const Vec3 da = w_p_tag - a->m, db = w_p_tag - b->m;
+    if (da.norm() < 1e-6 || db.norm() < 1e-6) continue;
+    const Vec3 h = db.normalized() - da.normalized();
+    HtH += h * h.transpose();
+    ++n;
+  }
+  if (n < 3) return P + Mat3::Identity() * params_.output_bias_sigma_m * params_.output_bias_sigma_m;
+  const Eigen::LDLT<Mat3> ldlt(HtH + 1e-6 * Mat3::Identity());
+  return P + params_.output_bias_sigma_m * params_.output_bias_sigma_m * ldlt.solve(Mat3::Identity());
+}
+
+LocalizerEstimate Estimator::estimate() const {
+  LocalizerEstimate e;
+  e.t_s = t_last_event_;
+  e.x = ekf_.state();
+  e.phase = phase_;
+  const ErrMat& P = ekf_.covariance();
+  e.cov_pose.block<3, 3>(0, 0) = reportedPositionCovariance();
+  e.cov_pose.block<3, 3>(0, 3) = P.block<3, 3>(kPos, kAtt);
+  e.cov_pose.block<3, 3>(3, 0) = P.block<3, 3>(kAtt, kPos);
+  e.cov_pose.block<3, 3>(3, 3) = P.block<3, 3>(kAtt, kAtt);
+  e.sigma_p_m = e.cov_pose.diagonal().head<3>().cwiseMax(0.0).cwiseSqrt();
+  e.sigma_v_mps = P.diagonal().segment<3>(kVel).cwiseMax(0.0).cwiseSqrt();
+  return e;
+}
+
+}  // namespace uwb

@@ -1,0 +1,97 @@
+/** @file StartUp.cpp
+ *  @brief Start-up and re-acquisition by multilateration (docs/math/filter.md F16, F16b).
+ */
+#include "uwb/filter/StartUp.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace uwb {
+
+StartUp::StartUp(const AnchorTable& anchors, const Vec3& b_t_tag, const StartUpParams& params)
+    : anchors_(anchors), b_t_tag_(b_t_tag), params_(params) {
+  const std::vector<int> ids = anchors_.ids();
+  if (ids.empty()) throw std::invalid_argument("StartUp: no anchors");
+  Vec3 centroid = Vec3::Zero();
+  box_min_ = Vec3::Constant(1e300);
+  box_max_ = Vec3::Constant(-1e300);
+  for (int id : ids) {
+    const Vec3& a = anchors_.find(id)->m;
+    centroid += a;
+    box_min_ = box_min_.cwiseMin(a);
+    box_max_ = box_max_.cwiseMax(a);
+  }
+  centroid /= static_cast<double>(ids.size());
+  // starting guesses: near the floor, at flight height, at the anchors' centroid
+  guesses_ = {Vec3(centroid.x(), centroid.y(), 0.5), Vec3(centroid.x(), centroid.y(), 1.5), centroid};
+  samples_.reserve(4096);  // ≥ max_window_s of TDoA at the LPS rates: no allocation per event
+}
+
+void StartUp::begin(double t_s, const NavState& x_ref, bool moving) {
+  active_ = true;
+  moving_ = moving;
+  t_ref_ = t_try_ = t_s;
+  x_ref_ = x_ref;
+  samples_.clear();
+}
+
+std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x_now, std::optional<double> floor_z_m) {
+  if (!active_) return std::nullopt;
+  // (F16b) displacement since t_ref from the prediction, without the reference velocity (that is v0's part)
+  MultilaterationSample s;
+  s.z = z;
+  s.w_d_b = x_now.w_p_b - x_ref_.w_p_b - (z.t_s - t_ref_) * x_ref_.w_v_b;
+  s.w_q_b = x_now.w_q_b;
+  if (samples_.size() < samples_.capacity()) samples_.push_back(s);
+  if (!(z.t_s - t_try_ >= params_.window_s && samples_.size() >= params_.min_samples)) return std::nullopt;
+
+  const bool moving = moving_ && !floor_z_m;
+  std::optional<MultilaterationResult> r =
+      floor_z_m ? multilaterateOnFloor(samples_, anchors_, b_t_tag_, guesses_, *floor_z_m)
+      : moving  ? multilaterateMoving(samples_, anchors_, b_t_tag_, guesses_, t_ref_)
+                : multilaterate(samples_, anchors_, b_t_tag_, guesses_);
+  const bool inside = r && (r->w_p0.array() >= box_min_.array() - params_.box_margin_m).all() &&
+                      (r->w_p0.array() <= box_max_.array() + params_.box_margin_m).all() &&
+                      (!moving || r->w_v0.norm() < 5.0);
+  if (!inside) {
+    // keep the most recent part and try again later (the earliest samples are the worst: take-off, faults)
+    const double t_keep = z.t_s - std::min(params_.max_window_s, 0.5 * params_.window_s);
+    std::erase_if(samples_, [&](const MultilaterationSample& m) { return m.z.t_s < t_keep; });
+    t_try_ = z.t_s - 0.5 * params_.window_s;
+    return std::nullopt;
+  }
+  StartFix fix;
+  fix.with_velocity = moving;
+  fix.w_p0 = r->w_p0;
+  fix.rms_residual_m = r->rms_residual_m;
+  const double T = z.t_s - t_ref_;
+  const Vec3 d_now = x_now.w_p_b - x_ref_.w_p_b - T * x_ref_.w_v_b;
+  // (F16b) p_now = p0 + v0 T + d_now, v_now = v0 + (v_pred_now − v_pred_ref)
+  Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Identity();
+  Eigen::Matrix<double, 6, 6> S = Eigen::Matrix<double, 6, 6>::Zero();
+  if (moving) {
+    fix.w_p_b = r->w_p0 + T * r->w_v0 + d_now;
+    fix.w_v_b = r->w_v0 + (x_now.w_v_b - x_ref_.w_v_b);
+    J.block<3, 3>(0, 3) = T * Mat3::Identity();
+    S = J * r->covariance_pv * J.transpose();
+  } else {
+    fix.w_p_b = r->w_p0 + d_now;
+    fix.w_v_b = x_now.w_v_b;
+    S.block<3, 3>(0, 0) = r->covariance;
+  }
+  // floors on the stds: the solve's own covariance ignores the correlated TDoA bias
+  const double sp = std::clamp(std::sqrt(S.block<3, 3>(0, 0).trace() / 3.0), params_.min_pos_sigma_m,
+                               params_.max_pos_sigma_m);
+  const double sv = moving ? std::max(std::sqrt(S.block<3, 3>(3, 3).trace() / 3.0), params_.min_vel_sigma_mps)
+                            : params_.min_vel_sigma_mps;
+  fix.cov.setZero();
+  fix.cov.block<3, 3>(0, 0) = sp * sp * Mat3::Identity();
+  if (floor_z_m) fix.cov(2, 2) = 0.1 * 0.1;  // on the floor: the height is known to a few cm (F22)
+  fix.cov.block<3, 3>(3, 3) = sv * sv * Mat3::Identity();
+  active_ = false;
+  samples_.clear();
+  return fix;
+}
+
+}  // namespace uwb
