@@ -82,9 +82,6 @@ void applyConfig(const json& j, uwb::EkfParams& p) {
     else if (key == "max_gap_s") p.max_gap_s = num();
     else if (key == "ground_phase") p.ground_phase = uwb::parseGroundPhase(value.get<std::string>());
     else if (key == "takeoff_climb_mps") p.takeoff_climb_mps = num();
-    else if (key == "takeoff_acc_mps2") p.takeoff_acc_mps2 = num();
-    else if (key == "landing_height_m") p.landing_height_m = num();
-    else if (key == "landing_hold_s") p.landing_hold_s = num();
     else if (key == "acquisition_s") p.acquisition_s = num();
     else if (key == "acquisition_tdoa_sigma_m") p.acquisition_tdoa_sigma_m = num();
     else if (key == "start_w_p_b") {

@@ -82,12 +82,20 @@ EstimateChecks checkEstimate(const Trajectory& estimate, const TrajectoryMetrics
   // settling: the last airborne sample above the threshold
   double t_last_bad = -std::numeric_limits<double>::infinity();
   bool any_air = false;
+  const double t_start = std::isnan(params.t_start_s) ? c.first_estimate_t_s : params.t_start_s;
+  double sum_early = 0.0;
+  std::size_t n_early = 0;
   for (const PositionErrorSample& s : samples) {
     if (!s.airborne || s.t_s < c.first_estimate_t_s) continue;
     any_air = true;
     if (s.error_norm_m > params.settle_error_m) t_last_bad = s.t_s;
-    if (s.t_s > c.first_estimate_t_s + 3.0) c.max_error_after_3s_m = std::max(c.max_error_after_3s_m, s.error_norm_m);
+    if (s.t_s > t_start + 3.0) c.max_error_after_3s_m = std::max(c.max_error_after_3s_m, s.error_norm_m);
+    if (s.t_s >= t_start + 3.0 && s.t_s <= t_start + 5.0) {
+      sum_early += s.error_norm_m * s.error_norm_m;
+      ++n_early;
+    }
   }
+  if (n_early > 0) c.rmse_3_to_5s_m = std::sqrt(sum_early / static_cast<double>(n_early));
   if (any_air) {
     if (std::isinf(t_last_bad)) c.settle_time_s = 0.0;
     else if (t_last_bad < samples.back().t_s) c.settle_time_s = t_last_bad - c.first_estimate_t_s;

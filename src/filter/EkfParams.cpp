@@ -45,9 +45,6 @@ void EkfParams::validate() const {
   requireNonNegative(update_predict_dt_s, "update_predict_dt_s");
   requirePositive(max_gap_s, "max_gap_s");
   requirePositive(takeoff_climb_mps, "takeoff_climb_mps");
-  requirePositive(takeoff_acc_mps2, "takeoff_acc_mps2");
-  requirePositive(landing_height_m, "landing_height_m");
-  requirePositive(landing_hold_s, "landing_hold_s");
   requireNonNegative(acquisition_s, "acquisition_s");
   requireNonNegative(takeoff_acc_bias_sigma_mps2, "takeoff_acc_bias_sigma_mps2");
   requirePositive(acquisition_tdoa_sigma_m, "acquisition_tdoa_sigma_m");
@@ -59,6 +56,7 @@ void EkfParams::validate() const {
   requirePositive(start_window_s, "start_window_s");
   requirePositive(moving_start_vel_sigma_mps, "moving_start_vel_sigma_mps");
   requirePositive(moving_start_att_sigma_rad, "moving_start_att_sigma_rad");
+  requirePositive(moving_start_yaw_sigma_rad, "moving_start_yaw_sigma_rad");
   requireNonNegative(output_bias_sigma_m, "output_bias_sigma_m");
   requirePositive(tof_sigma_m, "tof_sigma_m");
   if (!std::isfinite(tof_offset_m)) throw std::invalid_argument("EkfParams.tof_offset_m must be finite");

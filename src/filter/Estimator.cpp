@@ -117,6 +117,7 @@ void Estimator::initialize(double t_s, const Vec3& acc_mean_b, bool moving) {
                                  params_.moving_start_att_sigma_rad;
     P0.block<3, 3>(kVel, kVel) = Mat3::Identity() * params_.moving_start_vel_sigma_mps *
                                  params_.moving_start_vel_sigma_mps;
+    P0(kAtt + 2, kAtt + 2) = params_.moving_start_yaw_sigma_rad * params_.moving_start_yaw_sigma_rad;
   }
   if (params_.has_start_position) P0.block<3, 3>(kPos, kPos) = Mat3::Identity() * 0.05 * 0.05;
   ekf_.initialize(x0, P0);
@@ -407,6 +408,11 @@ void Estimator::addTdoa(const TdoaObservation& z) {
       return;
     }
     handleTimeJump(t, t - t_pred_);
+  }
+  if (imu_mode_ && t - t_pred_ > kMaxIntegrationGap_s) {
+    // (F17) the IMU stream stopped (dropout or a clock jump seen first here): nothing is integrated across the gap
+    handleTimeJump(t, t - t_pred_);
+    t_last_imu_ = t;
   }
   if (!imu_mode_ && t - t_pred_ > kMaxIntegrationGap_s * 4.0) handleTimeJump(t, t - t_pred_);
   t_last_event_ = std::max(t_last_event_, t);

@@ -45,7 +45,9 @@ LocalizerResult TdoaLocalizer::run(const SensorLog& input, double output_period_
     switch (ev.kind) {
       case SensorEvent::Kind::kImu: estimator.addImu(ev.t_s, log.imu[ev.index].imu); break;
       case SensorEvent::Kind::kTdoa: estimator.addTdoa(log.tdoa[ev.index]); break;
-      case SensorEvent::Kind::kTof: estimator.addTof(log.tof[ev.index]); break;
+      case SensorEvent::Kind::kTof:
+        estimator.addTof(log.tof[ev.index]);
+        continue;  // outputs follow the IMU and TDoA events only: the trajectory does not depend on the ToF stream
     }
     if (estimator.ready() && ev.t_s - t_last_out >= output_period_s) {
       result.estimates.push_back(estimator.estimate());

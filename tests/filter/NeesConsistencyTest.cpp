@@ -33,6 +33,7 @@ TEST(NeesConsistency, PositionNeesWithinChiSquareBounds) {
   p.acc_noise_mps2_sqrthz = acc_std * std::sqrt(0.001);   // white per-sample std → spectral density
   p.lateral_acc_noise_mps2_sqrthz = 0.05;
   p.gyro_noise_radps_sqrthz = gyro_std * std::sqrt(0.001);
+  p.output_bias_sigma_m = 0.0;  // white TDoA noise: no correlated bias to report (F23)
   double nees_sum = 0.0;
   std::size_t n = 0;
   for (int run = 0; run < kRuns; ++run) {

@@ -140,38 +140,6 @@ TEST(OutlierGate, RobustWeightsFollowTheLoss) {
   EXPECT_DOUBLE_EQ(robustUpdateWeight(RobustLoss::kHuber, 1.0, 0.05, 0.01, 0.04, 3), 1.0);
 }
 
-TEST(GroundPhase, TdoaOnTheGroundIsIgnoredUntilTakeoff) {
-  // GIVEN 2 s on the ground with TDoA off by ±2 m per pair, then a climb of 1 m and hover
-  const AnchorTable anchors = boxAnchors();
-  const Vec3 p0(0.8, -0.5, 0.05);
-  const auto truth = [&](double t) {
-    // climb: a = +1 m/s² for 1 s, −1 m/s² for 1 s (Δz = 1 m), starting at t = 2 s
-    const double tc = t - 2.0;
-    if (tc <= 0.0) return Truth{p0, Vec3::Zero(), Vec3::Zero()};
-    if (tc <= 1.0) return Truth{p0 + Vec3(0, 0, 0.5 * tc * tc), Vec3(0, 0, tc), Vec3(0, 0, 1.0)};
-    if (tc <= 2.0) {
-      const double s = tc - 1.0;
-      return Truth{p0 + Vec3(0, 0, 0.5 + s - 0.5 * s * s), Vec3(0, 0, 1.0 - s), Vec3(0, 0, -1.0)};
-    }
-    return Truth{p0 + Vec3(0, 0, 1.0), Vec3::Zero(), Vec3::Zero()};
-  };
-  const auto ground_error = [](double t, int pair) { return t < 2.0 ? ((pair % 2) ? 2.0 : -2.0) : 0.0; };
-  EkfParams p;  // defaults: detect take-off
-  // WHEN localizing
-  const LocalizerResult r =
-      TdoaLocalizer(p, anchors).run(makeLog(anchors, truth, 10.0, 0.1, true, 4, ground_error));
-  // THEN take-off is detected shortly after 2 s, ground TDoA were not used, and the estimate is not dragged off
-  EXPECT_GT(r.summary.takeoff_t_s, 2.0);
-  EXPECT_LT(r.summary.takeoff_t_s, 2.8);
-  EXPECT_GT(r.summary.n_tdoa_ground, 700u);
-  EXPECT_LT(finalError(r, truth), 0.15);
-  for (const LocalizerEstimate& e : r.estimates) {
-    if (e.phase == FlightPhase::kGround) {
-      EXPECT_LT(e.x.w_v_b.norm(), 0.1) << "t = " << e.t_s;
-    }
-  }
-}
-
 TEST(GroundPhase, UserGivenStartSkipsMultilateration) {
   // GIVEN a hovering body and a start position given by the user
   const AnchorTable anchors = boxAnchors();

@@ -204,8 +204,8 @@ TEST(TofLocalizer, InvalidAndOutOfRangeReadingsAreIgnoredAndCounted) {
   ASSERT_EQ(r_dirty.estimates.size(), r_valid.estimates.size());
   for (std::size_t i = 0; i < r_dirty.estimates.size(); ++i)
     ASSERT_EQ(r_dirty.estimates[i].x.w_p_b, r_valid.estimates[i].x.w_p_b) << "at " << r_dirty.estimates[i].t_s;
-  // AND readings on the ground are not used
-  EXPECT_GT(r_dirty.summary.n_tof_not_airborne, 0u);
+  // AND readings before the position is known are not used
+  EXPECT_GT(r_dirty.summary.n_tof_not_ready, 0u);
 }
 
 TEST(TofLocalizer, DefaultOffLeavesTheEstimatesUnchanged) {

@@ -19,6 +19,8 @@ struct EstimateCheckParams {
   double ceiling_z_m = std::numeric_limits<double>::infinity();  ///< arena top (e.g. the highest anchor) [m]
   double settle_error_m = 0.3;      ///< "settled": error at or below this [m]
   double step_max_dt_s = 0.05;      ///< steps are measured between outputs at most this far apart [s]
+  /// Start of the log (e.g. the first TDoA) for the early-error window; NaN: the first estimate [s]
+  double t_start_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct EstimateChecks {
@@ -33,7 +35,8 @@ struct EstimateChecks {
   /// Time from the first estimate until the error stays ≤ settle_error_m for the rest of the airborne flight
   /// (NaN: never; 0: from the start).
   double settle_time_s = std::numeric_limits<double>::quiet_NaN();
-  double max_error_after_3s_m = 0.0;    ///< largest error later than 3 s after the first estimate
+  double max_error_after_3s_m = 0.0;    ///< largest airborne error later than 3 s after t_start_s
+  double rmse_3_to_5s_m = std::numeric_limits<double>::quiet_NaN();  ///< airborne RMSE over [t_start + 3, + 5] s
 };
 
 /// The checks of `estimate` against the compared samples of computeTrajectoryMetrics (metrics.samples).

@@ -27,10 +27,11 @@ enum class ProcessModel {
 /// Robust loss of the iteratively reweighted TDoA update (docs/math/filter.md F13).
 enum class RobustLoss { kNone, kHuber, kCauchy };
 
-/// Strategy for the time on the ground before take-off (docs/math/filter.md F15–F16).
+/// Whether the IMU's evidence of the ground is used (docs/math/filter.md F14, F18).
 enum class GroundPhase {
-  kDetectTakeoff,  ///< hold at rest (zero-velocity updates), ignore TDoA until take-off is detected
-  kNone,           ///< use TDoA from the first sample (e.g. flights that start in the air)
+  kDetectTakeoff,  ///< "detect": at rest or in floor contact (re-decided at every IMU sample) → zero-velocity updates,
+                   ///< floor height, TDoA down-weighted (never dropped)
+  kNone,           ///< "none": no ground evidence (every TDoA at the flight std; no zero-velocity updates)
 };
 
 struct EkfParams {
@@ -91,10 +92,8 @@ struct EkfParams {
 
   // --- ground phase and start ---
   GroundPhase ground_phase = GroundPhase::kDetectTakeoff;
-  double takeoff_climb_mps = 0.25;       ///< take-off: vertical velocity from the accelerometer above this
-  double takeoff_acc_mps2 = 0.6;         ///< …or mean vertical specific-force excess over 0.1 s above this
-  double landing_height_m = 0.12;        ///< landed: estimate this close to the take-off height …
-  double landing_hold_s = 0.5;           ///< … and nearly still for this long
+  /// Take-off from the ground (F15): vertical velocity from the accelerometer's leaky integral above this [m/s]
+  double takeoff_climb_mps = 0.25;
   /// Added (as a std) to the thrust-axis accelerometer bias at take-off (docs/math/filter.md F20). The bias learned
   /// on the ground (zero-velocity updates) is not the one in flight: with the motors running the thrust-model
   /// residual against the Vicon acceleration is −0.06…−0.09 m/s² while the ground estimate is −0.09…+0.10 m/s²
@@ -118,6 +117,7 @@ struct EkfParams {
   double start_window_s = 0.6;           ///< multilateration window of the start / re-acquisition [s] (F16)
   double moving_start_vel_sigma_mps = 1.0;  ///< velocity std when the IMU starts while moving (in the air) [m/s]
   double moving_start_att_sigma_rad = 0.1;  ///< roll/pitch std when the IMU starts while moving [rad]
+  double moving_start_yaw_sigma_rad = 0.02; ///< yaw std when the IMU starts while moving [rad] (yaw 0 assumed)
   /// Std of the slowly varying TDoA bias as seen in the position (F23): the reported position covariance is the
   /// filter's plus this bias term mapped through the current anchor geometry. 0 reports the filter's P alone.
   double output_bias_sigma_m = 0.2;

@@ -1,17 +1,16 @@
 /** @file ProtocolScenarios.cpp
  *  @brief Simulated flights of the generalization protocol (docs/math/simulation.md S1–S20 for the simulator).
  */
-#include "ProtocolScenarios.h"
+#include "uwb/eval/ProtocolScenarios.h"
 
 #include <cmath>
 #include <filesystem>
 
-#include "Command.h"
 #include "uwb/io/FlightWindow.h"
 #include "uwb/sim/FlightSimulator.h"
 #include "uwb/sim/Scenario.h"
 
-namespace uwb::app {
+namespace uwb {
 namespace {
 
 /// Another room: the paper's anchors rotated by 30° about z and moved by (3, −2, 0) m.
@@ -46,20 +45,21 @@ sim::SimParams simParams(std::uint64_t field_seed) {
 
 }  // namespace
 
-std::vector<SimScenarioRun> protocolSimulations() {
+std::vector<SimScenarioRun> protocolSimulations(const std::string& data_dir, const std::vector<std::uint64_t>& seeds,
+                                                const std::string& only) {
   struct Layout {
     std::string name;
     AnchorSurvey survey;
   };
   std::vector<Layout> layouts = {{"paper", sim::paperAnchors()}, {"moved", movedPaperAnchors()}};
   try {
-    layouts.push_back({"const4", sim::anchorPreset("util-const4", defaultDataDir())});
+    layouts.push_back({"const4", sim::anchorPreset("util-const4", data_dir)});
   } catch (const std::exception&) {
     // the UTIL constellation needs the real-data folder; the two built-in layouts remain
   }
   std::vector<SimScenarioRun> out;
   for (const Layout& layout : layouts) {
-    for (std::uint64_t seed : {11u, 12u, 13u}) {
+    for (std::uint64_t seed : seeds) {
       const sim::SimParams sp = simParams(seed);
       const std::string tag = layout.name + "-s" + std::to_string(seed);
       {
@@ -114,7 +114,9 @@ std::vector<SimScenarioRun> protocolSimulations() {
       }
     }
   }
+  if (!only.empty())
+    std::erase_if(out, [&](const SimScenarioRun& r) { return r.name.find(only) == std::string::npos; });
   return out;
 }
 
-}  // namespace uwb::app
+}  // namespace uwb

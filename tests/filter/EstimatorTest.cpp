@@ -1,0 +1,273 @@
+/** @file EstimatorTest.cpp
+ *  @brief The online estimator and its components on synthetic flights: the batch path equals the online loop,
+ *         starts in motion (F16b) and on the floor (F16c), rest and contact evidence (F18), time jumps and
+ *         re-acquisition (F16, F17), the floor (F22) and the reported covariance (F23).
+ */
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "FilterTestUtil.h"
+#include "uwb/filter/Estimator.h"
+#include "uwb/filter/Multilateration.h"
+#include "uwb/filter/RestDetector.h"
+#include "uwb/filter/TdoaLocalizer.h"
+#include "uwb/model/TdoaModel.h"
+
+namespace uwb {
+namespace {
+
+using filtertest::arenaAnchors;
+
+/// A body flying a horizontal circle (r = 1 m, 0.8 rad/s) at 1.4 m around (0.5, 0): position, velocity, acceleration.
+struct CircleTruth {
+  Vec3 p, v, a;
+};
+CircleTruth circle(double t) {
+  const double w = 0.8, r = 1.0;
+  return {Vec3(0.5 + r * std::cos(w * t), r * std::sin(w * t), 1.4),
+          Vec3(-r * w * std::sin(w * t), r * w * std::cos(w * t), 0.0),
+          Vec3(-r * w * w * std::cos(w * t), -r * w * w * std::sin(w * t), 0.0)};
+}
+
+/// IMU (1 kHz, level body, rotor vibration) and TDoA (400 Hz, neighbour pairs) of the circle flight over [t0, t1].
+SensorLog circleLog(double t0, double t1, unsigned seed, double tdoa_sigma_m = 0.05) {
+  const AnchorTable anchors = arenaAnchors();
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  SensorLog log;
+  for (double t = t0; t <= t1; t += 0.001) {
+    TimedImu s;
+    s.t_s = t;
+    // full-model specific force of a level body: a + g e_z (the filter's thrust model sees only its z part)
+    s.imu.b_acc_mps2 = circle(t).a + Vec3(0, 0, kGravity_mps2) + 0.5 * Vec3(n(rng), n(rng), n(rng));
+    s.imu.b_gyro_radps = 0.05 * Vec3(n(rng), n(rng), n(rng));
+    log.imu.push_back(s);
+  }
+  int k = 0;
+  for (double t = t0; t <= t1; t += 0.0025, ++k) {
+    const int a = k % 8, b = (k + 1) % 8;
+    const Vec3 p_tag = tagPosition(circle(t).p, Quat::Identity(), kUtilTagOffset_b);
+    log.tdoa.push_back({t, a, b, range(p_tag, anchors.find(b)->m) - range(p_tag, anchors.find(a)->m) +
+                                     tdoa_sigma_m * n(rng)});
+  }
+  return log;
+}
+
+EkfParams lateralFullParams() {
+  EkfParams p;
+  p.accel_model = AccelModel::kFull;  // the synthetic IMU carries the horizontal acceleration
+  return p;
+}
+
+TEST(Estimator, BatchRunEqualsTheOnlineLoop) {
+  // GIVEN a synthetic take-off log and the default parameters
+  filtertest::TakeoffLogSpec spec;
+  spec.duration_s = 6.0;
+  const SensorLog log = filtertest::takeoffLog(spec);
+  const EkfParams p;
+  // WHEN the batch path runs with one output per event, and the same events are pushed one at a time
+  const LocalizerResult batch = TdoaLocalizer(p, arenaAnchors()).run(log, 0.0);
+  Estimator online(p, arenaAnchors());
+  std::vector<LocalizerEstimate> out;
+  SensorEventCursor cursor(log);
+  for (SensorEvent ev; cursor.next(ev);) {
+    if (ev.kind == SensorEvent::Kind::kImu) online.addImu(ev.t_s, log.imu[ev.index].imu);
+    else online.addTdoa(log.tdoa[ev.index]);
+    if (online.ready()) out.push_back(online.estimate());
+  }
+  // THEN every output is the same, bit for bit, in the same number
+  ASSERT_GT(batch.estimates.size(), 1000u);
+  ASSERT_EQ(out.size(), batch.estimates.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    EXPECT_EQ(out[i].x.w_p_b, batch.estimates[i].x.w_p_b) << i;
+    EXPECT_EQ(out[i].x.w_q_b.coeffs(), batch.estimates[i].x.w_q_b.coeffs()) << i;
+    EXPECT_EQ(out[i].sigma_p_m, batch.estimates[i].sigma_p_m) << i;
+  }
+  EXPECT_EQ(online.summary().n_tdoa_used, batch.summary.n_tdoa_used);
+}
+
+TEST(Estimator, StartsInTheAirWithUnknownVelocity) {
+  // GIVEN a log that begins while the body circles at 0.8 m/s (no ground phase, no start position)
+  const SensorLog log = circleLog(3.0, 13.0, 7);
+  // WHEN localizing with the defaults
+  const LocalizerResult r = TdoaLocalizer(lateralFullParams(), arenaAnchors()).run(log);
+  // THEN the position is found within a second and is within 0.3 m from 3 s after the first TDoA on
+  ASSERT_FALSE(r.estimates.empty());
+  EXPECT_LT(r.summary.ready_t_s, 3.0 + 1.0);
+  double worst = 0.0;
+  for (const LocalizerEstimate& e : r.estimates)
+    if (e.t_s > 3.0 + 3.0) worst = std::max(worst, (e.x.w_p_b - circle(e.t_s).p).norm());
+  EXPECT_LT(worst, 0.3);
+  // and at least 90 % of the TDoA were used, gated or went into the start-up
+  const LocalizerSummary& s = r.summary;
+  EXPECT_GE(static_cast<double>(s.n_tdoa_used + s.n_tdoa_rejected + s.n_tdoa_start), 0.9 * s.n_tdoa_total);
+  EXPECT_EQ(s.n_reacquisitions, 0u);
+}
+
+TEST(Estimator, RecoversFromATimeJumpInAllStreams) {
+  // GIVEN the circle log with every stamp after t = 8 s moved 5 s later (a clock jump), the truth moved with it
+  SensorLog log = circleLog(0.0, 14.0, 9);
+  for (auto& s : log.imu)
+    if (s.t_s > 8.0) s.t_s += 5.0;
+  for (auto& s : log.tdoa)
+    if (s.t_s > 8.0) s.t_s += 5.0;
+  // WHEN localizing
+  const LocalizerResult r = TdoaLocalizer(lateralFullParams(), arenaAnchors()).run(log);
+  // THEN the jump is seen, and 3 s after it the estimate is back within 0.3 m of the truth
+  EXPECT_GE(r.summary.n_time_jumps, 1u);
+  double worst = 0.0;
+  for (const LocalizerEstimate& e : r.estimates)
+    if (e.t_s > 13.0 + 3.0) worst = std::max(worst, (e.x.w_p_b - circle(e.t_s - 5.0).p).norm());
+  EXPECT_LT(worst, 0.3);
+}
+
+TEST(Estimator, ReacquiresAfterGarbageTdoa) {
+  // GIVEN the circle log with 2 s of uniformly random TDoA in [−10, 10] m
+  SensorLog log = circleLog(0.0, 16.0, 3);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-10.0, 10.0);
+  for (auto& z : log.tdoa)
+    if (z.t_s > 6.0 && z.t_s < 8.0) z.tdoa_m = u(rng);
+  // WHEN localizing
+  const LocalizerResult r = TdoaLocalizer(lateralFullParams(), arenaAnchors()).run(log);
+  // THEN 3 s after the garbage the estimate is within 0.3 m again
+  double worst = 0.0;
+  for (const LocalizerEstimate& e : r.estimates)
+    if (e.t_s > 11.0) worst = std::max(worst, (e.x.w_p_b - circle(e.t_s).p).norm());
+  EXPECT_LT(worst, 0.3);
+}
+
+TEST(Estimator, GroundTdoaAreDownWeightedNotDropped) {
+  // GIVEN a take-off log whose TDoA on the floor carry a height bias of +1 m (floor multipath) for 2 s
+  filtertest::TakeoffLogSpec spec;
+  spec.duration_s = 10.0;
+  spec.acc_noise_mps2 = 0.8;  // motors running (the frame shakes against the floor: floor_gyro_noise_radps)
+  spec.tdoa_dz = [](double t) { return t < 2.0 ? 1.0 : 0.0; };
+  // WHEN localizing
+  const LocalizerResult r = TdoaLocalizer(EkfParams{}, arenaAnchors()).run(filtertest::takeoffLog(spec));
+  // THEN the floor TDoA were used (down-weighted), the estimate stayed near the floor before the climb, and the
+  // hover at the end is accurate
+  EXPECT_GT(r.summary.n_tdoa_used_at_rest, 100u);
+  for (const LocalizerEstimate& e : r.estimates)
+    if (e.t_s > 1.0 && e.t_s < 1.9) EXPECT_LT(e.x.w_p_b.z(), 0.4) << e.t_s;
+  const LocalizerEstimate& last = r.estimates.back();
+  EXPECT_LT((last.x.w_p_b - Vec3(0.8, -0.5, 1.05)).norm(), 0.15);
+  EXPECT_FALSE(std::isnan(r.summary.takeoff_t_s));
+}
+
+TEST(Estimator, ReportedCovarianceAddsTheBiasFloor) {
+  // GIVEN the circle flight, once with the bias floor of F23 and once without
+  const SensorLog log = circleLog(0.0, 8.0, 2);
+  EkfParams with = lateralFullParams();
+  with.output_bias_sigma_m = 0.2;
+  EkfParams without = with;
+  without.output_bias_sigma_m = 0.0;
+  const LocalizerResult a = TdoaLocalizer(with, arenaAnchors()).run(log, 0.1);
+  const LocalizerResult b = TdoaLocalizer(without, arenaAnchors()).run(log, 0.1);
+  // THEN the states are the same, the reported σ larger by at least σ_b · (smallest singular value of H)⁻¹
+  ASSERT_EQ(a.estimates.size(), b.estimates.size());
+  const LocalizerEstimate& ea = a.estimates.back();
+  const LocalizerEstimate& eb = b.estimates.back();
+  EXPECT_EQ(ea.x.w_p_b, eb.x.w_p_b);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_GT(ea.sigma_p_m(k), eb.sigma_p_m(k));
+    // |h| ≤ 2 for every pair, so (HᵀH)⁻¹ ≥ I/(4 m) with m = 8 pairs in view
+    EXPECT_GE(ea.sigma_p_m(k) * ea.sigma_p_m(k), eb.sigma_p_m(k) * eb.sigma_p_m(k) + 0.04 / (4.0 * 8.0));
+  }
+  // and the pose covariance is symmetric with the position block matching σ
+  EXPECT_LT((ea.cov_pose - ea.cov_pose.transpose()).norm(), 1e-12 * ea.cov_pose.norm());
+  EXPECT_DOUBLE_EQ(std::sqrt(ea.cov_pose(2, 2)), ea.sigma_p_m.z());
+}
+
+TEST(RestDetector, RestIsDecidedAndRevisedFromTheImu) {
+  RestDetector d;
+  std::mt19937 rng(1);
+  std::normal_distribution<double> n(0.0, 1.0);
+  ImuReading still;
+  d.reset(still);
+  double t = 0.0;
+  // GIVEN a still IMU for 1 s THEN it is at rest and not shaking
+  for (; t < 1.0; t += 0.001) {
+    ImuReading m;
+    m.b_acc_mps2 += 0.01 * Vec3(n(rng), n(rng), n(rng));
+    m.b_gyro_radps = 0.001 * Vec3(n(rng), n(rng), n(rng));
+    d.update(t, m, 0.001);
+  }
+  EXPECT_TRUE(d.atRest());
+  EXPECT_FALSE(d.shaking());
+  // WHEN the rotors spin up (vibration) THEN rest ends within 0.2 s
+  double t_end = -1.0;
+  for (; t < 2.0; t += 0.001) {
+    ImuReading m;
+    m.b_acc_mps2 += 1.0 * Vec3(n(rng), n(rng), n(rng));
+    m.b_gyro_radps = 0.05 * Vec3(n(rng), n(rng), n(rng));
+    d.update(t, m, 0.001);
+    if (!d.atRest() && t_end < 0.0) t_end = t;
+  }
+  EXPECT_LT(t_end - 1.0, 0.2);
+  EXPECT_FALSE(d.shaking());  // flight-level gyro noise is not floor contact
+  // WHEN the frame shakes against the floor THEN shaking is reported
+  for (; t < 2.5; t += 0.001) {
+    ImuReading m;
+    m.b_acc_mps2 += 1.0 * Vec3(n(rng), n(rng), n(rng));
+    m.b_gyro_radps = 0.5 * Vec3(n(rng), n(rng), n(rng));
+    d.update(t, m, 0.001);
+  }
+  EXPECT_TRUE(d.shaking());
+}
+
+TEST(Multilateration, MovingSolveRecoversPositionAndVelocity) {
+  // GIVEN noise-free TDoA of a body moving at (0.6, −0.4, 0.1) m/s from (0.3, 0.2, 1.2) for 0.6 s, with zero
+  // predicted displacement (the filter knew nothing of the motion)
+  const AnchorTable anchors = arenaAnchors();
+  const Vec3 p0(0.3, 0.2, 1.2), v0(0.6, -0.4, 0.1);
+  std::vector<MultilaterationSample> s;
+  int k = 0;
+  for (double t = 0.0; t <= 0.6; t += 0.0025, ++k) {
+    const int a = k % 8, b = (k + 1) % 8;
+    const Vec3 p_tag = tagPosition(p0 + t * v0, Quat::Identity(), kUtilTagOffset_b);
+    MultilaterationSample m;
+    m.z = {t, a, b, range(p_tag, anchors.find(b)->m) - range(p_tag, anchors.find(a)->m)};
+    s.push_back(m);
+  }
+  const std::vector<Vec3> guesses = {Vec3(0, 0, 1.5)};
+  // WHEN solving for position only and for position and velocity
+  const auto still = multilaterate(s, anchors, kUtilTagOffset_b, guesses);
+  const auto moving = multilaterateMoving(s, anchors, kUtilTagOffset_b, guesses, 0.0);
+  // THEN the moving solve recovers both to a millimetre; the static one is off by about half the distance flown
+  ASSERT_TRUE(moving && still);
+  EXPECT_LT((moving->w_p0 - p0).norm(), 1e-3);
+  EXPECT_LT((moving->w_v0 - v0).norm(), 1e-3);
+  EXPECT_GT((still->w_p0 - p0).norm(), 0.1);
+  // and too short a window is refused
+  const std::vector<MultilaterationSample> shortw(s.begin(), s.begin() + 20);
+  EXPECT_FALSE(multilaterateMoving(shortw, anchors, kUtilTagOffset_b, guesses, 0.0));
+}
+
+TEST(Multilateration, OnTheFloorOnlyXAndYAreSolved) {
+  // GIVEN TDoA of a body on the floor whose height they overstate by 1 m (floor multipath)
+  const AnchorTable anchors = arenaAnchors();
+  const Vec3 p(1.0, -1.5, 0.03);
+  std::vector<MultilaterationSample> s;
+  for (int k = 0; k < 80; ++k) {
+    const int a = k % 8, b = (k + 1) % 8;
+    const Vec3 p_tag = tagPosition(p + Vec3(0, 0, 1.0), Quat::Identity(), kUtilTagOffset_b);
+    MultilaterationSample m;
+    m.z = {0.0025 * k, a, b, range(p_tag, anchors.find(b)->m) - range(p_tag, anchors.find(a)->m)};
+    s.push_back(m);
+  }
+  // WHEN solving on the floor (z = 0.03) and freely
+  const auto floor = multilaterateOnFloor(s, anchors, kUtilTagOffset_b, {Vec3(0, 0, 0.5)}, 0.03);
+  const auto free = multilaterate(s, anchors, kUtilTagOffset_b, {Vec3(0, 0, 0.5)});
+  // THEN the floor solve keeps z and its covariance has no z part; the free one follows the bias up
+  ASSERT_TRUE(floor && free);
+  EXPECT_DOUBLE_EQ(floor->w_p0.z(), 0.03);
+  EXPECT_EQ(floor->covariance(2, 2), 0.0);
+  EXPECT_LT((floor->w_p0.head<2>() - p.head<2>()).norm(), 0.5);
+  EXPECT_GT(free->w_p0.z(), 0.8);
+}
+
+}  // namespace
+}  // namespace uwb

@@ -1,0 +1,87 @@
+/** @file GeneralizationTest.cpp
+ *  @brief Flights the defaults were not chosen on (docs/math/filter.md F14–F23, `uwbtdoa protocol`): a real flight
+ *         whose log starts in the air, a simulated start in hover, a simulated flight with two take-offs. Bounds are
+ *         the protocol's values at the time of commit plus a margin.
+ */
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "support/TestSupport.h"
+#include "uwb/eval/EstimateChecks.h"
+#include "uwb/eval/Localization.h"
+#include "uwb/eval/ProtocolScenarios.h"
+#include "uwb/io/FlightWindow.h"
+#include "uwb/io/UtilCsv.h"
+
+namespace uwb {
+namespace {
+
+EstimateChecks checks(const LocalizationRun& run, const Flight& flight, const AnchorSurvey& survey) {
+  EstimateCheckParams cp;
+  cp.ceiling_z_m = -1e300;
+  for (const Anchor& a : survey.anchors) cp.ceiling_z_m = std::max(cp.ceiling_z_m, a.w_p.z());
+  cp.t_start_s = flight.tdoa.front().t_s;
+  return checkEstimate(run.trajectory, *run.metrics, cp);
+}
+
+const SimScenarioRun& scenario(const std::vector<SimScenarioRun>& runs, const std::string& name) {
+  for (const SimScenarioRun& r : runs)
+    if (r.name == name) return r;
+  throw std::runtime_error("no scenario " + name);
+}
+
+TEST(Generalization, RealFlightLoggedFromMidAir) {
+  // GIVEN a real dev flight cut to start 10 s after power-up (in the air) and to end 1 s before the landing
+  const auto path = test::pilotFlight("0425-traj3");
+  UWB_REQUIRE_REAL_DATA(path);
+  const AnchorSurvey survey = readAnchorSurvey(test::pilotSurvey("0425").string());
+  const Flight full = readFlightCsv(path->string());
+  const Flight cut = sliceFlight(full, 10.0, 29.5);
+  // WHEN localizing it with the defaults
+  const LocalizationRun run = localizeFlight(cut, survey);
+  // THEN the airborne RMSE is that of a whole flight, 3–5 s after the first TDoA the error is small, no step jumps
+  ASSERT_TRUE(run.metrics);
+  EXPECT_LT(run.metrics->airborne.rmse_m, 0.30);
+  const EstimateChecks c = checks(run, cut, survey);
+  EXPECT_LT(c.rmse_3_to_5s_m, 0.35);
+  EXPECT_LT(c.max_airborne_step_m, 0.3);
+  EXPECT_EQ(run.summary.n_reacquisitions, 0u);
+}
+
+TEST(Generalization, SimulatedStartInHover) {
+  // GIVEN a simulated circle flight whose log starts 2 s after the climb (paper anchors, drone/room seed 11)
+  const std::vector<SimScenarioRun> runs = protocolSimulations("", {11}, "hover-start-paper");
+  const SimScenarioRun& s = scenario(runs, "hover-start-paper-s11");
+  // WHEN localizing
+  const LocalizationRun run = localizeFlight(s.flight, s.survey);
+  // THEN the position is found at once and the error is that of the rest of the flight within 3 s
+  ASSERT_TRUE(run.metrics);
+  EXPECT_LT(run.summary.ready_t_s - s.flight.tdoa.front().t_s, 1.0);
+  EXPECT_LT(run.metrics->airborne.rmse_m, 0.30);
+  const EstimateChecks c = checks(run, s.flight, s.survey);
+  EXPECT_LT(c.rmse_3_to_5s_m, 0.40);
+  const LocalizerSummary& sum = run.summary;
+  EXPECT_GE(static_cast<double>(sum.n_tdoa_used + sum.n_tdoa_rejected + sum.n_tdoa_start), 0.9 * sum.n_tdoa_total);
+}
+
+TEST(Generalization, SimulatedTwoTakeoffs) {
+  // GIVEN a simulated circle flight, a landing, and a second flight (a hover) from where it landed
+  const std::vector<SimScenarioRun> runs = protocolSimulations("", {11}, "two-takeoffs-paper");
+  const SimScenarioRun& s = scenario(runs, "two-takeoffs-paper-s11");
+  // WHEN localizing
+  const LocalizationRun run = localizeFlight(s.flight, s.survey);
+  // THEN both flights are tracked, the body rested twice, nothing is below the floor or above the anchors on the
+  // ground, and no output jumps while airborne
+  ASSERT_TRUE(run.metrics);
+  EXPECT_LT(run.metrics->airborne.rmse_m, 0.32);
+  EXPECT_GE(run.summary.n_rest_periods, 2u);
+  const EstimateChecks c = checks(run, s.flight, s.survey);
+  EXPECT_FALSE(c.floor_or_ceiling_violated);
+  EXPECT_LT(c.max_airborne_step_m, 0.3);
+  const LocalizerSummary& sum = run.summary;
+  EXPECT_GE(static_cast<double>(sum.n_tdoa_used + sum.n_tdoa_rejected + sum.n_tdoa_start), 0.9 * sum.n_tdoa_total);
+}
+
+}  // namespace
+}  // namespace uwb
