@@ -43,7 +43,9 @@ constexpr double kGroundHeightSigma_m = 0.1;
 /// Ground contact (F18): shaking within this long counts [s]; only below this estimated height above the floor [m];
 /// after leaving the ground, shaking counts again only after this long [s] (the take-off's own transient).
 constexpr double kContactHold_s = 0.3;
-constexpr double kContactMaxHeight_m = 0.5;
+constexpr double kContactMaxHeight_m = 0.8;
+/// The contact height test uses the lowest estimate of the last 1.5 s, sampled every 50 ms (F18).
+constexpr double kLowZPeriod_s = 0.05;
 constexpr double kContactRearm_s = 0.5;
 constexpr double kContactSustained_s = 1.5;
 /// Below this estimated height above the floor TDoA are down-weighted as on the ground (F14) [m].
@@ -229,6 +231,7 @@ void Estimator::leaveGround(double t_s, bool climbing) {
 
 void Estimator::enterGround(double t_s) {
   on_ground_ = true;
+  n_low_z_ = 0;
   v_climb_ = 0.0;
   ++summary_.n_rest_periods;
   if (moved_) summary_.landing_t_s = t_s;
@@ -324,9 +327,19 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
       if (t_s - t_last_shake_ >= kContactHold_s) t_shake_since_ = t_s;  // a new shaking episode
       t_last_shake_ = t_s;
     }
+    // recent lowest height: on ground contact the estimate can run away upwards (contact force in the thrust
+    // model, floor-biased TDoA) before the shaking shows
+    if (ready_ && t_s - t_low_z_sample_ >= kLowZPeriod_s) {
+      low_z_[i_low_z_] = ekf_.state().w_p_b.z();
+      i_low_z_ = (i_low_z_ + 1) % low_z_.size();
+      n_low_z_ = std::min(n_low_z_ + 1, low_z_.size());
+      t_low_z_sample_ = t_s;
+    }
+    double z_low = ready_ ? ekf_.state().w_p_b.z() : 0.0;
+    for (std::size_t k = 0; k < n_low_z_; ++k) z_low = std::min(z_low, low_z_[k]);
     // shaking near the floor, or shaking for long wherever the estimate is (flight shakes only briefly)
     const bool contact = t_s - t_last_shake_ < kContactHold_s &&
-                         (!ready_ || ekf_.state().w_p_b.z() - params_.ground_z_m < kContactMaxHeight_m ||
+                         (!ready_ || z_low - params_.ground_z_m < kContactMaxHeight_m ||
                           t_s - t_shake_since_ >= kContactSustained_s);
     const bool ground_now = (rest_.atRest() || contact) && !climbing;
     if (ground_now && !on_ground_) {

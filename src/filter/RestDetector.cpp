@@ -21,9 +21,10 @@ RestDetector::RestDetector(const RestDetectorParams& params)
       acc_var_max_(params.acc_std_mps2 * params.acc_std_mps2),
       gyro_ms_max_(params.gyro_rms_radps * params.gyro_rms_radps),
       rate_per_s_(1.0 / params.tau_s),
+      hp_rate_per_s_(1.0 / params.hp_tau_s),
       contact_ms_min_(params.contact_gyro_hp_rms_radps * params.contact_gyro_hp_rms_radps) {
   if (!(params.acc_std_mps2 > 0.0 && params.gyro_rms_radps > 0.0 && params.tau_s > 0.0 && params.min_hold_s >= 0.0 &&
-        params.contact_gyro_hp_rms_radps > 0.0))
+        params.contact_gyro_hp_rms_radps > 0.0 && params.hp_tau_s > 0.0))
     throw std::invalid_argument("RestDetectorParams: thresholds and tau_s must be > 0, min_hold_s >= 0");
 }
 
@@ -46,8 +47,9 @@ void RestDetector::update(double t_s, const ImuReading& imu, double dt_s) {
     acc_mean_ = a * acc_mean_ + (1 - a) * an;
     acc_var_ = a * acc_var_ + (1 - a) * (an - acc_mean_) * (an - acc_mean_);
     gyro_ms_ = a * gyro_ms_ + (1 - a) * imu.b_gyro_radps.squaredNorm();
-    // high-passed gyro: deviation from its own moving mean (rotor-frame shaking, not turning)
-    gyro_mean_ = a * gyro_mean_ + (1 - a) * imu.b_gyro_radps;
+    // high-passed gyro: deviation from its own short moving mean (rotor-frame shaking, not turning)
+    const double a_hp = expNegative(dt_s * hp_rate_per_s_);
+    gyro_mean_ = a_hp * gyro_mean_ + (1 - a_hp) * imu.b_gyro_radps;
     gyro_hp_ms_ = a * gyro_hp_ms_ + (1 - a) * (imu.b_gyro_radps - gyro_mean_).squaredNorm();
   }
   const bool still = stillNow();

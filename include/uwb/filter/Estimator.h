@@ -17,6 +17,7 @@
  */
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <limits>
 #include <string>
@@ -145,6 +146,9 @@ class Estimator {
   double v_climb_ = 0.0;         ///< take-off detector's vertical velocity (F15) [m/s]
   double g_ref_ = kGravity_mps2; ///< vertical specific force on the ground [m/s²]
   double t_last_shake_ = -1e300, t_shake_since_ = 0.0, t_left_ground_ = -1e300;
+  std::array<double, 30> low_z_{};  ///< recent heights, one per 50 ms (F18)
+  std::size_t i_low_z_ = 0, n_low_z_ = 0;
+  double t_low_z_sample_ = -1e300;
   bool moved_ = false;
   FlightPhase phase_ = FlightPhase::kAcquisition;
   double t_last_event_ = std::numeric_limits<double>::quiet_NaN();
