@@ -50,6 +50,8 @@ int featureDim(FeatureMap map);
 /// Writes the GP input row of f into row (featureDim(map) values).
 void featureRow(FeatureMap map, const TdoaFeature& f, double* row);
 MatX featureMatrix(FeatureMap map, const std::vector<TdoaFeature>& features);
+/// Names of the featureDim(map) input columns, with units (e.g. "b_p_a_x_m", "yaw_a_rad").
+std::vector<std::string> featureColumnNames(FeatureMap map);
 
 /// Paper and extra presets: kernel, feature map, one GP per pair or one global GP.
 struct BiasPreset {
@@ -84,6 +86,18 @@ struct BiasTrainReport {
   double mean_predicted_std_m = 0.0;  ///< mean predictive std (latent) on the held-out part
   double train_seconds = 0.0;
   int num_models = 0;
+  /// Full-data ELBO per datum of the returned model(s) on their training samples (docs/math/gp.md P41); with
+  /// several GPs, their mean weighted by training samples.
+  double final_elbo = 0.0;
+};
+
+/// Predictive distribution of a measurement's error ε (docs/math/gp.md P43): ε ~ N(mean, latent + noise).
+struct BiasPredictive {
+  double mean_m = 0.0;              ///< pair mean (P28) + GP mean
+  double latent_variance_m2 = 0.0;  ///< var_f of the GP mean (with the jitter)
+  double noise_variance_m2 = 0.0;   ///< σ_n² of the GP's likelihood: the part of ε the inputs do not explain
+  bool covered = false;             ///< false: no GP covers the pair (mean 0, variances 0)
+  double varianceM2() const { return latent_variance_m2 + noise_variance_m2; }
 };
 
 /// Progress: (model index, number of models, epoch report).
@@ -106,6 +120,8 @@ class BiasModel {
 
   /// Predicted bias (mean, latent variance) for one measurement's feature. {0, 0} when no model covers the pair.
   BiasPrediction predict(const TdoaFeature& f) const;
+  /// Predictive distribution of ε itself (latent and likelihood variance, without the extra variance P31).
+  BiasPredictive predictive(const TdoaFeature& f) const;
   /// A cheap-to-copy, thread-compatible callable for the filter (shares this model's immutable state).
   BiasPredictor predictor() const;
 
