@@ -81,6 +81,7 @@ void runAndReport(const std::vector<NamedFlight>& train, const std::vector<Named
   const std::string report = (std::filesystem::path(options.out_dir) / "REPORT.md").string();
   if (options.json) {
     const nlohmann::json j = {{"results", toJson(result.rows)},
+                              {"runs", runsToJson(result.runs)},
                               {"out_dir", options.out_dir},
                               {"report", report},
                               {"figures", figures},
@@ -92,6 +93,9 @@ void runAndReport(const std::vector<NamedFlight>& train, const std::vector<Named
     return;
   }
   std::cout << toMarkdown(result.rows) << '\n';
+  std::cout << fmt::format("per test flight, {} M = {} (bias calibration: docs/math/gp.md P43):\n", result.best_kernel,
+                           result.best_inducing)
+            << perFlightMarkdown(result.runs, result.best_kernel, result.best_inducing) << '\n';
   std::cout << fmt::format("best: {} with M = {}; report: {} ({} figures); {:.0f} s\n", result.best_kernel,
                            result.best_inducing, report, figures.size(), result.seconds);
 }
