@@ -117,7 +117,11 @@ def test_run_evaluation_writes_the_report_and_renders_its_figures(flights, tmp_p
     r = u.run_evaluation({"zigzag": train["flight"]}, {"circle": test["flight"]}, train["survey"], kernels=["z1"],
                          inducing=[8, 12], repeats=1, epochs=2, out=str(tmp_path), command="pytest", progress=lines.append)
     assert [row["inducing"] for row in r["rows"]] == [8, 12]
-    assert {"kernel", "improvement_pct", "improvement_pct_min", "improvement_pct_max"} <= set(r["rows"][0])
+    assert {"kernel", "change_pct", "change_pct_min", "change_pct_max", "coverage_1sigma", "coverage_2sigma",
+            "nlpd"} <= set(r["rows"][0])
+    run = r["runs"][0]
+    assert run["change_pct"] == pytest.approx(100 * (run["rmse_corrected_m"] / run["rmse_uncorrected_m"] - 1))
+    assert 0.0 <= run["coverage_1sigma"] <= run["coverage_2sigma"] <= 1.0
     assert any("training data" in line for line in lines)
     for name in ("results.json", "REPORT.md", "figdata/errors.csv", "fig5_improvement.png",
                  "fig6_error_distribution.png", "trajectory_circle.png"):

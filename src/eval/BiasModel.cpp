@@ -190,6 +190,7 @@ void BiasTrainParams::validate() const {
   if (!(holdout_block_s > 0)) throw std::invalid_argument("holdout_block_s must be > 0");
   if (min_samples_per_inducing < 1) throw std::invalid_argument("min_samples_per_inducing must be ≥ 1");
   if (!(extra_sigma_m >= 0) || !std::isfinite(extra_sigma_m)) throw std::invalid_argument("extra_sigma_m must be ≥ 0");
+  if (!(mean_scale >= 0) || mean_scale > 1) throw std::invalid_argument("mean_scale must be in [0, 1]");
   svgp.validate();
 }
 
@@ -212,6 +213,11 @@ void BiasModel::buildPredictors() {
   preds->reserve(entries_.size());
   for (const auto& e : entries_) preds->emplace_back(e.gp);
   predictors_ = preds;
+}
+
+void BiasModel::setMeanScale(double w) {
+  if (!(w >= 0.0) || w > 1.0) throw std::invalid_argument("bias model: mean_scale must be in [0, 1]");
+  mean_scale_ = w;
 }
 
 void BiasModel::setExtraVariance(double variance_m2) {
@@ -247,6 +253,7 @@ BiasPrediction BiasModel::predict(const TdoaFeature& f) const {
   BiasPrediction p = predictWith(entries_, *predictors_, features_, f);
   p.mean_m += pairMean(f.id_a, f.id_b);  // docs/math/gp.md (P28): m_AB + GP mean
   p.variance_m2 += extra_variance_m2_;    // (P31)
+  p.mean_m *= mean_scale_;                 // (P44)
   return p;
 }
 
@@ -261,6 +268,7 @@ BiasPredictive BiasModel::predictive(const TdoaFeature& f) const {
     p.latent_variance_m2 = std::max(p.latent_variance_m2, 0.0);
     p.noise_variance_m2 = e.gp.noiseVariance();  // (P43)
     p.mean_m += pairMean(f.id_a, f.id_b);       // (P28)
+    p.mean_m *= mean_scale_;                     // (P44)
     p.covered = true;
     return p;
   }
@@ -288,6 +296,7 @@ nlohmann::json BiasModel::toJson() const {
           {"models", models},
           {"pair_means", means},
           {"extra_variance_m2", extra_variance_m2_},
+          {"mean_scale", mean_scale_},
           {"training", meta}};
 }
 
@@ -314,6 +323,7 @@ BiasModel BiasModel::fromJson(const nlohmann::json& j) {
     BiasModel model(j.at("preset").get<std::string>(), map, std::move(entries), std::move(means));
     if (j.contains("training")) model.metadata_json = j.at("training").dump();
     if (j.contains("extra_variance_m2")) model.setExtraVariance(j.at("extra_variance_m2").get<double>());
+    if (j.contains("mean_scale")) model.setMeanScale(j.at("mean_scale").get<double>());
     return model;
   } catch (const nlohmann::json::exception& e) {
     throw std::invalid_argument(std::string("bias model: ") + e.what());
@@ -454,6 +464,7 @@ BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params,
   if (entries.empty()) throw std::invalid_argument("no anchor pair has enough training samples for the requested inducing points");
   BiasModel model(preset.name, preset.features, std::move(entries), std::move(means));
   model.setExtraVariance(params.extra_sigma_m * params.extra_sigma_m);  // (P31)
+  model.setMeanScale(params.mean_scale);                                 // (P44)
 
   if (report) {
     BiasTrainReport r;

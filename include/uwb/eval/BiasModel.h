@@ -75,6 +75,8 @@ struct BiasTrainParams {
   /// Std added (in quadrature) to every predicted bias variance, i.e. to the filter's TDoA noise R when the
   /// correction is on [m] (docs/math/gp.md P31). 0: the paper's R + latent variance only.
   double extra_sigma_m = 0.0;
+  /// Factor on the predicted mean stored in the model (P44); 1 = the paper's correction.
+  double mean_scale = 1.0;
   void validate() const;
 };
 
@@ -132,6 +134,9 @@ class BiasModel {
   /// Variance added to every prediction [m²] (P31).
   double extraVariance() const { return extra_variance_m2_; }
   void setExtraVariance(double variance_m2);  ///< throws std::invalid_argument when negative or not finite
+  /// Factor w ∈ [0, 1] on the predicted mean (docs/math/gp.md P44): the correction subtracts w·µ. 1 = the paper.
+  double meanScale() const { return mean_scale_; }
+  void setMeanScale(double w);  ///< throws std::invalid_argument outside [0, 1]
   /// Constant mean of the pair (0 when none was learned).
   double pairMean(int id_a, int id_b) const;
 
@@ -150,6 +155,7 @@ class BiasModel {
   std::vector<Entry> entries_;
   std::vector<PairMean> pair_means_;
   double extra_variance_m2_ = 0.0;
+  double mean_scale_ = 1.0;
   std::shared_ptr<const std::vector<gp::SvgpPredictor>> predictors_;
 };
 

@@ -29,7 +29,8 @@ struct EvaluationRun {
   std::vector<double> coverage;     ///< at calibrationLevels()
 };
 
-/// One row of the table: a kernel and a number of inducing points.
+/// One row of the table: a kernel and a number of inducing points. RMSEs are per flight (airborne samples of one
+/// flight), then averaged over test flights and repeats; they are not pooled over the samples of all flights.
 struct EvaluationRow {
   std::string kernel;
   int inducing = 0;
@@ -37,9 +38,11 @@ struct EvaluationRow {
   int n_flights = 0;
   double rmse_uncorrected_m = 0.0;  ///< mean over repeats and test flights
   double rmse_corrected_m = 0.0;    ///< mean over repeats and test flights
-  double improvement_pct = 0.0;     ///< 100 (1 − corrected / uncorrected), from the means above
-  double improvement_pct_min = 0.0; ///< over repeats (each repeat: mean over flights)
-  double improvement_pct_max = 0.0;
+  /// 100 (corrected / uncorrected − 1) from the means above: NEGATIVE = the correction reduced the error
+  /// (e.g. −18.4 %), the one sign convention of the tool, tables, JSON and docs.
+  double change_pct = 0.0;
+  double change_pct_min = 0.0;      ///< over repeats (each repeat: mean over flights); min = the best repeat
+  double change_pct_max = 0.0;
   double bias_rmse_before_m = 0.0;
   double bias_rmse_after_m = 0.0;
   double train_seconds = 0.0;       ///< mean per model
