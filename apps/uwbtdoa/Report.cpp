@@ -31,6 +31,9 @@ void EvaluationCliOptions::addTo(CLI::App& sub) {
       ->check(CLI::IsMember({"estimate", "truth"}))
       ->capture_default_str();
   sub.add_flag("--no-plots", no_plots, "Write the data and report but do not render PNG figures");
+  sub.add_flag("--full-variance", full_variance,
+               "Corrected measurements get the TDoA variance scaled by (var_f + noise)/E[eps^2] instead of R + var_f "
+               "(docs/math/gp.md P45)");
   sub.add_flag("--json", json, "Print one JSON object (results and paths) on stdout");
 }
 
@@ -43,6 +46,7 @@ EvaluationParams EvaluationCliOptions::toParams() const {
   p.dataset.inputs = biasInputSourceFromString(inputs);
   if (epochs > 0) p.train.svgp.epochs = epochs;
   if (batch > 0) p.train.svgp.batch_size = batch;
+  p.train.full_variance = full_variance;
   return p;
 }
 

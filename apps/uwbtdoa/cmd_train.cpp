@@ -32,7 +32,7 @@ struct TrainOptions {
   std::uint64_t seed = 1;
   double lr = 0.01, lr_inducing = 0.01, natgrad = 0.2, holdout = 0.2, extra_sigma = uwb::BiasTrainParams{}.extra_sigma_m;
   double min_z = 0.3, max_abs_error = 1.0, mean_scale = 1.0;
-  bool neighbour_only = false, json_out = false, quiet = false;
+  bool neighbour_only = false, json_out = false, quiet = false, full_variance = false;
 };
 
 void progressBar(int model, int models, const uwb::gp::EpochReport& r) {
@@ -98,6 +98,7 @@ void run(const TrainOptions& o) {
   tp.svgp.num_threads = o.threads;
   tp.extra_sigma_m = o.extra_sigma;
   tp.mean_scale = o.mean_scale;
+  tp.full_variance = o.full_variance;
   if (!o.dump_arrays.empty()) dumpArrays(o.dump_arrays, data, tp);
   uwb::BiasTrainReport rep;
   uwb::BiasModel model = uwb::trainBiasModel(data, tp, &rep, o.quiet ? uwb::BiasTrainProgress{} : uwb::BiasTrainProgress{progressBar});
@@ -128,6 +129,7 @@ void run(const TrainOptions& o) {
                {"inputs", o.inputs},
                {"extra_sigma_m", o.extra_sigma},
                {"mean_scale", o.mean_scale},
+               {"full_variance", o.full_variance},
                {"flights", o.flights},
                {"n_train", rep.n_train},
                {"n_holdout", rep.n_holdout},
@@ -187,6 +189,9 @@ void setup(CLI::App& sub) {
   sub.add_option("--mean-scale", o->mean_scale,
                  "Factor w in [0, 1] on the predicted bias mean stored in the model (docs/math/gp.md P44)")
       ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  sub.add_flag("--full-variance", o->full_variance,
+               "The filter uses the TDoA variance scaled by (var_f + noise)/E[eps^2] for corrected measurements instead "
+               "of adding var_f (docs/math/gp.md P45)");
   sub.add_option("--seed", o->seed, "Random seed (k-means++, shuffling)");
   sub.add_option("--lr", o->lr, "Adam learning rate of the hyperparameters");
   sub.add_option("--lr-inducing", o->lr_inducing, "Adam learning rate of the inducing points");

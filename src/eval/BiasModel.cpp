@@ -249,7 +249,27 @@ BiasPrediction predictWith(const std::vector<BiasModel::Entry>& entries, const s
 }
 }  // namespace
 
+void BiasModel::setFullVariance(bool on, double target_mean_square_m2) {
+  if (on && !(target_mean_square_m2 > 0.0 && std::isfinite(target_mean_square_m2)))
+    throw std::invalid_argument("bias model: the full variance needs the training targets' mean square > 0");
+  full_variance_ = on;
+  target_mean_square_m2_ = on ? target_mean_square_m2 : 0.0;
+}
+
 BiasPrediction BiasModel::predict(const TdoaFeature& f) const {
+  if (full_variance_) {
+    // docs/math/gp.md (P45): R = (var_f + σ_n²)/E[ε²] · σ_tdoa² + σ_x²
+    const BiasPredictive q = predictive(f);
+    BiasPrediction p;
+    p.variance_m2 = extra_variance_m2_;
+    if (q.covered) {
+      p.mean_m = q.mean_m;
+      p.noise_scale = q.varianceM2() / target_mean_square_m2_;
+    } else {
+      p.mean_m = mean_scale_ * pairMean(f.id_a, f.id_b);
+    }
+    return p;
+  }
   BiasPrediction p = predictWith(entries_, *predictors_, features_, f);
   p.mean_m += pairMean(f.id_a, f.id_b);  // docs/math/gp.md (P28): m_AB + GP mean
   p.variance_m2 += extra_variance_m2_;    // (P31)
@@ -297,6 +317,8 @@ nlohmann::json BiasModel::toJson() const {
           {"pair_means", means},
           {"extra_variance_m2", extra_variance_m2_},
           {"mean_scale", mean_scale_},
+          {"full_variance", full_variance_},
+          {"target_mean_square_m2", target_mean_square_m2_},
           {"training", meta}};
 }
 
@@ -324,6 +346,8 @@ BiasModel BiasModel::fromJson(const nlohmann::json& j) {
     if (j.contains("training")) model.metadata_json = j.at("training").dump();
     if (j.contains("extra_variance_m2")) model.setExtraVariance(j.at("extra_variance_m2").get<double>());
     if (j.contains("mean_scale")) model.setMeanScale(j.at("mean_scale").get<double>());
+    if (j.value("full_variance", false))
+      model.setFullVariance(true, j.at("target_mean_square_m2").get<double>());
     return model;
   } catch (const nlohmann::json::exception& e) {
     throw std::invalid_argument(std::string("bias model: ") + e.what());
@@ -465,6 +489,15 @@ BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params,
   BiasModel model(preset.name, preset.features, std::move(entries), std::move(means));
   model.setExtraVariance(params.extra_sigma_m * params.extra_sigma_m);  // (P31)
   model.setMeanScale(params.mean_scale);                                 // (P44)
+  if (params.full_variance) {  // (P45): E[ε²] of the training targets
+    double sum_sq = 0.0, n = 0.0;
+    for (std::size_t i = 0; i < data.samples.size(); ++i) {
+      if (hold[i]) continue;
+      sum_sq += data.samples[i].error_m * data.samples[i].error_m;
+      n += 1.0;
+    }
+    model.setFullVariance(true, sum_sq / n);
+  }
 
   if (report) {
     BiasTrainReport r;

@@ -77,6 +77,8 @@ struct BiasTrainParams {
   double extra_sigma_m = 0.0;
   /// Factor on the predicted mean stored in the model (P44); 1 = the paper's correction.
   double mean_scale = 1.0;
+  /// The filter's TDoA variance scaled by the unexplained share of the error (P45) instead of R + var_f.
+  bool full_variance = false;
   void validate() const;
 };
 
@@ -134,6 +136,12 @@ class BiasModel {
   /// Variance added to every prediction [m²] (P31).
   double extraVariance() const { return extra_variance_m2_; }
   void setExtraVariance(double variance_m2);  ///< throws std::invalid_argument when negative or not finite
+  /// P45: with the full variance on, predict() asks the filter for R = (var_f + σ_n²)/E[ε²] · σ_tdoa² + extra (the
+  /// filter's TDoA variance scaled by the share of the training error power the model leaves unexplained) instead
+  /// of the paper's σ_tdoa² + var_f + extra. E[ε²]: mean square of the training targets.
+  bool fullVariance() const { return full_variance_; }
+  double targetMeanSquare() const { return target_mean_square_m2_; }
+  void setFullVariance(bool on, double target_mean_square_m2);  ///< throws when on and the mean square is not > 0
   /// Factor w ∈ [0, 1] on the predicted mean (docs/math/gp.md P44): the correction subtracts w·µ. 1 = the paper.
   double meanScale() const { return mean_scale_; }
   void setMeanScale(double w);  ///< throws std::invalid_argument outside [0, 1]
@@ -156,6 +164,8 @@ class BiasModel {
   std::vector<PairMean> pair_means_;
   double extra_variance_m2_ = 0.0;
   double mean_scale_ = 1.0;
+  bool full_variance_ = false;
+  double target_mean_square_m2_ = 0.0;
   std::shared_ptr<const std::vector<gp::SvgpPredictor>> predictors_;
 };
 
