@@ -36,6 +36,20 @@ def test_training_data_match_the_simulated_error(flights, trained):
     np.testing.assert_array_equal(X[:, 0], a["yaw_a"])
 
 
+def test_bias_calibration_on_a_flight_the_model_was_not_trained_on(flights, trained):
+    _, test = flights
+    data, model, report = trained
+    assert np.isfinite(report["final_elbo"])
+    test_data = u.build_bias_dataset([test["flight"]], test["survey"])
+    c = u.bias_calibration(test_data, model)
+    # the counts add up, coverages are fractions that grow with the interval, the NLPD is a number
+    assert c["n"] + c["n_uncovered"] == len(test_data)
+    assert 0.0 <= c["coverage_1sigma"] <= c["coverage_2sigma"] <= 1.0
+    assert len(c["levels"]) == len(c["coverage"])
+    assert all(a <= b + 1e-12 for a, b in zip(c["coverage"], c["coverage"][1:]))
+    assert np.isfinite(c["nlpd"]) and c["rmse_m"] > 0
+
+
 def test_train_localize_and_compare(flights, trained, tmp_path):
     _, test = flights
     _, model, report = trained
