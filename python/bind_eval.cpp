@@ -388,11 +388,13 @@ void bindEval(py::module_& m) {
           else if (n == "natgrad_step") p.svgp.natgrad_step = py::cast<double>(value);
           else if (n == "train_inducing") p.svgp.train_inducing = py::cast<bool>(value);
           else if (n == "num_threads") p.svgp.num_threads = py::cast<int>(value);
+          else if (n == "mean_scale") p.mean_scale = py::cast<double>(value);
+          else if (n == "full_variance") p.full_variance = py::cast<bool>(value);
           else if (n == "min_samples_per_inducing") p.min_samples_per_inducing = py::cast<int>(value);
           else
             throw std::invalid_argument("unknown training parameter '" + n +
                                         "' (known: epochs, batch_size, seed, lr, lr_inducing, natgrad_step, "
-                                        "train_inducing, num_threads, min_samples_per_inducing)");
+                                        "train_inducing, num_threads, mean_scale, full_variance, min_samples_per_inducing)");
         }
         p.validate();
         BiasTrainProgress cb;

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -47,7 +48,8 @@ void progressBar(int model, int models, const uwb::gp::EpochReport& r) {
   std::cerr.flush();
 }
 
-/// The training arrays as CSV, one row per sample, named columns: the GP inputs of the preset (featureColumnNames),
+/// The training arrays as CSV, one row per sample, named columns: the flight (file stem), time [s], the anchor pair,
+/// the GP inputs of the preset (featureColumnNames),
 /// the target ε [m] (paper eq. 6; the pair-mean presets subtract their per-pair constant from it before the GP),
 /// whether the sample is in the held-out time blocks, and where it comes from.
 void dumpArrays(const std::string& path, const uwb::BiasDataset& data, const uwb::BiasTrainParams& tp) {
@@ -63,7 +65,8 @@ void dumpArrays(const std::string& path, const uwb::BiasDataset& data, const uwb
   for (std::size_t i = 0; i < data.samples.size(); ++i) {
     const uwb::BiasSample& s = data.samples[i];
     uwb::featureRow(preset.features, s.feature, row);
-    out << fmt::format("{},{:.6f},{},{}", s.flight, s.t_s, s.feature.id_a, s.feature.id_b);
+    const std::string flight = std::filesystem::path(data.flights.at(static_cast<std::size_t>(s.flight)).source).stem().string();
+    out << fmt::format("{},{:.6f},{},{}", flight, s.t_s, s.feature.id_a, s.feature.id_b);
     for (int d = 0; d < D; ++d) out << fmt::format(",{:.17g}", row[d]);
     out << fmt::format(",{:.17g},{}\n", s.error_m, hold[i] ? 1 : 0);
   }
