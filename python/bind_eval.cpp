@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bindings.h"
+#include "uwb/eval/BiasCalibration.h"
 #include "uwb/eval/BiasDataset.h"
 #include "uwb/eval/BiasModel.h"
 #include "uwb/eval/Evaluation.h"
@@ -221,7 +222,7 @@ py::dict trainReportDict(const BiasTrainReport& r) {
   py::dict d;
   d["n_train"] = r.n_train, d["n_holdout"] = r.n_holdout, d["bias_rmse_before_m"] = r.bias_rmse_before_m;
   d["bias_rmse_after_m"] = r.bias_rmse_after_m, d["mean_predicted_std_m"] = r.mean_predicted_std_m;
-  d["train_seconds"] = r.train_seconds, d["num_models"] = r.num_models;
+  d["train_seconds"] = r.train_seconds, d["num_models"] = r.num_models, d["final_elbo"] = r.final_elbo;
   return d;
 }
 
@@ -385,11 +386,14 @@ void bindEval(py::module_& m) {
           else if (n == "lr_inducing") p.svgp.lr_inducing = py::cast<double>(value);
           else if (n == "natgrad_step") p.svgp.natgrad_step = py::cast<double>(value);
           else if (n == "train_inducing") p.svgp.train_inducing = py::cast<bool>(value);
+          else if (n == "num_threads") p.svgp.num_threads = py::cast<int>(value);
+          else if (n == "mean_scale") p.mean_scale = py::cast<double>(value);
+          else if (n == "full_variance") p.full_variance = py::cast<bool>(value);
           else if (n == "min_samples_per_inducing") p.min_samples_per_inducing = py::cast<int>(value);
           else
             throw std::invalid_argument("unknown training parameter '" + n +
                                         "' (known: epochs, batch_size, seed, lr, lr_inducing, natgrad_step, "
-                                        "train_inducing, min_samples_per_inducing)");
+                                        "train_inducing, num_threads, mean_scale, full_variance, min_samples_per_inducing)");
         }
         p.validate();
         BiasTrainProgress cb;
@@ -415,6 +419,21 @@ void bindEval(py::module_& m) {
       "Trains the preset's GP(s) on the dataset (time blocks held out). Keyword arguments: SVGP training\n"
       "parameters (epochs, batch_size, seed, lr, ...). Returns (BiasModel, report {n_train, n_holdout,\n"
       "bias_rmse_before_m, bias_rmse_after_m, mean_predicted_std_m, train_seconds, num_models}).");
+
+  m.def(
+      "bias_calibration",
+      [](const BiasDataset& data, const BiasModel& model) {
+        BiasCalibration c;
+        {
+          py::gil_scoped_release release;
+          c = biasCalibration(data, model);
+        }
+        return jsonToPython(toJson(c));
+      },
+      py::arg("dataset"), py::arg("model"),
+      "Calibration of the model's predicted bias on a dataset (docs/math/gp.md P43): r = ε − µ against\n"
+      "σ² = var_f + σ_n². Returns {n, n_uncovered, coverage_1sigma, coverage_2sigma, nlpd [nats], rmse_m,\n"
+      "mean_std_m, levels, coverage (at levels)}.");
 
   // -------------------------------------------------------------------------------------- localization
   m.def(
@@ -473,16 +492,7 @@ void bindEval(py::module_& m) {
         }
         py::dict d;
         d["rows"] = jsonToPython(toJson(result.rows));
-        py::list runs;
-        for (const auto& r : result.runs) {
-          py::dict x;
-          x["kernel"] = r.kernel, x["inducing"] = r.inducing, x["repeat"] = r.repeat, x["flight"] = r.flight;
-          x["rmse_uncorrected_m"] = r.rmse_uncorrected_m, x["rmse_corrected_m"] = r.rmse_corrected_m;
-          x["bias_rmse_before_m"] = r.bias_rmse_before_m, x["bias_rmse_after_m"] = r.bias_rmse_after_m;
-          x["train_seconds"] = r.train_seconds;
-          runs.append(x);
-        }
-        d["runs"] = runs;
+        d["runs"] = jsonToPython(runsToJson(result.runs));  // with the bias calibration per run (P43)
         d["best_kernel"] = result.best_kernel, d["best_inducing"] = result.best_inducing;
         d["n_train_samples"] = result.n_train_samples, d["seconds"] = result.seconds;
         d["dataset_report"] = result.dataset_report;
@@ -511,7 +521,8 @@ void bindEval(py::module_& m) {
       py::arg("progress") = py::none(),
       "The paper's evaluation (uwbtdoa evaluate): train every (kernel, M, repeat), localize every test flight\n"
       "without and with correction. train/test: {name: Flight} or a list of Flights (named after their file).\n"
-      "Returns {rows (results.json objects), runs, best_kernel, best_inducing, n_train_samples, seconds,\n"
+      "Returns {rows (results.json objects), runs (per configuration, repeat and test flight, with change_pct and the\n"
+      "bias calibration coverage_1sigma, coverage_2sigma, nlpd), best_kernel, best_inducing, n_train_samples, seconds,\n"
       "dataset_report, markdown}. With out=DIR, writes the CLI's report files there and renders the figures.");
   m.def("filter_param_names",
         [] {

@@ -32,6 +32,8 @@ SvgpTrainParams trainParams(const py::kwargs& kw) {
     else if (n == "train_inducing") p.train_inducing = py::cast<bool>(value);
     else if (n == "train_hyperparameters") p.train_hyperparameters = py::cast<bool>(value);
     else if (n == "min_noise_variance") p.min_noise_variance = py::cast<double>(value);
+    else if (n == "num_threads") p.num_threads = py::cast<int>(value);
+    else if (n == "final_full_data_q") p.final_full_data_q = py::cast<bool>(value);
     else if (n == "mode") {
       const auto s = py::cast<std::string>(value);
       if (s == "fast") p.mode = gp::ElboMode::kFast;
@@ -41,7 +43,7 @@ SvgpTrainParams trainParams(const py::kwargs& kw) {
       throw std::invalid_argument("unknown training parameter '" + n +
                                   "' (known: epochs, batch_size, seed, lr, lr_inducing, lr_final_fraction, "
                                   "natgrad_step, lr_variational, train_inducing, train_hyperparameters, "
-                                  "min_noise_variance, mode)");
+                                  "min_noise_variance, num_threads, final_full_data_q, mode)");
     }
   }
   p.validate();
@@ -108,13 +110,27 @@ void bindGpTrain(py::module_& m) {
         py::dict d;
         d["elbo"] = toNumpy(h.col(0), true), d["val_rmse"] = toNumpy(h.col(1), true);
         d["elapsed_s"] = toNumpy(h.col(2), true), d["seconds"] = s.seconds, d["steps"] = s.steps;
+        d["batches_per_epoch"] = s.batches_per_epoch, d["final_elbo"] = s.final_elbo;
         return d;
       },
       py::arg("gp"), py::arg("X"), py::arg("y"), py::arg("X_val") = py::none(), py::arg("y_val") = py::none(),
       py::arg("on_epoch") = py::none(),
       "Optimizes gp in place on (X, y) (Adam + natural gradients). Keyword arguments override SvgpTrainParams\n"
       "(epochs, batch_size, seed, lr, lr_inducing, natgrad_step, train_inducing, ...). on_epoch(dict) is called\n"
-      "after every epoch. Returns {elbo, val_rmse, elapsed_s (per epoch), seconds, steps}.");
+      "after every epoch. Returns {elbo, val_rmse, elapsed_s (per epoch), seconds, steps, batches_per_epoch,\n"
+      "final_elbo (full-data ELBO per datum of the returned model)}. Equal-size minibatches (P40); q(v) ends at its\n"
+      "full-data optimum (P41); num_threads share each minibatch (P42, 0: all cores).");
+  m.def(
+      "full_data_elbo",
+      [](const Svgp& gp, const py::handle& X, const py::handle& y, int num_threads) {
+        const MatX Xm = matX(X, "X");
+        const VecX yv = vecX(y, "y");
+        if (yv.size() != Xm.rows()) throw std::invalid_argument("y: length differs from the rows of X");
+        py::gil_scoped_release release;
+        return gp::fullDataElbo(gp, Xm, yv, num_threads).elbo;
+      },
+      py::arg("gp"), py::arg("X"), py::arg("y"), py::arg("num_threads") = 1,
+      "ELBO per datum over all of (X, y) (docs/math/gp.md P15, P41), in chunks.");
 }
 
 }  // namespace uwb::python

@@ -31,6 +31,9 @@ void EvaluationCliOptions::addTo(CLI::App& sub) {
       ->check(CLI::IsMember({"estimate", "truth"}))
       ->capture_default_str();
   sub.add_flag("--no-plots", no_plots, "Write the data and report but do not render PNG figures");
+  sub.add_flag("--full-variance", full_variance,
+               "Corrected measurements get the TDoA variance scaled by (var_f + noise)/E[eps^2] instead of R + var_f "
+               "(docs/math/gp.md P45)");
   sub.add_flag("--json", json, "Print one JSON object (results and paths) on stdout");
 }
 
@@ -43,6 +46,7 @@ EvaluationParams EvaluationCliOptions::toParams() const {
   p.dataset.inputs = biasInputSourceFromString(inputs);
   if (epochs > 0) p.train.svgp.epochs = epochs;
   if (batch > 0) p.train.svgp.batch_size = batch;
+  p.train.full_variance = full_variance;
   return p;
 }
 
@@ -81,6 +85,7 @@ void runAndReport(const std::vector<NamedFlight>& train, const std::vector<Named
   const std::string report = (std::filesystem::path(options.out_dir) / "REPORT.md").string();
   if (options.json) {
     const nlohmann::json j = {{"results", toJson(result.rows)},
+                              {"runs", runsToJson(result.runs)},
                               {"out_dir", options.out_dir},
                               {"report", report},
                               {"figures", figures},
@@ -92,6 +97,9 @@ void runAndReport(const std::vector<NamedFlight>& train, const std::vector<Named
     return;
   }
   std::cout << toMarkdown(result.rows) << '\n';
+  std::cout << fmt::format("per test flight, {} M = {} (bias calibration: docs/math/gp.md P43):\n", result.best_kernel,
+                           result.best_inducing)
+            << perFlightMarkdown(result.runs, result.best_kernel, result.best_inducing) << '\n';
   std::cout << fmt::format("best: {} with M = {}; report: {} ({} figures); {:.0f} s\n", result.best_kernel,
                            result.best_inducing, report, figures.size(), result.seconds);
 }

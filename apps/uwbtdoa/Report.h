@@ -23,6 +23,7 @@ struct EvaluationCliOptions {
   int threads = 2;
   std::string inputs = "estimate";  ///< GP inputs of the training data: "estimate" (filter) or "truth"
   bool no_plots = false;
+  bool full_variance = false;  ///< the models ask the filter for the scaled TDoA variance (docs/math/gp.md P45)
   bool json = false;
   std::string out_dir;
   void addTo(CLI::App& sub);

@@ -1,6 +1,7 @@
 /** @file cmd_train.cpp
  *  @brief `uwbtdoa train FLIGHT.csv [FLIGHT2.csv …] --anchors SURVEY.txt --kernel z1|z2|tdoa --inducing M
- *         [--epochs E] [--batch B] [--seed S] [--lr LR] --out MODEL.json [--json]`
+ *         [--epochs E] [--batch B] [--seed S] [--lr LR] [--threads T] [--dump-arrays ARRAYS.csv] --out MODEL.json
+ *         [--json]`
  *
  *  Builds the training set (paper eq. 6, eval/BiasDataset.h), trains the bias SVGP(s) (eval/BiasModel.h) with a
  *  progress bar on stderr, and prints the held-out bias RMSE before/after and the learned hyperparameters.
@@ -8,12 +9,15 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "Command.h"
+#include "uwb/core/Error.h"
 #include "uwb/eval/BiasModel.h"
 #include "uwb/io/UtilCsv.h"
 
@@ -24,11 +28,12 @@ using nlohmann::json;
 struct TrainOptions {
   std::vector<std::string> flights;
   std::string anchors, kernel = "tdoa", out, inputs = "estimate";
-  int inducing = 100, epochs = 20, batch = 1024, passes = 1;
+  int inducing = 100, epochs = 20, batch = 1024, passes = 1, threads = 0;
+  std::string dump_arrays;
   std::uint64_t seed = 1;
   double lr = 0.01, lr_inducing = 0.01, natgrad = 0.2, holdout = 0.2, extra_sigma = uwb::BiasTrainParams{}.extra_sigma_m;
-  double min_z = 0.3, max_abs_error = 1.0;
-  bool neighbour_only = false, json_out = false, quiet = false;
+  double min_z = 0.3, max_abs_error = 1.0, mean_scale = 1.0;
+  bool neighbour_only = false, json_out = false, quiet = false, full_variance = false;
 };
 
 void progressBar(int model, int models, const uwb::gp::EpochReport& r) {
@@ -41,6 +46,31 @@ void progressBar(int model, int models, const uwb::gp::EpochReport& r) {
                            bar, model, models, r.epoch, r.epochs, r.elbo, r.val_rmse, left);
   if (r.epoch == r.epochs) std::cerr << '\n';
   std::cerr.flush();
+}
+
+/// The training arrays as CSV, one row per sample, named columns: the flight (file stem), time [s], the anchor pair,
+/// the GP inputs of the preset (featureColumnNames),
+/// the target ε [m] (paper eq. 6; the pair-mean presets subtract their per-pair constant from it before the GP),
+/// whether the sample is in the held-out time blocks, and where it comes from.
+void dumpArrays(const std::string& path, const uwb::BiasDataset& data, const uwb::BiasTrainParams& tp) {
+  const uwb::BiasPreset preset = uwb::BiasPreset::byName(tp.preset);
+  const std::vector<bool> hold = uwb::holdoutMask(data.samples, tp.holdout_fraction, tp.holdout_block_s);
+  std::ofstream out(path);
+  if (!out) throw uwb::FileError("cannot write training arrays to " + path);
+  out << "flight,t_s,id_a,id_b";
+  for (const auto& name : uwb::featureColumnNames(preset.features)) out << ',' << name;
+  out << ",error_m,holdout\n";
+  const int D = uwb::featureDim(preset.features);
+  double row[uwb::kMaxFeatureDim];
+  for (std::size_t i = 0; i < data.samples.size(); ++i) {
+    const uwb::BiasSample& s = data.samples[i];
+    uwb::featureRow(preset.features, s.feature, row);
+    const std::string flight = std::filesystem::path(data.flights.at(static_cast<std::size_t>(s.flight)).source).stem().string();
+    out << fmt::format("{},{:.6f},{},{}", flight, s.t_s, s.feature.id_a, s.feature.id_b);
+    for (int d = 0; d < D; ++d) out << fmt::format(",{:.17g}", row[d]);
+    out << fmt::format(",{:.17g},{}\n", s.error_m, hold[i] ? 1 : 0);
+  }
+  if (!out) throw uwb::FileError("error while writing training arrays to " + path);
 }
 
 void run(const TrainOptions& o) {
@@ -68,7 +98,11 @@ void run(const TrainOptions& o) {
   tp.svgp.lr = o.lr;
   tp.svgp.lr_inducing = o.lr_inducing;
   tp.svgp.natgrad_step = o.natgrad;
+  tp.svgp.num_threads = o.threads;
   tp.extra_sigma_m = o.extra_sigma;
+  tp.mean_scale = o.mean_scale;
+  tp.full_variance = o.full_variance;
+  if (!o.dump_arrays.empty()) dumpArrays(o.dump_arrays, data, tp);
   uwb::BiasTrainReport rep;
   uwb::BiasModel model = uwb::trainBiasModel(data, tp, &rep, o.quiet ? uwb::BiasTrainProgress{} : uwb::BiasTrainProgress{progressBar});
   // docs/math/gp.md (P30): further passes take the GP inputs from the filter corrected by the previous pass's model
@@ -80,6 +114,7 @@ void run(const TrainOptions& o) {
     if (!o.quiet) std::cerr << "pass " << pass << ": GP inputs from the filter corrected by pass " << pass - 1 << '\n';
     model = uwb::trainBiasModel(data, tp, &rep, o.quiet ? uwb::BiasTrainProgress{} : uwb::BiasTrainProgress{progressBar});
   }
+  if (!o.dump_arrays.empty() && o.passes > 1) dumpArrays(o.dump_arrays, data, tp);  // the last pass's arrays
 
   json hyper = json::object();
   for (const auto& e : model.entries()) {
@@ -96,6 +131,8 @@ void run(const TrainOptions& o) {
                {"passes", o.passes},
                {"inputs", o.inputs},
                {"extra_sigma_m", o.extra_sigma},
+               {"mean_scale", o.mean_scale},
+               {"full_variance", o.full_variance},
                {"flights", o.flights},
                {"n_train", rep.n_train},
                {"n_holdout", rep.n_holdout},
@@ -103,6 +140,8 @@ void run(const TrainOptions& o) {
                {"bias_rmse_after_m", rep.bias_rmse_after_m},
                {"mean_predicted_std_m", rep.mean_predicted_std_m},
                {"train_seconds", rep.train_seconds},
+               {"final_elbo", rep.final_elbo},
+               {"threads", o.threads},
                {"num_models", rep.num_models},
                {"hyperparameters", hyper},
                {"model", o.out}};
@@ -119,9 +158,10 @@ void run(const TrainOptions& o) {
     std::cout << summary.dump() << '\n';
     return;
   }
-  std::cout << fmt::format("trained {} ({} GP{}, M = {}) on {} samples in {:.1f} s; held out {} samples\n", o.kernel,
-                           rep.num_models, rep.num_models == 1 ? "" : "s", o.inducing, rep.n_train, rep.train_seconds,
-                           rep.n_holdout);
+  std::cout << fmt::format("trained {} ({} GP{}, M = {}) on {} samples in {:.1f} s; held out {} samples; full-data "
+                           "ELBO per datum {:.4f}\n",
+                           o.kernel, rep.num_models, rep.num_models == 1 ? "" : "s", o.inducing, rep.n_train,
+                           rep.train_seconds, rep.n_holdout, rep.final_elbo);
   std::cout << fmt::format("bias RMSE on the held-out part: before {:.4f} m, after {:.4f} m ({:+.1f} %), mean predicted std {:.4f} m\n",
                            rep.bias_rmse_before_m, rep.bias_rmse_after_m,
                            100.0 * (rep.bias_rmse_after_m - rep.bias_rmse_before_m) / rep.bias_rmse_before_m,
@@ -149,10 +189,22 @@ void setup(CLI::App& sub) {
   sub.add_option("--extra-sigma", o->extra_sigma,
                  "Std [m] added in quadrature to the filter's TDoA noise when the correction is on (docs/math/gp.md P31)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  sub.add_option("--mean-scale", o->mean_scale,
+                 "Factor w in [0, 1] on the predicted bias mean stored in the model (docs/math/gp.md P44)")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  sub.add_flag("--full-variance", o->full_variance,
+               "The filter uses the TDoA variance scaled by (var_f + noise)/E[eps^2] for corrected measurements instead "
+               "of adding var_f (docs/math/gp.md P45)");
   sub.add_option("--seed", o->seed, "Random seed (k-means++, shuffling)");
   sub.add_option("--lr", o->lr, "Adam learning rate of the hyperparameters");
   sub.add_option("--lr-inducing", o->lr_inducing, "Adam learning rate of the inducing points");
   sub.add_option("--natgrad", o->natgrad, "Natural-gradient step for q(v) (0: Adam instead)");
+  sub.add_option("--threads", o->threads, "Threads sharing each minibatch (0: one per hardware thread); the model "
+                 "is bit-identical for a given seed and thread count")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  sub.add_option("--dump-arrays", o->dump_arrays,
+                 "Write the training arrays (flight, t_s, id_a, id_b, the preset's GP input columns, error_m, holdout) "
+                 "as CSV, to train elsewhere");
   sub.add_option("--holdout", o->holdout, "Held-out fraction (time blocks) for the before/after RMSE");
   sub.add_option("--min-z", o->min_z, "Exclude samples with ground-truth z below this [m] (on the ground)");
   sub.add_option("--max-abs-error", o->max_abs_error, "Exclude gross outliers |eps| above this [m] (0: off)");

@@ -36,6 +36,20 @@ def test_training_data_match_the_simulated_error(flights, trained):
     np.testing.assert_array_equal(X[:, 0], a["yaw_a"])
 
 
+def test_bias_calibration_on_a_flight_the_model_was_not_trained_on(flights, trained):
+    _, test = flights
+    data, model, report = trained
+    assert np.isfinite(report["final_elbo"])
+    test_data = u.build_bias_dataset([test["flight"]], test["survey"])
+    c = u.bias_calibration(test_data, model)
+    # the counts add up, coverages are fractions that grow with the interval, the NLPD is a number
+    assert c["n"] + c["n_uncovered"] == len(test_data)
+    assert 0.0 <= c["coverage_1sigma"] <= c["coverage_2sigma"] <= 1.0
+    assert len(c["levels"]) == len(c["coverage"])
+    assert all(a <= b + 1e-12 for a, b in zip(c["coverage"], c["coverage"][1:]))
+    assert np.isfinite(c["nlpd"]) and c["rmse_m"] > 0
+
+
 def test_train_localize_and_compare(flights, trained, tmp_path):
     _, test = flights
     _, model, report = trained
@@ -117,7 +131,11 @@ def test_run_evaluation_writes_the_report_and_renders_its_figures(flights, tmp_p
     r = u.run_evaluation({"zigzag": train["flight"]}, {"circle": test["flight"]}, train["survey"], kernels=["z1"],
                          inducing=[8, 12], repeats=1, epochs=2, out=str(tmp_path), command="pytest", progress=lines.append)
     assert [row["inducing"] for row in r["rows"]] == [8, 12]
-    assert {"kernel", "improvement_pct", "improvement_pct_min", "improvement_pct_max"} <= set(r["rows"][0])
+    assert {"kernel", "change_pct", "change_pct_min", "change_pct_max", "coverage_1sigma", "coverage_2sigma",
+            "nlpd"} <= set(r["rows"][0])
+    run = r["runs"][0]
+    assert run["change_pct"] == pytest.approx(100 * (run["rmse_corrected_m"] / run["rmse_uncorrected_m"] - 1))
+    assert 0.0 <= run["coverage_1sigma"] <= run["coverage_2sigma"] <= 1.0
     assert any("training data" in line for line in lines)
     for name in ("results.json", "REPORT.md", "figdata/errors.csv", "fig5_improvement.png",
                  "fig6_error_distribution.png", "trajectory_circle.png"):

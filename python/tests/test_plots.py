@@ -22,10 +22,10 @@ def _write_report_dir(out, rng):
     results = []
     for k, kernel in enumerate(KERNELS):
         for m in INDUCING:
-            imp = 5.0 + 4.0 * k + 8.0 * math.log10(m)
+            change = -(5.0 + 4.0 * k + 8.0 * math.log10(m))
             results.append({"kernel": kernel, "inducing": m, "rmse_uncorrected_m": 0.226,
-                            "rmse_corrected_m": 0.226 * (1 - imp / 100), "improvement_pct": imp,
-                            "improvement_pct_min": imp - 1.5, "improvement_pct_max": imp + 1.0})
+                            "rmse_corrected_m": 0.226 * (1 + change / 100), "change_pct": change,
+                            "change_pct_min": change - 1.0, "change_pct_max": change + 1.5})
     (out / "results.json").write_text(json.dumps(results, indent=1))
 
     with open(fig / "errors.csv", "w", newline="") as f:
@@ -95,10 +95,47 @@ def test_report_renders_every_figure_from_the_data_files(tmp_path):
 
 def test_report_without_optional_files_draws_fig5_only(tmp_path):
     (tmp_path / "results.json").write_text(json.dumps(
-        [{"kernel": "tdoa", "inducing": 30, "improvement_pct": 15.2, "improvement_pct_min": 14.0,
-          "improvement_pct_max": 16.0}]))
+        [{"kernel": "tdoa", "inducing": 30, "change_pct": -15.2, "change_pct_min": -16.0, "change_pct_max": -14.0}]))
     written = plots.render_report(str(tmp_path))
     assert [os.path.basename(p) for p in written] == ["fig5_improvement.png"]
+
+
+def test_change_is_read_with_one_sign_from_new_and_old_results():
+    new = {"kernel": "tdoa", "inducing": 30, "change_pct": -15.2, "change_pct_min": -16.0, "change_pct_max": -14.0}
+    old = {"kernel": "tdoa", "inducing": 30, "improvement_pct": 15.2, "improvement_pct_min": 14.0,
+           "improvement_pct_max": 16.0}
+    for r in (new, old):
+        assert plots._change(r) == pytest.approx(-15.2)
+        assert plots._change(r, "min") == pytest.approx(-16.0)
+        assert plots._change(r, "max") == pytest.approx(-14.0)
+
+
+def test_calibration_and_per_flight_figures_are_drawn_from_the_report_files(tmp_path):
+    # GIVEN results.json, runs.csv and figdata/calibration.csv as `uwbtdoa evaluate` writes them
+    (tmp_path / "figdata").mkdir()
+    (tmp_path / "results.json").write_text(json.dumps(
+        [{"kernel": "tdoa", "inducing": 30, "change_pct": -10.0}, {"kernel": "z1", "inducing": 10, "change_pct": 2.0}]))
+    runs = ["kernel,inducing,repeat,flight,rmse_uncorrected_m,rmse_corrected_m,bias_rmse_before_m,bias_rmse_after_m,"
+            "train_seconds,coverage_1sigma,coverage_2sigma,nlpd"]
+    cal = ["kernel,inducing,repeat,flight,level,coverage"]
+    levels = [0.05 * i for i in range(1, 20)] + [0.99]
+    for kernel, m in (("tdoa", 30), ("z1", 10)):
+        for flight in ("f1", "f2"):
+            runs.append(f"{kernel},{m},0,{flight},0.25,0.22,0.27,0.23,1.0,0.70,0.93,0.1")
+            cal += [f"{kernel},{m},0,{flight},{lv:.2f},{min(1.0, 0.9 * lv):.4f}" for lv in levels]
+    (tmp_path / "runs.csv").write_text("\n".join(runs) + "\n")
+    (tmp_path / "figdata" / "calibration.csv").write_text("\n".join(cal) + "\n")
+    # WHEN the report is rendered
+    written = [os.path.basename(p) for p in plots.render_report(str(tmp_path))]
+    # THEN the calibration curve and the per-flight bars are PNGs
+    for name in ("calibration.png", "per_flight.png"):
+        assert name in written
+        assert _is_png(tmp_path / name)
+
+
+def test_calibration_curve_rejects_mismatched_lengths():
+    with pytest.raises(ValueError, match="2 values for 3 levels"):
+        plots.calibration_curve([0.1, 0.5, 0.9], {"a": [0.1, 0.5]})
 
 
 def test_report_errors_name_the_file_and_line(tmp_path):

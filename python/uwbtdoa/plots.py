@@ -20,14 +20,15 @@ Data-file contract (written by ``uwbtdoa evaluate``; everything in SI units, ang
 
     {"kernel": "tdoa",              # kernel name (z1, z2, tdoa, or any other string)
      "inducing": 30,                # number of inducing points M (integer)
-     "rmse_uncorrected_m": 0.226,   # airborne RMSE without correction, mean over repeats and test flights
+     "rmse_uncorrected_m": 0.226,   # airborne RMSE without correction: per test flight, then the mean over
+                                    #   repeats and test flights (not pooled over samples)
      "rmse_corrected_m": 0.192,     # airborne RMSE with correction, same averaging
-     "improvement_pct": 15.0,       # 100 * (1 - rmse_corrected / rmse_uncorrected) from the means above;
-                                    #   POSITIVE = the correction reduces the error (paper: 15.25 %)
-     "improvement_pct_min": 13.0,   # minimum over repeats (of the per-repeat mean over test flights)
-     "improvement_pct_max": 17.0}   # maximum over repeats
-    Only kernel, inducing, improvement_pct, improvement_pct_min and improvement_pct_max are needed by
-    Fig. 5; other keys are ignored.
+     "change_pct": -15.0,           # 100 * (rmse_corrected / rmse_uncorrected - 1) from the means above;
+                                    #   NEGATIVE = the correction reduces the error (paper: -15.25 %)
+     "change_pct_min": -17.0,       # minimum over repeats (of the per-repeat mean over test flights): best repeat
+     "change_pct_max": -13.0}       # maximum over repeats
+    Only kernel, inducing, change_pct, change_pct_min and change_pct_max are needed by Fig. 5; other keys
+    are ignored. Files with the older "improvement_pct" (= -change_pct) keys are read as well.
 
 ``DIR/figdata/errors.csv`` (optional; Fig. 6) -- header line, then one row per evaluated sample::
 
@@ -40,7 +41,8 @@ Data-file contract (written by ``uwbtdoa evaluate``; everything in SI units, ang
     t: time [s]; error_m: Euclidean position error |p_est - p_gt| [m].
     Rows are the samples that the RMSE is computed over (airborne only). Any number of configurations and
     repeats may be present (all rows of a configuration are pooled); decimate to <= ~50 Hz to keep the file
-    small. Fig. 6 is drawn for the configuration with the highest improvement_pct in results.json that has
+    small. Fig. 6 pools the samples of all test flights (its RMSE is not the table's per-flight mean); it is
+    drawn for the configuration with the most negative change_pct in results.json that has
     corrected rows (``fig6_error_distribution.png``) and, per kernel, for that kernel's best M
     (``fig6_error_distribution_<kernel>.png``).
 
@@ -52,8 +54,9 @@ Data-file contract (written by ``uwbtdoa evaluate``; everything in SI units, ang
      "error_m": [...],              # measured TDoA error (paper eq. 6) per training sample [m] (N)
      "grid_alpha_i_rad": [...],     # grid axis for anchor A's yaw (n_i values, increasing)
      "grid_alpha_j_rad": [...],     # grid axis for anchor B's yaw (n_j values, increasing)
-     "grid_mean_m": [[...], ...],   # n_j rows of n_i values: GP mean at (grid_alpha_i[c], grid_alpha_j[r])
-                                    #   is grid_mean_m[r][c]  (row = alpha_j, column = alpha_i) [m]
+     "grid_mean_m": [[...], ...],   # n_j rows of n_i values: the model's mean averaged over the training
+                                    #   samples in the cell centred at (grid_alpha_i[c], grid_alpha_j[r]) is
+                                    #   grid_mean_m[r][c] (row = alpha_j, column = alpha_i) [m]; null = no data
      "inducing_alpha_i_rad": [...], # inducing points' yaw of anchor A (M)
      "inducing_alpha_j_rad": [...]} # inducing points' yaw of anchor B (M)
     kernel, inducing, id_a, id_b are used in titles only. NaN cells in grid_mean_m (JSON null) are blank.
@@ -69,8 +72,20 @@ Data-file contract (written by ``uwbtdoa evaluate``; everything in SI units, ang
 
 ``DIR/figdata/anchors.csv`` (optional; drawn in the top view) -- ``id,x,y,z`` with a header line [m].
 
+``DIR/figdata/calibration.csv`` (optional; calibration figure) -- header, then one row per run and level::
+
+    kernel,inducing,repeat,flight,level,coverage
+    tdoa,30,0,0425-traj2,0.68,0.71
+
+    level: nominal probability p of the central interval µ ± z_p σ of the predicted bias; coverage: observed
+    fraction of TDoA errors inside it on that test flight (docs/math/gp.md P43).
+
+``DIR/runs.csv`` (optional; per-flight bars) -- one row per configuration, repeat and test flight with at least
+``kernel,inducing,repeat,flight,rmse_uncorrected_m,rmse_corrected_m`` and optionally ``coverage_1sigma,
+coverage_2sigma,nlpd``; drawn for the best configuration, repeats averaged.
+
 PNGs written: ``fig5_improvement.png``, ``fig6_error_distribution.png`` (+ per kernel),
-``fig7_bias_vs_angles.png``, ``trajectory_<flight>.png``.
+``fig7_bias_vs_angles.png``, ``calibration.png``, ``per_flight.png``, ``trajectory_<flight>.png``.
 """
 from __future__ import annotations
 
@@ -113,17 +128,28 @@ def _finish(fig, path: str | None):
     return fig
 
 
+def _change(r: Mapping, bound: str = "") -> float:
+    """change_pct (negative = error reduced) of a results.json entry, or its min/max over repeats; entries of
+    older files carry improvement_pct = −change_pct (their min/max swap)."""
+    suffix = f"_{bound}" if bound else ""
+    if "change_pct" in r:
+        return float(r.get("change_pct" + suffix, r["change_pct"]))
+    old = {"": "", "min": "_max", "max": "_min"}[bound]
+    return -float(r.get("improvement_pct" + old, r["improvement_pct"]))
+
+
 def _rmse(x: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.square(x)))) if x.size else float("nan")
 
 
 # --------------------------------------------------------------------------------------------- Fig. 5
 def fig5_improvement(results: Sequence[Mapping], path: str | None = None, title: str | None = None):
-    """Improvement of the airborne RMSE [%] against the number of inducing points, one line per kernel.
+    """Change of the airborne RMSE [%] against the number of inducing points, one line per kernel.
 
-    ``results``: list of dicts with keys kernel, inducing, improvement_pct, improvement_pct_min,
-    improvement_pct_max (the schema of results.json). The min/max spread over repeats is drawn as error bars
-    and a light band. improvement_pct = 100 (1 − corrected/uncorrected): positive = the correction helps.
+    ``results``: list of dicts with keys kernel, inducing, change_pct, change_pct_min, change_pct_max (the schema
+    of results.json; older files with improvement_pct = −change_pct are accepted). The min/max spread over
+    repeats is drawn as error bars and a light band. change_pct = 100 (corrected/uncorrected − 1): negative =
+    the correction reduces the error.
     """
     if not results:
         raise ValueError("fig5_improvement: no results")
@@ -135,17 +161,17 @@ def fig5_improvement(results: Sequence[Mapping], path: str | None = None, title:
     for k, (kernel, rows) in enumerate(by_kernel.items()):
         rows = sorted(rows, key=lambda r: int(r["inducing"]))
         m = np.array([int(r["inducing"]) for r in rows], dtype=float)
-        y = np.array([float(r["improvement_pct"]) for r in rows])
-        lo = np.array([float(r.get("improvement_pct_min", r["improvement_pct"])) for r in rows])
-        hi = np.array([float(r.get("improvement_pct_max", r["improvement_pct"])) for r in rows])
+        y = np.array([_change(r) for r in rows])
+        lo = np.array([_change(r, "min") for r in rows])
+        hi = np.array([_change(r, "max") for r in rows])
         lo, hi = np.minimum(lo, y), np.maximum(hi, y)
         line = ax.errorbar(m, y, yerr=[y - lo, hi - y], marker=markers[k % len(markers)], capsize=4,
                            linewidth=1.8, markersize=6, label=kernel_label(kernel))
         ax.fill_between(m, lo, hi, color=line[0].get_color(), alpha=0.15, linewidth=0)
     ax.axhline(0.0, color="0.4", linewidth=0.8, linestyle="--")
     ax.set_xlabel("number of inducing points M")
-    ax.set_ylabel("improvement of airborne RMSE [%]\n100·(1 − RMSE_corrected / RMSE_uncorrected)")
-    ax.set_title(title or "Fig. 5: RMSE improvement vs. number of inducing points\n(mean over repeats and test flights; "
+    ax.set_ylabel("change of airborne RMSE [%] (negative = reduced)\n100·(RMSE_corrected / RMSE_uncorrected − 1)")
+    ax.set_title(title or "Fig. 5: RMSE change vs. number of inducing points\n(mean over repeats and test flights; "
                  "bars and band: min/max over repeats)", fontsize=10.5)
     all_m = sorted({int(r["inducing"]) for r in results})
     ax.set_xticks(all_m)
@@ -207,7 +233,8 @@ def fig6_error_distribution(err_uncorrected, err_corrected, path: str | None = N
 # --------------------------------------------------------------------------------------------- Fig. 7
 def fig7_bias_vs_angles(alpha_i, alpha_j, error, grid_alpha_i, grid_alpha_j, grid_mean, inducing_alpha,
                         path: str | None = None, title: str | None = None, pair: tuple[int, int] | None = None):
-    """Measured TDoA error over the two anchor yaw angles (left) next to the GP mean on a grid (right).
+    """Measured TDoA error over the two anchor yaw angles (left) next to the model mean per grid cell (right;
+    NaN cells, where there is no data, are blank).
 
     ``alpha_i``, ``alpha_j``, ``error``: per-sample yaw angles of anchors A and B in the body frame [rad] and
     the measured TDoA error [m]. ``grid_alpha_i`` (n_i), ``grid_alpha_j`` (n_j): grid axes [rad];
@@ -235,13 +262,13 @@ def fig7_bias_vs_angles(alpha_i, alpha_j, error, grid_alpha_i, grid_alpha_j, gri
                  linewidths=0, rasterized=True)
     mesh = ax_r.pcolormesh(gi * deg, gj * deg, np.ma.masked_invalid(gm), cmap="viridis", vmin=-lim, vmax=lim,
                            shading="auto")
-    if ai.size:  # where the training samples lie: the GP mean elsewhere is extrapolation
+    if ai.size and np.isfinite(gm).all():  # a full grid: shade where the samples lie (elsewhere: extrapolation)
         ax_r.scatter(ai * deg, aj * deg, s=1.5, c="k", alpha=0.25, linewidths=0, rasterized=True, zorder=2)
         ax_r.plot([], [], "o", color="k", alpha=0.5, markersize=4, label="sample locations")  # legend entry
     if z.shape[0]:
         ax_r.scatter(z[:, 0] * deg, z[:, 1] * deg, s=28, c="red", edgecolors="white", linewidths=0.6,
                      label=f"inducing points (M={z.shape[0]})", zorder=3)
-    if ai.size or z.shape[0]:
+    if (ai.size and np.isfinite(gm).all()) or z.shape[0]:
         ax_r.legend(loc="upper right", fontsize=8.5, framealpha=0.85)
     a_name, b_name = ("A", "B") if pair is None else (str(pair[0]), str(pair[1]))
     for ax in (ax_l, ax_r):
@@ -254,7 +281,7 @@ def fig7_bias_vs_angles(alpha_i, alpha_j, error, grid_alpha_i, grid_alpha_j, gri
         ax.grid(True, alpha=0.25)
     ax_l.set_ylabel(f"α_j: yaw of anchor {b_name} in body frame [deg]")
     ax_l.set_title(f"measured TDoA error (n={err.size})")
-    ax_r.set_title("GP posterior mean")
+    ax_r.set_title("model mean at the samples, per cell (blank: no data)")
     cbar = fig.colorbar(mesh, ax=[ax_l, ax_r], shrink=0.95, pad=0.02)
     cbar.set_label("TDoA error / GP mean [m]")
     fig.suptitle(title or "Fig. 7: TDoA bias against the anchor yaw angles")
@@ -298,6 +325,82 @@ def trajectory_top_view(gt_xy, est_uncorrected_xy, est_corrected_xy=None, anchor
     ax.set_title(title or "Trajectory, top view")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=9)
+    return _finish(fig, path)
+
+
+# ------------------------------------------------------------------------------------------ calibration
+def calibration_curve(levels, coverage_by_label: Mapping[str, Sequence[float]], path: str | None = None,
+                      title: str | None = None):
+    """Coverage of the predicted bias intervals against their nominal probability (docs/math/gp.md P43).
+
+    ``levels``: nominal probabilities p of the central intervals µ ± z_p σ (1-D, in (0, 1)).
+    ``coverage_by_label``: {label: observed fractions at ``levels``}. The diagonal is perfect calibration;
+    below it the predicted σ is too small (over-confident), above it too large. 1σ and 2σ are marked.
+    """
+    lv = np.asarray(levels, dtype=float).ravel()
+    if lv.size == 0 or not coverage_by_label:
+        raise ValueError("calibration_curve: no levels or no coverage")
+    fig, ax = plt.subplots(figsize=(5.8, 5.4))
+    ax.plot([0, 1], [0, 1], color="0.4", linestyle="--", linewidth=1.0, label="calibrated")
+    for p, name in ((0.6827, "1σ"), (0.9545, "2σ")):
+        ax.axvline(p, color="0.75", linewidth=0.8)
+        ax.text(p, 0.02, f" {name}", color="0.4", fontsize=8.5)
+    for label, cov in coverage_by_label.items():
+        c = np.asarray(cov, dtype=float).ravel()
+        if c.size != lv.size:
+            raise ValueError(f"calibration_curve: '{label}' has {c.size} values for {lv.size} levels")
+        ax.plot(lv, c, marker="o", markersize=3.5, linewidth=1.5, label=str(label))
+    ax.set_xlim(0, 1)
+    ax.set_ylim(0, 1)
+    ax.set_aspect("equal")
+    ax.set_xlabel("nominal probability of the interval µ ± z·σ")
+    ax.set_ylabel("observed fraction of TDoA errors inside")
+    ax.set_title(title or "Calibration of the predicted bias on the test flights", fontsize=10.5)
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="upper left", fontsize=8.5)
+    return _finish(fig, path)
+
+
+def per_flight_bars(flights: Sequence[str], rmse_uncorrected, rmse_corrected, coverage_1sigma=None,
+                    coverage_2sigma=None, path: str | None = None, title: str | None = None):
+    """Per test flight: airborne RMSE without / with correction (left) and, when given, the 1σ / 2σ coverage of
+    the predicted bias (right, nominal 68.3 / 95.4 % as lines). Changes are labelled as 100 (corr/unc − 1) %:
+    negative = the correction reduced the error."""
+    names = [str(f) for f in flights]
+    unc = np.asarray(rmse_uncorrected, dtype=float).ravel()
+    cor = np.asarray(rmse_corrected, dtype=float).ravel()
+    if not names or unc.size != len(names) or cor.size != len(names):
+        raise ValueError("per_flight_bars: flights, rmse_uncorrected, rmse_corrected must have the same length > 0")
+    with_cov = coverage_1sigma is not None and coverage_2sigma is not None
+    fig, axes = plt.subplots(1, 2 if with_cov else 1, figsize=(11.0 if with_cov else 6.5, 4.3), squeeze=False)
+    x = np.arange(len(names))
+    ax = axes[0][0]
+    ax.bar(x - 0.2, unc, 0.4, label="uncorrected", color="tab:blue")
+    ax.bar(x + 0.2, cor, 0.4, label="corrected", color="tab:orange")
+    for i in range(len(names)):
+        change = 100.0 * (cor[i] / unc[i] - 1.0) if unc[i] > 0 else float("nan")
+        ax.annotate(f"{change:+.1f} %", (x[i] + 0.2, cor[i]), textcoords="offset points", xytext=(0, 3),
+                    ha="center", fontsize=8)
+    ax.set_xticks(x, names, rotation=20, ha="right")
+    ax.set_ylabel("airborne RMSE [m]")
+    ax.set_title("localization error per flight (label: change, − = reduced)", fontsize=10)
+    ax.legend(fontsize=8.5)
+    ax.grid(True, axis="y", alpha=0.3)
+    if with_cov:
+        c1 = 100.0 * np.asarray(coverage_1sigma, dtype=float).ravel()
+        c2 = 100.0 * np.asarray(coverage_2sigma, dtype=float).ravel()
+        ax = axes[0][1]
+        ax.bar(x - 0.2, c1, 0.4, label="within 1σ", color="tab:green")
+        ax.bar(x + 0.2, c2, 0.4, label="within 2σ", color="tab:olive")
+        ax.axhline(68.27, color="tab:green", linestyle="--", linewidth=1.0)
+        ax.axhline(95.45, color="tab:olive", linestyle="--", linewidth=1.0)
+        ax.set_ylim(0, 100)
+        ax.set_xticks(x, names, rotation=20, ha="right")
+        ax.set_ylabel("TDoA errors inside the predicted interval [%]")
+        ax.set_title("coverage of the predicted bias (dashed: nominal)", fontsize=10)
+        ax.legend(fontsize=8.5, loc="lower right")
+        ax.grid(True, axis="y", alpha=0.3)
+    fig.suptitle(title or "Per test flight")
     return _finish(fig, path)
 
 
@@ -346,9 +449,11 @@ def load_results(path: str) -> list[dict]:
     if not isinstance(data, list):
         raise ReportDataError(f"{path}: expected a JSON array of result objects")
     for i, r in enumerate(data):
-        for key in ("kernel", "inducing", "improvement_pct"):
+        for key in ("kernel", "inducing"):
             if not isinstance(r, dict) or key not in r:
                 raise ReportDataError(f"{path}: entry {i} lacks key '{key}'")
+        if "change_pct" not in r and "improvement_pct" not in r:
+            raise ReportDataError(f"{path}: entry {i} lacks key 'change_pct'")
     return data
 
 
@@ -409,6 +514,25 @@ def load_fig7(path: str) -> dict:
     return out
 
 
+def load_calibration(path: str) -> dict[str, np.ndarray]:
+    """Reads figdata/calibration.csv: kernel, flight (str), inducing, repeat (int), level, coverage."""
+    cols = _read_csv(path, ["kernel", "inducing", "repeat", "flight", "level", "coverage"])
+    return {"kernel": np.array(cols["kernel"], dtype=str), "flight": np.array(cols["flight"], dtype=str),
+            "inducing": _floats(path, cols, "inducing").astype(int), "repeat": _floats(path, cols, "repeat").astype(int),
+            "level": _floats(path, cols, "level"), "coverage": _floats(path, cols, "coverage")}
+
+
+def load_runs(path: str) -> dict[str, np.ndarray]:
+    """Reads runs.csv (one row per configuration, repeat and test flight)."""
+    cols = _read_csv(path, ["kernel", "inducing", "repeat", "flight", "rmse_uncorrected_m", "rmse_corrected_m"])
+    out = {"kernel": np.array(cols["kernel"], dtype=str), "flight": np.array(cols["flight"], dtype=str),
+           "inducing": _floats(path, cols, "inducing").astype(int), "repeat": _floats(path, cols, "repeat").astype(int)}
+    for c in ("rmse_uncorrected_m", "rmse_corrected_m", "coverage_1sigma", "coverage_2sigma", "nlpd"):
+        if c in cols:
+            out[c] = _floats(path, cols, c)
+    return out
+
+
 def _safe(name: str) -> str:
     return "".join(c if c.isalnum() or c in "-_." else "_" for c in str(name))
 
@@ -439,7 +563,7 @@ def render_report(out_dir: str, log=sys.stderr) -> list[str]:
         e = load_errors(errors_path)
         unc = e["error_m"][e["corrected"] == 0]
         configs = {(k, m) for k, m, c in zip(e["kernel"], e["inducing"], e["corrected"]) if c == 1}
-        ranked = sorted((-float(r["improvement_pct"]), str(r["kernel"]), int(r["inducing"])) for r in results
+        ranked = sorted((_change(r), str(r["kernel"]), int(r["inducing"])) for r in results
                         if (str(r["kernel"]), int(r["inducing"])) in configs)
         if not ranked:  # no results entry matches: take the configurations in file order
             ranked = [(0.0, k, m) for k, m in sorted(configs)]
@@ -478,6 +602,40 @@ def render_report(out_dir: str, log=sys.stderr) -> list[str]:
              "fig7_bias_vs_angles.png")
     else:
         print(f"[plots] {fig7_path} absent: Fig. 7 skipped", file=log)
+
+    best = None  # the best configuration of results.json: lowest corrected RMSE relative to uncorrected
+    if results:
+        r0 = min(results, key=_change)
+        best = (str(r0["kernel"]), int(r0["inducing"]))
+
+    cal_path = os.path.join(fig_dir, "calibration.csv")
+    if os.path.isfile(cal_path):
+        c = load_calibration(cal_path)
+        levels = np.unique(c["level"])
+        curves: dict[str, np.ndarray] = {}
+        for kern, m in dict.fromkeys(zip(c["kernel"].tolist(), c["inducing"].tolist())):
+            sel = (c["kernel"] == kern) & (c["inducing"] == m)
+            curves[f"{kern} M={m}"] = np.array([np.mean(c["coverage"][sel & (c["level"] == lv)]) for lv in levels])
+        if curves:
+            save(calibration_curve(levels, curves, title="Calibration of the predicted bias on the test flights\n"
+                                   "(mean over repeats and flights)"), "calibration.png")
+    else:
+        print(f"[plots] {cal_path} absent: calibration figure skipped", file=log)
+
+    runs_path = os.path.join(out_dir, "runs.csv")
+    if os.path.isfile(runs_path) and best is not None:
+        r = load_runs(runs_path)
+        sel = (r["kernel"] == best[0]) & (r["inducing"] == best[1])
+        flights = list(dict.fromkeys(r["flight"][sel].tolist()))
+        if flights:
+            def mean_of(key):
+                if key not in r:
+                    return None
+                return [float(np.mean(r[key][sel & (r["flight"] == f)])) for f in flights]
+            save(per_flight_bars(flights, mean_of("rmse_uncorrected_m"), mean_of("rmse_corrected_m"),
+                                 mean_of("coverage_1sigma"), mean_of("coverage_2sigma"),
+                                 title=f"Per test flight, {best[0]} M={best[1]} (repeats averaged)"),
+                 "per_flight.png")
 
     traj_path = os.path.join(fig_dir, "trajectories.csv")
     if os.path.isfile(traj_path):

@@ -82,10 +82,33 @@ void featureRow(FeatureMap map, const TdoaFeature& f, double* row) {
 }
 
 MatX featureMatrix(FeatureMap map, const std::vector<TdoaFeature>& features) {
+  // Filled in place (column-major, as the GP takes it): no second N×D copy.
   const int D = featureDim(map);
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> X(features.size(), D);
-  for (std::size_t i = 0; i < features.size(); ++i) featureRow(map, features[i], X.row(static_cast<Eigen::Index>(i)).data());
+  MatX X(static_cast<Eigen::Index>(features.size()), D);
+  double row[kMaxFeatureDim];
+  for (std::size_t i = 0; i < features.size(); ++i) {
+    featureRow(map, features[i], row);
+    for (int d = 0; d < D; ++d) X(static_cast<Eigen::Index>(i), d) = row[d];
+  }
   return X;
+}
+
+std::vector<std::string> featureColumnNames(FeatureMap map) {
+  const auto xyz = [](const std::string& prefix) {
+    return std::vector<std::string>{prefix + "_x_m", prefix + "_y_m", prefix + "_z_m"};
+  };
+  std::vector<std::string> names;
+  const auto add = [&](const std::vector<std::string>& more) { names.insert(names.end(), more.begin(), more.end()); };
+  switch (map) {
+    case FeatureMap::kYawAngles: return {"yaw_a_rad", "yaw_b_rad"};
+    case FeatureMap::kBodyPositions: add(xyz("b_p_a")); add(xyz("b_p_b")); break;
+    case FeatureMap::kWorldPosition: add(xyz("w_p_b")); break;
+    case FeatureMap::kBodyPositionsAnchors:
+      add(xyz("b_p_a")); add(xyz("b_p_b")); add(xyz("w_p_anchor_a")); add(xyz("w_p_anchor_b"));
+      break;
+    case FeatureMap::kBodyPositionsWorld: add(xyz("b_p_a")); add(xyz("b_p_b")); add(xyz("w_p_b")); break;
+  }
+  return names;
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -167,6 +190,7 @@ void BiasTrainParams::validate() const {
   if (!(holdout_block_s > 0)) throw std::invalid_argument("holdout_block_s must be > 0");
   if (min_samples_per_inducing < 1) throw std::invalid_argument("min_samples_per_inducing must be ≥ 1");
   if (!(extra_sigma_m >= 0) || !std::isfinite(extra_sigma_m)) throw std::invalid_argument("extra_sigma_m must be ≥ 0");
+  if (!(mean_scale >= 0) || mean_scale > 1) throw std::invalid_argument("mean_scale must be in [0, 1]");
   svgp.validate();
 }
 
@@ -189,6 +213,11 @@ void BiasModel::buildPredictors() {
   preds->reserve(entries_.size());
   for (const auto& e : entries_) preds->emplace_back(e.gp);
   predictors_ = preds;
+}
+
+void BiasModel::setMeanScale(double w) {
+  if (!(w >= 0.0) || w > 1.0) throw std::invalid_argument("bias model: mean_scale must be in [0, 1]");
+  mean_scale_ = w;
 }
 
 void BiasModel::setExtraVariance(double variance_m2) {
@@ -220,10 +249,49 @@ BiasPrediction predictWith(const std::vector<BiasModel::Entry>& entries, const s
 }
 }  // namespace
 
+void BiasModel::setFullVariance(bool on, double target_mean_square_m2) {
+  if (on && !(target_mean_square_m2 > 0.0 && std::isfinite(target_mean_square_m2)))
+    throw std::invalid_argument("bias model: the full variance needs the training targets' mean square > 0");
+  full_variance_ = on;
+  target_mean_square_m2_ = on ? target_mean_square_m2 : 0.0;
+}
+
 BiasPrediction BiasModel::predict(const TdoaFeature& f) const {
+  if (full_variance_) {
+    // docs/math/gp.md (P45): R = (var_f + σ_n²)/E[ε²] · σ_tdoa² + σ_x²
+    const BiasPredictive q = predictive(f);
+    BiasPrediction p;
+    p.variance_m2 = extra_variance_m2_;
+    if (q.covered) {
+      p.mean_m = q.mean_m;
+      p.noise_scale = q.varianceM2() / target_mean_square_m2_;
+    } else {
+      p.mean_m = mean_scale_ * pairMean(f.id_a, f.id_b);
+    }
+    return p;
+  }
   BiasPrediction p = predictWith(entries_, *predictors_, features_, f);
   p.mean_m += pairMean(f.id_a, f.id_b);  // docs/math/gp.md (P28): m_AB + GP mean
   p.variance_m2 += extra_variance_m2_;    // (P31)
+  p.mean_m *= mean_scale_;                 // (P44)
+  return p;
+}
+
+BiasPredictive BiasModel::predictive(const TdoaFeature& f) const {
+  BiasPredictive p;
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    const auto& e = entries_[i];
+    if (e.id_a >= 0 && (e.id_a != f.id_a || e.id_b != f.id_b)) continue;
+    double row[kMaxFeatureDim];
+    featureRow(features_, f, row);
+    (*predictors_)[i].predictOne(Eigen::Map<const RowVecX>(row, featureDim(features_)), p.mean_m, p.latent_variance_m2);
+    p.latent_variance_m2 = std::max(p.latent_variance_m2, 0.0);
+    p.noise_variance_m2 = e.gp.noiseVariance();  // (P43)
+    p.mean_m += pairMean(f.id_a, f.id_b);       // (P28)
+    p.mean_m *= mean_scale_;                     // (P44)
+    p.covered = true;
+    return p;
+  }
   return p;
 }
 
@@ -248,6 +316,9 @@ nlohmann::json BiasModel::toJson() const {
           {"models", models},
           {"pair_means", means},
           {"extra_variance_m2", extra_variance_m2_},
+          {"mean_scale", mean_scale_},
+          {"full_variance", full_variance_},
+          {"target_mean_square_m2", target_mean_square_m2_},
           {"training", meta}};
 }
 
@@ -274,6 +345,9 @@ BiasModel BiasModel::fromJson(const nlohmann::json& j) {
     BiasModel model(j.at("preset").get<std::string>(), map, std::move(entries), std::move(means));
     if (j.contains("training")) model.metadata_json = j.at("training").dump();
     if (j.contains("extra_variance_m2")) model.setExtraVariance(j.at("extra_variance_m2").get<double>());
+    if (j.contains("mean_scale")) model.setMeanScale(j.at("mean_scale").get<double>());
+    if (j.value("full_variance", false))
+      model.setFullVariance(true, j.at("target_mean_square_m2").get<double>());
     return model;
   } catch (const nlohmann::json::exception& e) {
     throw std::invalid_argument(std::string("bias model: ") + e.what());
@@ -377,37 +451,59 @@ BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params,
   };
 
   std::vector<BiasModel::Entry> entries;
+  double elbo_weighted = 0.0, elbo_samples = 0.0;
   int model_index = 0;
   const int num_models = static_cast<int>(groups.size());
   for (const auto& [key, idx] : groups) {
-    std::vector<TdoaFeature> ftr, fho;
-    std::vector<double> ytr, yho;
-    for (std::size_t i : idx) {
-      (hold[i] ? fho : ftr).push_back(data.samples[i].feature);
-      (hold[i] ? yho : ytr).push_back(data.samples[i].error_m - meanOf(data.samples[i].feature));
-    }
     ++model_index;
-    if (ftr.size() < need) continue;  // per-pair: too few for this pair → no model (predicts 0)
-    const MatX X = featureMatrix(preset.features, ftr);
-    const VecX y = Eigen::Map<const VecX>(ytr.data(), static_cast<Eigen::Index>(ytr.size()));
-    const MatX Xh = featureMatrix(preset.features, fho);
-    const VecX yh = Eigen::Map<const VecX>(yho.data(), static_cast<Eigen::Index>(yho.size()));
+    std::size_t n_tr = 0;
+    for (std::size_t i : idx) n_tr += hold[i] ? 0 : 1;
+    if (n_tr < need) continue;  // per-pair: too few for this pair → no model (predicts 0)
+    // The GP inputs are written straight into the matrices the trainer reads (no intermediate feature copies).
+    const int D = featureDim(preset.features);
+    MatX X(static_cast<Eigen::Index>(n_tr), D), Xh(static_cast<Eigen::Index>(idx.size() - n_tr), D);
+    VecX y(X.rows()), yh(Xh.rows());
+    Eigen::Index itr = 0, iho = 0;
+    double row[kMaxFeatureDim];
+    for (std::size_t i : idx) {
+      const TdoaFeature& f = data.samples[i].feature;
+      featureRow(preset.features, f, row);
+      MatX& dst = hold[i] ? Xh : X;
+      Eigen::Index& k = hold[i] ? iho : itr;
+      for (int d = 0; d < D; ++d) dst(k, d) = row[d];
+      (hold[i] ? yh : y)[k] = data.samples[i].error_m - meanOf(f);
+      ++k;
+    }
     gp::Svgp svgp = gp::initSvgp(preset.kernel(), X, y, params.num_inducing, params.svgp.seed, preset.normalization);
     const int mi = model_index;
-    gp::trainSvgp(svgp, X, y, params.svgp, yh.size() > 0 ? &Xh : nullptr, yh.size() > 0 ? &yh : nullptr,
-                  [&](const gp::EpochReport& r) {
-                    if (progress) progress(mi, num_models, r);
-                  });
+    const gp::SvgpTrainSummary ts =
+        gp::trainSvgp(svgp, X, y, params.svgp, yh.size() > 0 ? &Xh : nullptr, yh.size() > 0 ? &yh : nullptr,
+                      [&](const gp::EpochReport& r) {
+                        if (progress) progress(mi, num_models, r);
+                      });
+    elbo_weighted += ts.final_elbo * static_cast<double>(X.rows());
+    elbo_samples += static_cast<double>(X.rows());
     entries.push_back({key.first, key.second, std::move(svgp)});
   }
   if (entries.empty()) throw std::invalid_argument("no anchor pair has enough training samples for the requested inducing points");
   BiasModel model(preset.name, preset.features, std::move(entries), std::move(means));
   model.setExtraVariance(params.extra_sigma_m * params.extra_sigma_m);  // (P31)
+  model.setMeanScale(params.mean_scale);                                 // (P44)
+  if (params.full_variance) {  // (P45): E[ε²] of the training targets
+    double sum_sq = 0.0, n = 0.0;
+    for (std::size_t i = 0; i < data.samples.size(); ++i) {
+      if (hold[i]) continue;
+      sum_sq += data.samples[i].error_m * data.samples[i].error_m;
+      n += 1.0;
+    }
+    model.setFullVariance(true, sum_sq / n);
+  }
 
   if (report) {
     BiasTrainReport r;
     r.train_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     r.num_models = static_cast<int>(model.entries().size());
+    r.final_elbo = elbo_samples > 0 ? elbo_weighted / elbo_samples : std::nan("");
     double se_before = 0, se_after = 0, sum_std = 0;
     for (std::size_t i = 0; i < data.samples.size(); ++i) {
       if (!hold[i]) {

@@ -115,9 +115,10 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
   if (bias && *bias) {
     const BiasPrediction b =
         (*bias)(makeTdoaFeature(z.id_a, z.id_b, x.w_p_b, x.w_q_b, anchor_a->m, anchor_b->m));
-    if (std::isfinite(b.mean_m) && std::isfinite(b.variance_m2) && b.variance_m2 >= 0.0) {
+    if (std::isfinite(b.mean_m) && std::isfinite(b.variance_m2) && b.variance_m2 >= 0.0 &&
+        std::isfinite(b.noise_scale) && b.noise_scale > 0.0) {
       z_corr -= b.mean_m;
-      var += b.variance_m2;
+      var = var * b.noise_scale + b.variance_m2;  // docs/math/gp.md (P45); noise_scale = 1: R + var_f
       res.bias_mean_m = b.mean_m;
     }
   }

@@ -7,11 +7,139 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <exception>
+#include <functional>
+#include <mutex>
 #include <numeric>
 #include <random>
 #include <stdexcept>
+#include <thread>
 
 namespace uwb::gp {
+
+namespace {
+
+int resolveThreads(int num_threads) {
+  if (num_threads < 0) throw std::invalid_argument("SVGP training: num_threads must be ≥ 0");
+  return num_threads == 0 ? static_cast<int>(std::max(1u, std::thread::hardware_concurrency())) : num_threads;
+}
+
+/// A fixed team of threads that runs task(t) for t = 0 … size − 1 (t = 0 on the calling thread) and waits for all.
+/// Kept for the whole training so that a step does not pay for thread creation.
+class ThreadTeam {
+ public:
+  explicit ThreadTeam(int size) : size_(std::max(1, size)), errors_(static_cast<std::size_t>(size_)) {
+    for (int t = 1; t < size_; ++t) workers_.emplace_back([this, t] { loop(t); });
+  }
+  ThreadTeam(const ThreadTeam&) = delete;
+  ThreadTeam& operator=(const ThreadTeam&) = delete;
+  ~ThreadTeam() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    start_.notify_all();
+    for (auto& w : workers_) w.join();
+  }
+  int size() const { return size_; }
+
+  void run(const std::function<void(int)>& task) {
+    if (size_ == 1) {
+      task(0);
+      return;
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      task_ = &task;
+      pending_ = size_ - 1;
+      ++generation_;
+    }
+    start_.notify_all();
+    try {
+      task(0);
+    } catch (...) {
+      errors_[0] = std::current_exception();
+    }
+    std::unique_lock<std::mutex> lock(mutex_);
+    done_.wait(lock, [this] { return pending_ == 0; });
+    task_ = nullptr;
+    for (auto& e : errors_) {
+      if (e) {
+        const std::exception_ptr first = e;
+        for (auto& f : errors_) f = nullptr;
+        std::rethrow_exception(first);
+      }
+    }
+  }
+
+ private:
+  void loop(int t) {
+    std::uint64_t seen = 0;
+    for (;;) {
+      const std::function<void(int)>* task = nullptr;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        start_.wait(lock, [&] { return stop_ || generation_ != seen; });
+        if (stop_) return;
+        seen = generation_;
+        task = task_;
+      }
+      try {
+        (*task)(t);
+      } catch (...) {
+        errors_[static_cast<std::size_t>(t)] = std::current_exception();
+      }
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (--pending_ == 0) done_.notify_one();
+      }
+    }
+  }
+
+  int size_;
+  std::vector<std::exception_ptr> errors_;
+  std::vector<std::thread> workers_;
+  std::mutex mutex_;
+  std::condition_variable start_, done_;
+  const std::function<void(int)>* task_ = nullptr;
+  int pending_ = 0;
+  std::uint64_t generation_ = 0;
+  bool stop_ = false;
+};
+
+/// Rows [begin, end) of part t when n rows are cut into `parts` contiguous parts of sizes differing by ≤ 1.
+std::pair<Eigen::Index, Eigen::Index> partRange(Eigen::Index n, int parts, int t) {
+  return {n * t / parts, n * (t + 1) / parts};
+}
+
+constexpr Eigen::Index kFullDataChunk = 4096;  ///< rows per chunk of the full-data passes (P41)
+
+/// Runs chunk(begin, end, t) over consecutive kFullDataChunk-row chunks of n rows; thread t takes the chunks
+/// t, t + T, t + 2T, … so that every thread's partial sums are formed in a fixed order.
+void forEachChunk(ThreadTeam& team, Eigen::Index n, const std::function<void(Eigen::Index, Eigen::Index, int)>& chunk) {
+  const Eigen::Index chunks = (n + kFullDataChunk - 1) / kFullDataChunk;
+  team.run([&](int t) {
+    for (Eigen::Index c = t; c < chunks; c += team.size())
+      chunk(c * kFullDataChunk, std::min(n, (c + 1) * kFullDataChunk), t);
+  });
+}
+
+/// Seeded random subset of at most max_points rows (the first max_points of a shuffled index list).
+MatX seededSubset(const MatX& X_all, int max_points, std::mt19937_64& rng) {
+  if (X_all.rows() <= max_points) return X_all;
+  std::vector<Eigen::Index> idx(static_cast<std::size_t>(X_all.rows()));
+  std::iota(idx.begin(), idx.end(), 0);
+  std::shuffle(idx.begin(), idx.end(), rng);
+  MatX X(max_points, X_all.cols());
+  for (int i = 0; i < max_points; ++i) X.row(i) = X_all.row(idx[static_cast<std::size_t>(i)]);
+  return X;
+}
+
+/// k-means++ seeding and Lloyd iterations on all rows of X, drawing from rng.
+MatX kmeansOnRows(const MatX& X, int M, std::mt19937_64& rng, int lloyd_iterations);
+
+}  // namespace
 
 void SvgpTrainParams::validate() const {
   auto bad = [](const std::string& what) { throw std::invalid_argument("SvgpTrainParams: " + what); };
@@ -20,6 +148,7 @@ void SvgpTrainParams::validate() const {
   if (!(lr >= 0) || !(lr_inducing >= 0) || !(lr_variational >= 0)) bad("learning rates must be ≥ 0");
   if (!(lr_final_fraction > 0) || lr_final_fraction > 1) bad("lr_final_fraction must be in (0, 1]");
   if (natgrad_step > 1) bad("natgrad_step must be ≤ 1");
+  if (num_threads < 0) bad("num_threads must be ≥ 0 (0: one per hardware thread)");
   if (!(min_noise_variance > 0)) bad("min_noise_variance must be > 0");
 }
 
@@ -28,14 +157,12 @@ void SvgpTrainParams::validate() const {
 MatX kmeansPlusPlus(const MatX& X_all, int M, std::uint64_t seed, int lloyd_iterations, int max_points) {
   if (M < 1) throw std::invalid_argument("k-means++: need at least one center");
   std::mt19937_64 rng(seed);
-  MatX X = X_all;
-  if (X_all.rows() > max_points) {  // seeded random subset
-    std::vector<Eigen::Index> idx(static_cast<std::size_t>(X_all.rows()));
-    std::iota(idx.begin(), idx.end(), 0);
-    std::shuffle(idx.begin(), idx.end(), rng);
-    X.resize(max_points, X_all.cols());
-    for (int i = 0; i < max_points; ++i) X.row(i) = X_all.row(idx[static_cast<std::size_t>(i)]);
-  }
+  return kmeansOnRows(seededSubset(X_all, max_points, rng), M, rng, lloyd_iterations);
+}
+
+namespace {
+
+MatX kmeansOnRows(const MatX& X, int M, std::mt19937_64& rng, int lloyd_iterations) {
   const Eigen::Index N = X.rows();
   if (N < M) throw std::invalid_argument("k-means++: " + std::to_string(N) + " points for " + std::to_string(M) + " centers");
   MatX C(M, X.cols());
@@ -78,6 +205,8 @@ MatX kmeansPlusPlus(const MatX& X_all, int M, std::uint64_t seed, int lloyd_iter
   return C;
 }
 
+}  // namespace
+
 Svgp initSvgp(Kernel kernel, const MatX& X, const VecX& y, int num_inducing, std::uint64_t seed,
               InputNormalization normalization) {
   if (X.rows() != y.size() || X.rows() == 0) throw std::invalid_argument("initSvgp: X and y mismatch or empty");
@@ -103,8 +232,11 @@ Svgp initSvgp(Kernel kernel, const MatX& X, const VecX& y, int num_inducing, std
   }
   Svgp probe(kernel, MatX::Zero(1, X.cols()));
   probe.setInputTransform(shift, scale);
-  const MatX Xt = probe.transformInputs(X);
-  Svgp gp(kernel, kmeansPlusPlus(Xt, num_inducing, seed));
+  // k-means++ on a seeded subset (the same rows kmeansPlusPlus would pick), transformed after subsetting: no copy of
+  // the whole X is made.
+  if (num_inducing < 1) throw std::invalid_argument("k-means++: need at least one center");
+  std::mt19937_64 rng(seed);
+  Svgp gp(kernel, kmeansOnRows(probe.transformInputs(seededSubset(X, 20000, rng)), num_inducing, rng, 10));
   gp.setInputTransform(shift, scale);
   gp.setMean(ymean);
   gp.setNoiseVariance(0.5 * yvar);
@@ -163,16 +295,92 @@ void naturalGradientStep(Svgp& gp, NaturalParams& nat, const MatX& AAt, const Ve
   gp.setVariational(m, L);
 }
 
+std::vector<Eigen::Index> balancedBatchSizes(Eigen::Index num_data, Eigen::Index batch_size) {
+  if (num_data < 1 || batch_size < 1) throw std::invalid_argument("balancedBatchSizes: need N ≥ 1 and B ≥ 1");
+  // P40: n = ⌈N/B⌉ batches, batch b = positions ⌊bN/n⌋ … ⌊(b+1)N/n⌋ − 1 (sizes ⌊N/n⌋ or ⌈N/n⌉, all ≤ B)
+  const Eigen::Index n = (num_data + batch_size - 1) / batch_size;
+  std::vector<Eigen::Index> sizes(static_cast<std::size_t>(n));
+  for (Eigen::Index b = 0; b < n; ++b) sizes[static_cast<std::size_t>(b)] = num_data * (b + 1) / n - num_data * b / n;
+  return sizes;
+}
+
+namespace {
+
+ElboTerms fullDataElboOn(ThreadTeam& team, const Svgp& gp, const MatX& X, const VecX& y) {
+  // P15 over all data: Σ_n ELL_n from chunks (each chunk's exp_log_lik_sum), then − KL; per datum.
+  const Eigen::Index N = X.rows();
+  std::vector<double> ell(static_cast<std::size_t>(team.size()), 0.0);
+  forEachChunk(team, N, [&](Eigen::Index begin, Eigen::Index end, int t) {
+    const ElboTerms e = gp.elbo(X.middleRows(begin, end - begin), y.segment(begin, end - begin),
+                                static_cast<double>(N), nullptr, ElboMode::kExact);
+    ell[static_cast<std::size_t>(t)] += e.exp_log_lik_sum;
+  });
+  ElboTerms out;
+  for (double v : ell) out.exp_log_lik_sum += v;
+  out.exp_log_lik = out.exp_log_lik_sum / static_cast<double>(N);
+  out.kl = gp.kl();
+  out.elbo = out.exp_log_lik - out.kl / static_cast<double>(N);
+  return out;
+}
+
+void setOptimalVariationalOn(ThreadTeam& team, Svgp& gp, const MatX& X, const VecX& y) {
+  // P41: Σ k_Z(x_n) k_Z(x_n)ᵀ and Σ k_Z(x_n)(y_n − c) over chunks, then A Aᵀ = Lz⁻¹ (Σ k kᵀ) Lz⁻ᵀ once.
+  const Eigen::Index M = gp.numInducing(), N = X.rows();
+  std::vector<MatX> KKt(static_cast<std::size_t>(team.size()), MatX::Zero(M, M));
+  std::vector<VecX> Ky(static_cast<std::size_t>(team.size()), VecX::Zero(M));
+  forEachChunk(team, N, [&](Eigen::Index begin, Eigen::Index end, int t) {
+    const MatX Xt = gp.transformInputs(X.middleRows(begin, end - begin));
+    const MatX Kzx = gp.kernel().cross(gp.inducing(), Xt);
+    KKt[static_cast<std::size_t>(t)].selfadjointView<Eigen::Lower>().rankUpdate(Kzx);
+    Ky[static_cast<std::size_t>(t)].noalias() +=
+        Kzx * (y.segment(begin, end - begin).array() - gp.meanConstant()).matrix();
+  });
+  MatX KKt_sum = MatX::Zero(M, M);
+  VecX Ky_sum = VecX::Zero(M);
+  for (std::size_t t = 0; t < KKt.size(); ++t) {
+    KKt_sum += KKt[t];
+    Ky_sum += Ky[t];
+  }
+  KKt_sum = KKt_sum.selfadjointView<Eigen::Lower>();
+  MatX Kzz = gp.kernel().gram(gp.inducing());
+  Kzz.diagonal().array() += gp.jitter();
+  const Eigen::LLT<MatX> lz(Kzz);
+  if (lz.info() != Eigen::Success) throw std::runtime_error("optimal q(v): Kzz is not positive definite");
+  const auto Lz = lz.matrixL();
+  MatX AAt = Lz.solve(Lz.solve(KKt_sum).transpose());
+  AAt = 0.5 * (AAt + AAt.transpose()).eval();
+  const VecX Ay = Lz.solve(Ky_sum);
+  // The natural-gradient step with γ = 1 and the whole data as the batch (B = N) lands on the optimum (P23, P41).
+  NaturalParams nat = NaturalParams::fromSvgp(gp);
+  naturalGradientStep(gp, nat, AAt, Ay, static_cast<double>(N), static_cast<double>(N), 1.0);
+}
+
+}  // namespace
+
+ElboTerms fullDataElbo(const Svgp& gp, const MatX& X, const VecX& y, int num_threads) {
+  if (X.rows() != y.size() || X.rows() == 0) throw std::invalid_argument("fullDataElbo: X and y mismatch or empty");
+  ThreadTeam team(resolveThreads(num_threads));
+  return fullDataElboOn(team, gp, X, y);
+}
+
+void setOptimalVariational(Svgp& gp, const MatX& X, const VecX& y, int num_threads) {
+  if (X.rows() != y.size() || X.rows() == 0) throw std::invalid_argument("setOptimalVariational: X and y mismatch or empty");
+  ThreadTeam team(resolveThreads(num_threads));
+  setOptimalVariationalOn(team, gp, X, y);
+}
+
 SvgpTrainSummary trainSvgp(Svgp& gp, const MatX& X, const VecX& y, const SvgpTrainParams& params, const MatX* X_val,
                            const VecX* y_val, const std::function<void(const EpochReport&)>& on_epoch) {
   params.validate();
   if (X.rows() != y.size() || X.rows() == 0) throw std::invalid_argument("trainSvgp: X and y mismatch or empty");
   const auto t0 = std::chrono::steady_clock::now();
   const Eigen::Index N = X.rows(), D = X.cols(), M = gp.numInducing();
-  const Eigen::Index B = std::min<Eigen::Index>(params.batch_size, N);
-  const Eigen::Index nbatches = (N + B - 1) / B;
+  const std::vector<Eigen::Index> batch_sizes = balancedBatchSizes(N, std::min<Eigen::Index>(params.batch_size, N));
+  const Eigen::Index nbatches = static_cast<Eigen::Index>(batch_sizes.size());
   const bool natgrad = params.natgrad_step > 0;
   const int P = gp.kernel().numParams();
+  ThreadTeam team(resolveThreads(params.num_threads));
+  const int T = team.size();
 
   // Flat optimizer vector: [log θ (P) | log σ_n² | c | Z (M·D) | m (M) | L (M·M)]  (P24)
   const Eigen::Index oZ = P + 2, om = oZ + M * D, oL = om + M, n = natgrad ? om : oL + M * M;
@@ -215,22 +423,71 @@ SvgpTrainSummary trainSvgp(Svgp& gp, const MatX& X, const VecX& y, const SvgpTra
   std::iota(perm.begin(), perm.end(), 0);
   const double total_steps = static_cast<double>(params.epochs * nbatches);
   SvgpTrainSummary summary;
-  MatX Xb;
-  VecX yb, grad(n);
+  summary.batches_per_epoch = static_cast<int>(nbatches);
+  // Per thread: its contiguous part of the minibatch, its ELBO terms and gradient (P42).
+  std::vector<MatX> Xb(static_cast<std::size_t>(T));
+  std::vector<VecX> yb(static_cast<std::size_t>(T));
+  std::vector<SvgpGradient> gt(static_cast<std::size_t>(T));
+  std::vector<ElboTerms> et(static_cast<std::size_t>(T));
+  std::vector<Eigen::Index> part_size(static_cast<std::size_t>(T));
+  VecX grad(n);
   SvgpGradient g;
   for (int epoch = 1; epoch <= params.epochs; ++epoch) {
     std::shuffle(perm.begin(), perm.end(), rng);
     double elbo_sum = 0.0;
+    Eigen::Index start = 0;
     for (Eigen::Index b = 0; b < nbatches; ++b) {
-      const Eigen::Index start = b * B, size = std::min(B, N - start);
-      Xb.resize(size, X.cols());
-      yb.resize(size);
-      for (Eigen::Index i = 0; i < size; ++i) {
-        Xb.row(i) = X.row(perm[static_cast<std::size_t>(start + i)]);
-        yb[i] = y[perm[static_cast<std::size_t>(start + i)]];
+      const Eigen::Index size = batch_sizes[static_cast<std::size_t>(b)];
+      const int parts = static_cast<int>(std::min<Eigen::Index>(T, size));
+      // P42: every thread gathers and evaluates its contiguous part of the batch; the batch ELBO and gradient are
+      // the size-weighted sums of the parts' per-datum values (every term is an average over data or data-free),
+      // A Aᵀ and A r are plain sums. Parts are added in thread order: deterministic for a given thread count.
+      team.run([&](int t) {
+        const std::size_t ti = static_cast<std::size_t>(t);
+        part_size[ti] = 0;
+        if (t >= parts) return;
+        const auto [begin, end] = partRange(size, parts, t);
+        part_size[ti] = end - begin;
+        Xb[ti].resize(end - begin, D);
+        yb[ti].resize(end - begin);
+        for (Eigen::Index i = begin; i < end; ++i) {
+          const Eigen::Index src = perm[static_cast<std::size_t>(start + i)];
+          Xb[ti].row(i - begin) = X.row(src);
+          yb[ti][i - begin] = y[src];
+        }
+        et[ti] = gp.elbo(Xb[ti], yb[ti], static_cast<double>(N), &gt[ti], params.mode);
+      });
+      start += size;
+      double elbo = 0.0;
+      for (int t = 0; t < parts; ++t) {
+        const std::size_t ti = static_cast<std::size_t>(t);
+        const double w = static_cast<double>(part_size[ti]) / static_cast<double>(size);
+        elbo += w * et[ti].elbo;
+        if (t == 0) {
+          g.kernel = w * gt[0].kernel;
+          g.noise = w * gt[0].noise;
+          g.mean = w * gt[0].mean;
+          g.Z = w * gt[0].Z;
+          g.AAt = gt[0].AAt;
+          g.Ar = gt[0].Ar;
+          if (!natgrad) {
+            g.m = w * gt[0].m;
+            g.L = w * gt[0].L;
+          }
+        } else {
+          g.kernel += w * gt[ti].kernel;
+          g.noise += w * gt[ti].noise;
+          g.mean += w * gt[ti].mean;
+          g.Z += w * gt[ti].Z;
+          g.AAt += gt[ti].AAt;
+          g.Ar += gt[ti].Ar;
+          if (!natgrad) {
+            g.m += w * gt[ti].m;
+            g.L += w * gt[ti].L;
+          }
+        }
       }
-      const ElboTerms e = gp.elbo(Xb, yb, static_cast<double>(N), &g, params.mode);
-      elbo_sum += e.elbo;
+      elbo_sum += elbo;
       if (natgrad) {
         const VecX Ay = g.Ar + g.AAt * gp.variationalMean();  // A (y − c) = A r + A Aᵀ m
         naturalGradientStep(gp, nat, g.AAt, Ay, static_cast<double>(size), static_cast<double>(N), params.natgrad_step);
@@ -250,12 +507,15 @@ SvgpTrainSummary trainSvgp(Svgp& gp, const MatX& X, const VecX& y, const SvgpTra
       unpack();
       ++summary.steps;
     }
+    const bool last = epoch == params.epochs;
+    if (last && params.final_full_data_q) setOptimalVariationalOn(team, gp, X, y);  // P41
     EpochReport rep;
     rep.epoch = epoch;
     rep.epochs = params.epochs;
     rep.elbo = elbo_sum / static_cast<double>(nbatches);
+    if (last) summary.final_elbo = fullDataElboOn(team, gp, X, y).elbo;
     if (X_val && y_val && X_val->rows() > 0) {
-      const SvgpPrediction p = gp.predictor().predict(*X_val);
+      const SvgpPrediction p = gp.predictor().predict(*X_val, T);
       rep.val_rmse = std::sqrt((*y_val - p.mean).squaredNorm() / static_cast<double>(y_val->size()));
     }
     rep.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -50,6 +50,8 @@ int featureDim(FeatureMap map);
 /// Writes the GP input row of f into row (featureDim(map) values).
 void featureRow(FeatureMap map, const TdoaFeature& f, double* row);
 MatX featureMatrix(FeatureMap map, const std::vector<TdoaFeature>& features);
+/// Names of the featureDim(map) input columns, with units (e.g. "b_p_a_x_m", "yaw_a_rad").
+std::vector<std::string> featureColumnNames(FeatureMap map);
 
 /// Paper and extra presets: kernel, feature map, one GP per pair or one global GP.
 struct BiasPreset {
@@ -73,6 +75,10 @@ struct BiasTrainParams {
   /// Std added (in quadrature) to every predicted bias variance, i.e. to the filter's TDoA noise R when the
   /// correction is on [m] (docs/math/gp.md P31). 0: the paper's R + latent variance only.
   double extra_sigma_m = 0.0;
+  /// Factor on the predicted mean stored in the model (P44); 1 = the paper's correction.
+  double mean_scale = 1.0;
+  /// The filter's TDoA variance scaled by the unexplained share of the error (P45) instead of R + var_f.
+  bool full_variance = false;
   void validate() const;
 };
 
@@ -84,6 +90,18 @@ struct BiasTrainReport {
   double mean_predicted_std_m = 0.0;  ///< mean predictive std (latent) on the held-out part
   double train_seconds = 0.0;
   int num_models = 0;
+  /// Full-data ELBO per datum of the returned model(s) on their training samples (docs/math/gp.md P41); with
+  /// several GPs, their mean weighted by training samples.
+  double final_elbo = 0.0;
+};
+
+/// Predictive distribution of a measurement's error ε (docs/math/gp.md P43): ε ~ N(mean, latent + noise).
+struct BiasPredictive {
+  double mean_m = 0.0;              ///< pair mean (P28) + GP mean
+  double latent_variance_m2 = 0.0;  ///< var_f of the GP mean (with the jitter)
+  double noise_variance_m2 = 0.0;   ///< σ_n² of the GP's likelihood: the part of ε the inputs do not explain
+  bool covered = false;             ///< false: no GP covers the pair (mean 0, variances 0)
+  double varianceM2() const { return latent_variance_m2 + noise_variance_m2; }
 };
 
 /// Progress: (model index, number of models, epoch report).
@@ -106,6 +124,8 @@ class BiasModel {
 
   /// Predicted bias (mean, latent variance) for one measurement's feature. {0, 0} when no model covers the pair.
   BiasPrediction predict(const TdoaFeature& f) const;
+  /// Predictive distribution of ε itself (latent and likelihood variance, without the extra variance P31).
+  BiasPredictive predictive(const TdoaFeature& f) const;
   /// A cheap-to-copy, thread-compatible callable for the filter (shares this model's immutable state).
   BiasPredictor predictor() const;
 
@@ -116,6 +136,15 @@ class BiasModel {
   /// Variance added to every prediction [m²] (P31).
   double extraVariance() const { return extra_variance_m2_; }
   void setExtraVariance(double variance_m2);  ///< throws std::invalid_argument when negative or not finite
+  /// P45: with the full variance on, predict() asks the filter for R = (var_f + σ_n²)/E[ε²] · σ_tdoa² + extra (the
+  /// filter's TDoA variance scaled by the share of the training error power the model leaves unexplained) instead
+  /// of the paper's σ_tdoa² + var_f + extra. E[ε²]: mean square of the training targets.
+  bool fullVariance() const { return full_variance_; }
+  double targetMeanSquare() const { return target_mean_square_m2_; }
+  void setFullVariance(bool on, double target_mean_square_m2);  ///< throws when on and the mean square is not > 0
+  /// Factor w ∈ [0, 1] on the predicted mean (docs/math/gp.md P44): the correction subtracts w·µ. 1 = the paper.
+  double meanScale() const { return mean_scale_; }
+  void setMeanScale(double w);  ///< throws std::invalid_argument outside [0, 1]
   /// Constant mean of the pair (0 when none was learned).
   double pairMean(int id_a, int id_b) const;
 
@@ -134,6 +163,9 @@ class BiasModel {
   std::vector<Entry> entries_;
   std::vector<PairMean> pair_means_;
   double extra_variance_m2_ = 0.0;
+  double mean_scale_ = 1.0;
+  bool full_variance_ = false;
+  double target_mean_square_m2_ = 0.0;
   std::shared_ptr<const std::vector<gp::SvgpPredictor>> predictors_;
 };
 

@@ -55,7 +55,7 @@ struct EvaluationResult {
   std::vector<EvaluationRun> runs;
   std::vector<EvaluationRow> rows;
   std::map<std::string, LocalizationRun> uncorrected;  ///< by test flight
-  /// Corrected localization of each test flight with the best configuration (highest improvement, repeat 1).
+  /// Corrected localization of each test flight with the best configuration (most negative change, repeat 1).
   std::map<std::string, LocalizationRun> best_corrected;
   std::string best_kernel;
   int best_inducing = 0;

@@ -22,9 +22,15 @@ struct EvaluationRun {
   double bias_rmse_before_m = 0.0;  ///< TDoA bias RMSE on the test flight, raw
   double bias_rmse_after_m = 0.0;   ///< TDoA bias RMSE after subtracting the GP mean (ground-truth features)
   double train_seconds = 0.0;
+  /// Calibration of the predicted bias on this flight (eval/BiasCalibration.h, docs/math/gp.md P43).
+  double coverage_1sigma = 0.0;     ///< fraction of samples with |ε − µ| ≤ σ (nominal 0.683)
+  double coverage_2sigma = 0.0;     ///< fraction with |ε − µ| ≤ 2σ (nominal 0.954)
+  double nlpd = 0.0;                ///< mean negative log predictive density of ε [nats]
+  std::vector<double> coverage;     ///< at calibrationLevels()
 };
 
-/// One row of the table: a kernel and a number of inducing points.
+/// One row of the table: a kernel and a number of inducing points. RMSEs are per flight (airborne samples of one
+/// flight), then averaged over test flights and repeats; they are not pooled over the samples of all flights.
 struct EvaluationRow {
   std::string kernel;
   int inducing = 0;
@@ -32,12 +38,17 @@ struct EvaluationRow {
   int n_flights = 0;
   double rmse_uncorrected_m = 0.0;  ///< mean over repeats and test flights
   double rmse_corrected_m = 0.0;    ///< mean over repeats and test flights
-  double improvement_pct = 0.0;     ///< 100 (1 − corrected / uncorrected), from the means above
-  double improvement_pct_min = 0.0; ///< over repeats (each repeat: mean over flights)
-  double improvement_pct_max = 0.0;
+  /// 100 (corrected / uncorrected − 1) from the means above: NEGATIVE = the correction reduced the error
+  /// (e.g. −18.4 %), the one sign convention of the tool, tables, JSON and docs.
+  double change_pct = 0.0;
+  double change_pct_min = 0.0;      ///< over repeats (each repeat: mean over flights); min = the best repeat
+  double change_pct_max = 0.0;
   double bias_rmse_before_m = 0.0;
   double bias_rmse_after_m = 0.0;
   double train_seconds = 0.0;       ///< mean per model
+  double coverage_1sigma = 0.0;     ///< mean over repeats and test flights
+  double coverage_2sigma = 0.0;
+  double nlpd = 0.0;
 };
 
 /// Groups runs by (kernel, inducing) in first-seen kernel order and ascending inducing count.
@@ -48,5 +59,10 @@ std::string toCsv(const std::vector<EvaluationRow>& rows);
 /// JSON array, one object per row (keys as in EvaluationRow; the results.json contract of `evaluate`).
 nlohmann::json toJson(const std::vector<EvaluationRow>& rows);
 std::string runsToCsv(const std::vector<EvaluationRun>& runs);
+/// JSON array, one object per run (every key of EvaluationRun except the coverage curve, plus change_pct).
+nlohmann::json runsToJson(const std::vector<EvaluationRun>& runs);
+/// Per test flight (repeats averaged) for one configuration: airborne RMSE without/with correction, bias RMSE,
+/// 1σ/2σ coverage and NLPD of the predicted bias (docs/math/gp.md P43), as a Markdown table.
+std::string perFlightMarkdown(const std::vector<EvaluationRun>& runs, const std::string& kernel, int inducing);
 
 }  // namespace uwb

@@ -2,7 +2,8 @@
  *  @brief Training of a whitened SVGP: k-means++ inducing points, Adam with a decaying learning rate for the
  *         hyperparameters and inducing points, natural-gradient steps for q(v) (Salimbeni et al. 2018).
  *
- *  docs/math/gp.md P21–P24. Deterministic for a given seed (one std::mt19937_64, no threads).
+ *  docs/math/gp.md P21–P24, P40–P42. Deterministic for a given seed and thread count (one std::mt19937_64; a
+ *  minibatch is split into as many contiguous parts as threads and their sums are added in thread order).
  */
 #pragma once
 
@@ -27,6 +28,12 @@ struct SvgpTrainParams {
   bool train_hyperparameters = true;
   double min_noise_variance = 1e-6;  ///< floor on σ_n² [output units²]
   ElboMode mode = ElboMode::kFast;
+  /// Threads that share each minibatch (0: one per hardware thread). Results depend on the seed and on this count
+  /// (the order of the partial sums), not on scheduling.
+  int num_threads = 0;
+  /// After the last step, set q(v) to its optimum for the final hyperparameters on the FULL data (P41): the returned
+  /// model does not depend on which minibatch came last, and its full-data ELBO is never below the last iterate's.
+  bool final_full_data_q = true;
   /// Throws std::invalid_argument naming the bad field.
   void validate() const;
 };
@@ -44,7 +51,23 @@ struct SvgpTrainSummary {
   std::vector<EpochReport> history;
   double seconds = 0.0;
   int steps = 0;
+  int batches_per_epoch = 0;
+  /// ELBO per datum on the full training data of the returned model (P15 summed over all data).
+  double final_elbo = std::numeric_limits<double>::quiet_NaN();
 };
+
+/// Minibatch sizes of one epoch (P40): ⌈N/B⌉ batches whose sizes differ by at most one (batch b covers positions
+/// ⌊bN/n⌋ … ⌊(b+1)N/n⌋ − 1 of the epoch's permutation), so no step sees a tiny remainder batch whose natural-gradient
+/// step would be scaled by N/r.
+std::vector<Eigen::Index> balancedBatchSizes(Eigen::Index num_data, Eigen::Index batch_size);
+
+/// ELBO per datum (P15) over ALL of (X, y): Σ_n ELL_n / N − KL / N, in chunks (no copy of X), on num_threads threads
+/// (0: one per hardware thread).
+ElboTerms fullDataElbo(const Svgp& gp, const MatX& X, const VecX& y, int num_threads = 1);
+
+/// Sets q(v) to the ELBO's optimum for gp's current kernel, inducing points, mean and noise on all of (X, y) (P41):
+/// S⁻¹ = I + σ⁻² Σ_n a_n a_nᵀ, m = S σ⁻² Σ_n a_n (y_n − c). Chunks, threads as fullDataElbo.
+void setOptimalVariational(Svgp& gp, const MatX& X, const VecX& y, int num_threads = 1);
 
 /// k-means++ seeding (Arthur & Vassilvitskii 2007) then `lloyd_iterations` Lloyd steps; returns M×D centers.
 /// At most `max_points` rows (a seeded random subset) are used. Throws when X has fewer than M distinct rows.

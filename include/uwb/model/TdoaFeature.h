@@ -30,10 +30,13 @@ struct TdoaFeature {
 TdoaFeature makeTdoaFeature(int id_a, int id_b, const Vec3& w_p_b, const Quat& w_q_b, const Vec3& w_p_anchor_a,
                             const Vec3& w_p_anchor_b);
 
-/// Predicted TDoA bias: mean [m] and variance [m²]; the corrected measurement is z − mean.
+/// Predicted TDoA bias: mean [m] and variance [m²]; the corrected measurement is z − mean, its variance
+/// noise_scale · σ_tdoa² + variance_m2 (σ_tdoa² the filter's own TDoA variance). noise_scale = 1: the paper's
+/// R + var_f; a model that predicts how much of the error it leaves unexplained scales R by it (docs/math/gp.md P45).
 struct BiasPrediction {
   double mean_m = 0.0;
   double variance_m2 = 0.0;
+  double noise_scale = 1.0;  ///< factor (> 0) on the filter's TDoA variance for the corrected measurement
 };
 
 /// feature → predicted bias. Must be cheap (called once per TDoA update) and thread-compatible.

@@ -1,0 +1,62 @@
+/** @file TrainCliTest.cpp
+ *  @brief `uwbtdoa train`: --dump-arrays writes the training arrays with named columns, the summary reports the
+ *         full-data ELBO, and a given seed and thread count gives the same model file.
+ */
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "support/TestSupport.h"
+
+namespace uwb {
+namespace {
+
+std::string readAll(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(TrainCli, DumpsNamedTrainingArraysAndIsRepeatableForASeedAndThreadCount) {
+  if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
+  const auto flight = test::pilotFlight("0425-traj3");
+  UWB_REQUIRE_REAL_DATA(flight);
+  const auto dir = std::filesystem::temp_directory_path() / ("uwb_train_cli_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string base = "train " + flight->string() + " --anchors " + test::pilotSurvey("0425").string() +
+                           " --kernel tdoa --inducing 10 --epochs 2 --threads 2 --quiet --json";
+  // WHEN the same training runs twice, the first one also dumping its arrays
+  const test::CliResult a =
+      test::runCli(base + " --out " + (dir / "a.json").string() + " --dump-arrays " + (dir / "arrays.csv").string());
+  const test::CliResult b = test::runCli(base + " --out " + (dir / "b.json").string());
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  const nlohmann::json summary = nlohmann::json::parse(a.out);
+  // THEN the arrays have the named columns of the tdoa inputs, one row per sample, the held-out ones marked
+  std::ifstream csv(dir / "arrays.csv");
+  std::string header, line;
+  std::getline(csv, header);
+  EXPECT_EQ(header, "flight,t_s,id_a,id_b,b_p_a_x_m,b_p_a_y_m,b_p_a_z_m,b_p_b_x_m,b_p_b_y_m,b_p_b_z_m,error_m,holdout");
+  std::size_t rows = 0, held = 0;
+  while (std::getline(csv, line)) {
+    ++rows;
+    held += line.back() == '1' ? 1 : 0;
+    if (rows == 1) EXPECT_EQ(line.rfind("0425-traj3,", 0), 0u) << line;
+  }
+  EXPECT_EQ(rows, summary.at("n_train").get<std::size_t>() + summary.at("n_holdout").get<std::size_t>());
+  EXPECT_EQ(held, summary.at("n_holdout").get<std::size_t>());
+  EXPECT_TRUE(std::isfinite(summary.at("final_elbo").get<double>()));
+  // AND the two runs wrote the same model (the summary's file name aside)
+  nlohmann::json ma = nlohmann::json::parse(readAll(dir / "a.json")), mb = nlohmann::json::parse(readAll(dir / "b.json"));
+  EXPECT_EQ(ma.at("models").dump(), mb.at("models").dump());
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace uwb
