@@ -1,7 +1,7 @@
 /** @file cmd_localize.cpp
  *  @brief `uwbtdoa localize FLIGHT.csv --anchors SURVEY.txt [--out TRAJ.csv] [--json] [--config FILE.json] ...`:
  *         runs the localization filter (IMU-driven ESKF, or TDoA-only without IMU), writes the trajectory and
- *         prints the position RMSE against the flight's ground truth (issue 3, "Command line").
+ *         prints the position RMSE against the flight's ground truth.
  */
 #include <chrono>
 #include <ctime>
@@ -158,7 +158,7 @@ void runLocalize(const LocalizeArgs& a) {
   if (a.no_ground_detect) params.ground_phase = uwb::GroundPhase::kNone;
   if (a.fuse_tof) params.fuse_tof = true;
   params.validate();
-  // issue 5: the GP bias model as a plain BiasPredictor (the filter knows nothing of GPs)
+  // The GP bias model as a plain BiasPredictor (the filter knows nothing of GPs)
   uwb::BiasPredictor bias;
   if (!a.bias_model.empty()) bias = uwb::BiasModel::load(a.bias_model).predictor();
 

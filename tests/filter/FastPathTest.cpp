@@ -1,5 +1,5 @@
 /** @file FastPathTest.cpp
- *  @brief The structure-exploiting fast paths of the filter (issue 3) against their dense references:
+ *  @brief The structure-exploiting fast paths of the filter against their dense references:
  *         Taylor-series SO(3) Exp and right Jacobian (F6, F8), column-block covariance fold (F7), the TDoA message
  *         built from C's two blocks (G16), and the two-block equality node (G18); the filter's part of the TDoA node
  *         (G11–G12), its attitude row without C, and the equality node given the gate's P aᵀ.

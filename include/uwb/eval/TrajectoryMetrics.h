@@ -1,6 +1,6 @@
 /** @file TrajectoryMetrics.h
  *  @brief Position error of an estimated trajectory against ground truth: the estimate is interpolated at the
- *         ground-truth timestamps and the body origins are compared (issue 3, "Command line").
+ *         ground-truth timestamps and the body origins are compared.
  *         RMSE per axis and 3D, 50/90/99 % percentiles, whole flight and airborne (ground-truth z > 0.3 m).
  */
 #pragma once
