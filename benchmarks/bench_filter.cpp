@@ -1,25 +1,12 @@
 /** @file bench_filter.cpp
  *  @brief Cost of one IMU prediction, one covariance propagation, one TDoA update (graph node), and a whole flight
- *         (real-time factor). Run: build/bench_filter --benchmark_repetitions=5 --benchmark_report_aggregates_only.
+ *         (real-time factor).
+ *         Run: build/benchmarks/bench_filter --benchmark_repetitions=7 --benchmark_report_aggregates_only=true
  *         The flight benchmark uses 0425-traj2 when the data is present, else a synthetic 40 s flight with 1 kHz IMU
  *         and 400 Hz TDoA. Real-time factors (flight duration / run time): `rtf` and `rtf_cpu` use the CPU time of the
  *         benchmark thread (Google Benchmark divides kIsRate counters by CPU time), `rtf_wall` the wall-clock time of
  *         the timed loop. On a shared machine quote rtf_cpu; rtf_wall also counts time spent waiting for a core.
- *
- *  Session 3 (issue 3), CPU-time medians of --benchmark_repetitions=7, the session-2 binary (c2f16be) and the session-3
- *  one (403043c, then d5c12e9) run alternately, four rounds, load 1.8–2.4 (another developer on one of the two cores):
- *    IMU prediction                 243–251 ns → 187–203 ns
- *    prediction + covariance        760–911 ns → 654–814 ns
- *    TDoA update                    220–237 ns → 227–239 ns (path unchanged)
- *    whole flight, synthetic 40 s   4 314–4 928× (median 4 545×) → 5 112–5 786× (median 5 155×)
- *    whole flight, real 0425-traj2  4 218–4 869× (median 4 378×) → 4 744–5 591× (median 4 911×)
- *  callgrind, TdoaLocalizer::run on traj2: 40.0 M → 35.6 M instructions. The spread between runs on this shared
- *  machine (±5–10 %) is as large as one step of the work.
- *  Session 3, second round (f8c2d42, 3eb7bbe, 76f6e69: G18 downdate and F7 fold axpys in full 4-wide packets, one-pass
- *  clean check): callgrind 35.6 M → 31.6 M instructions, bit-identical results. c87c60b and 76f6e69 alternately at
- *  load 4.2–5.5 (both vCPUs oversubscribed), CPU-time medians of 7:
- *    whole flight, synthetic 40 s   4 630–4 851× (median 4 795×) → 4 885–5 316× (median 5 240×)
- *    whole flight, real 0425-traj2  4 697–4 872× (median 4 785×) → 4 683–5 187× (median 5 126×)
+ *         Measured figures: docs/results.md, "Speed".
  */
 #include <benchmark/benchmark.h>
 

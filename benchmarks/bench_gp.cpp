@@ -1,40 +1,15 @@
 /** @file bench_gp.cpp
- *  @brief SVGP speed against the GPyTorch 1.10 reference measured on this machine (issue 4):
+ *  @brief SVGP speed against the GPyTorch 1.10 reference measured on the same machine:
  *         N = 50,000, D = 4, minibatch 1024, one thread, float64, RBF-ARD kernel.
  *         GPyTorch (Adam): 0.51 s/epoch at M = 30, 1.51 s/epoch at M = 170.
  *         Targets: ≥ 10× faster at M = 30, ≥ 3× at M = 170; 10,000 predictions at M = 170 in < 10 ms.
  *
- *  Run: build-gp/benchmarks/bench_gp --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
- *  Eigen vectorizes with SSE2 only in the default build; configure with -DCMAKE_CXX_FLAGS=-march=native (whole
- *  project, so every translation unit agrees) for AVX2/FMA, about 2× faster GEMMs.
- *  Measured 2026-11-21 on the shared 2-core EPYC (load ≈ 8–10, CPU-time medians of 5):
- *    before (0552d0b):
- *      default:        epoch M=30 46 ms, M=170 1.00 s; predict 10k (mean+var) M=170 70 ms, mean only 14 ms;
- *                      one point M=30/170 1.2/10.5 µs
- *      -march=native:  epoch M=30 25 ms, M=170 0.54 s; predict 10k (mean+var) M=170 35 ms, mean only 5.2 ms;
- *                      one point 1.0/7.7 µs
- *    after (predictor with α and Q, P20; T1 reuse and GEMM kernel gradients in training, P17/P8):
- *      default:        epoch (Adam) M=30 46 ms, M=170 0.84 s; natgrad M=30 44 ms, M=170 0.86 s;
- *                      predict 10k (mean+var) M=30 3.9 ms, M=170 35 ms, mean only 14 ms; one point 0.54/6.6 µs
- *      -march=native:  epoch (Adam) M=30 22 ms, M=170 0.38–0.43 s; natgrad M=30 24 ms, M=170 0.42 s;
- *                      predict 10k (mean+var) M=30 1.7 ms, M=170 17 ms, mean only 4.9 ms; one point 0.32/3.6 µs
- *    session 2 (machine nearly idle, native): predict 10k M=170 one thread 17.6–18.7 ms, two threads 10.8–11.4 ms
- *      wall (the two vCPUs share resources: 1.6×); mean only 5.0 ms; one point 0.36/4.4 µs.
- *    GEMM calibration: 15 GFlop/s (default), 27–30 GFlop/s (native). The 10k/M=170 variance needs 0.29 GFlop
- *    (M² per point, already halved by the triangular Q_u): ≥ 10 ms at Eigen's GEMM rate on one float64 core.
- *    session 3 (fused predictor: Kernel::crossInto with a polynomial exp, P32; register-blocked kᵀQ_u k over 8-point
- *      tiles, P33; threads pull 128-row blocks from a counter), native, medians of 7, wall clock:
- *      before (c2f16be, uptime load 4.3–4.6, the other developer compiling): M=170 one thread 29.3 ms (CPU 19.3),
- *        two threads 36.7 ms; mean only 7.9 ms (CPU 5.3); M=30 2.0 ms; one point 0.60/6.8 µs (CPU 0.40/4.5)
- *      after (uptime load 1.8–2.2: bench_filter at 100 % on the other vCPU; GEMM calibration 25.4 GFlop/s):
- *        M=170 one thread 10.9–11.0 ms (CPU the same), two threads 10.4–10.7 ms (second thread shares a vCPU
- *        with bench_filter); mean only 3.4 ms; M=30 0.87–0.93 ms; one point 0.37–0.40/4.3–4.6 µs (path unchanged)
- *      later rounds (load 1.2–2.5, another benchmark or compiler on the other vCPU): one thread 11.0–13.2 ms
- *        (CPU 9.9–11.9), two threads 9.8–11.1 ms, mean only 3.4–3.7 ms; GEMM calibration 20.8–24.8 GFlop/s.
- *        No quiet window for a clean two-thread figure.
- *    Where the 11 ms go (one thread): kᵀQ_u k ≈ 7.4 ms = 39 GFlop/s, 80–85 % of the 46–50 GFlop/s this vCPU
- *    reaches in a register-only FMA loop; the kernel block ≈ 2.4–3.0 ms (1.7 M values, exp by a degree-11
- *    polynomial, ≈ 1.4 ns each); the mean ≈ 0.3 ms. At 100 % of FMA peak the variance alone would take ≈ 6 ms.
+ *  Run: build/benchmarks/bench_gp --benchmark_repetitions=9 --benchmark_report_aggregates_only=true
+ *  With UWB_NATIVE=ON (the default) the project is compiled with -march=native, so Eigen and the fused predictor use
+ *  AVX2/FMA; UWB_NATIVE=OFF gives the portable SSE2 build (about 2× slower GEMMs).
+ *  BM_EigenGemmCalibration measures the dense-GEMM rate of the core for comparison: the 10,000-point variance at
+ *  M = 170 needs 0.29 GFlop (M² per point, already halved by the triangular Q_u, docs/math/gp.md P20).
+ *  Measured figures: docs/results.md, "Speed".
  */
 #include <benchmark/benchmark.h>
 

@@ -44,7 +44,7 @@ BENCHMARK(BM_KinematicState);
 /// One TDoA error sample (two anchor patterns, two multipath fields, noise draws).
 void BM_BiasSample(benchmark::State& state) {
   std::mt19937_64 rng(1);
-  const BiasModel model(BiasParams{}, paperAnchors(), rng);
+  const SimulatedBias model(BiasParams{}, paperAnchors(), rng);
   const uwb::Quat q(Eigen::AngleAxisd(0.3, uwb::Vec3::UnitZ()));
   uwb::Vec3 p(0.2, 0.1, 1.5);
   for (auto _ : state) {

@@ -18,6 +18,7 @@
 #include "uwb/eval/Evaluation.h"
 #include "uwb/eval/Localization.h"
 #include "uwb/eval/TrajectoryMetrics.h"
+#include "uwb/filter/EkfParamRegistry.h"
 #include "uwb/filter/EkfParams.h"
 
 namespace uwb::python {
@@ -97,49 +98,24 @@ py::dict featuresToDict(const std::vector<const TdoaFeature*>& fs) {
 namespace {
 
 // ------------------------------------------------------------------------------------------- parameters
+/// One setter per EkfParams field, from the parameter registry (uwb/filter/EkfParamRegistry.h): the Python value
+/// is converted to the field's kind and checked against its range before it is set.
 const Setters<EkfParams>& ekfSetters() {
   static const Setters<EkfParams> s = [] {
     Setters<EkfParams> out;
-    using P = EkfParams;
-    for (const auto& [n, f] : std::vector<std::pair<std::string, double P::*>>{
-             {"acc_noise_mps2_sqrthz", &P::acc_noise_mps2_sqrthz},
-             {"lateral_acc_noise_mps2_sqrthz", &P::lateral_acc_noise_mps2_sqrthz},
-             {"gyro_noise_radps_sqrthz", &P::gyro_noise_radps_sqrthz},
-             {"acc_bias_rw_mps3_sqrthz", &P::acc_bias_rw_mps3_sqrthz},
-             {"gyro_bias_rw_radps2_sqrthz", &P::gyro_bias_rw_radps2_sqrthz},
-             {"pos_noise_m_sqrts", &P::pos_noise_m_sqrts},
-             {"cv_acc_noise_mps2_sqrthz", &P::cv_acc_noise_mps2_sqrthz},
-             {"ca_jerk_noise_mps3_sqrthz", &P::ca_jerk_noise_mps3_sqrthz},
-             {"init_pos_sigma_m", &P::init_pos_sigma_m}, {"init_vel_sigma_mps", &P::init_vel_sigma_mps},
-             {"init_att_sigma_rad", &P::init_att_sigma_rad}, {"init_yaw_sigma_rad", &P::init_yaw_sigma_rad},
-             {"init_acc_bias_sigma_mps2", &P::init_acc_bias_sigma_mps2},
-             {"init_gyro_bias_sigma_radps", &P::init_gyro_bias_sigma_radps}, {"tdoa_sigma_m", &P::tdoa_sigma_m},
-             {"anchor_sigma_m", &P::anchor_sigma_m}, {"gate_sigma", &P::gate_sigma}, {"robust_k", &P::robust_k},
-             {"max_lost_s", &P::max_lost_s}, {"max_predict_dt_s", &P::max_predict_dt_s},
-             {"cov_period_s", &P::cov_period_s}, {"max_gap_s", &P::max_gap_s},
-             {"takeoff_climb_mps", &P::takeoff_climb_mps}, 
-             {"acquisition_s", &P::acquisition_s}, {"acquisition_tdoa_sigma_m", &P::acquisition_tdoa_sigma_m},
-             {"ground_z_m", &P::ground_z_m}, {"tof_sigma_m", &P::tof_sigma_m}, {"tof_offset_m", &P::tof_offset_m},
-             {"floor_z_m", &P::floor_z_m}, {"tof_max_range_m", &P::tof_max_range_m},
-             {"tof_gate_sigma", &P::tof_gate_sigma}}) {
-      addField(out, n, f);
+    for (const EkfParamInfo& info : ekfParamRegistry()) {
+      out[info.name] = [&info](EkfParams& p, const py::handle& v) {
+        EkfParamValue value;
+        switch (info.kind) {
+          case EkfParamKind::kReal:
+          case EkfParamKind::kInteger: value = py::cast<double>(v); break;
+          case EkfParamKind::kBool: value = py::cast<bool>(v); break;
+          case EkfParamKind::kVec3: value = Vec3(row3(toMatrix(v, 3, info.name.c_str()), 0)); break;
+          case EkfParamKind::kChoice: value = py::cast<std::string>(v); break;
+        }
+        setEkfParam(p, info, value, "params");
+      };
     }
-    out["robust_iterations"] = [](P& p, const py::handle& v) { p.robust_iterations = py::cast<int>(v); };
-    out["has_start_position"] = [](P& p, const py::handle& v) { p.has_start_position = py::cast<bool>(v); };
-    out["fuse_tof"] = [](P& p, const py::handle& v) { p.fuse_tof = py::cast<bool>(v); };
-    out["start_w_p_b"] = [](P& p, const py::handle& v) {
-      p.start_w_p_b = row3(toMatrix(v, 3, "start_w_p_b"), 0);
-      p.has_start_position = true;
-    };
-    out["b_t_tag"] = [](P& p, const py::handle& v) { p.b_t_tag = row3(toMatrix(v, 3, "b_t_tag"), 0); };
-    out["accel_model"] = [](P& p, const py::handle& v) { p.accel_model = parseAccelModel(py::cast<std::string>(v)); };
-    out["process_model"] = [](P& p, const py::handle& v) {
-      p.process_model = parseProcessModel(py::cast<std::string>(v));
-    };
-    out["robust_loss"] = [](P& p, const py::handle& v) { p.robust_loss = parseRobustLoss(py::cast<std::string>(v)); };
-    out["ground_phase"] = [](P& p, const py::handle& v) {
-      p.ground_phase = parseGroundPhase(py::cast<std::string>(v));
-    };
     return out;
   }();
   return s;
@@ -459,7 +435,7 @@ void bindEval(py::module_& m) {
       },
       py::arg("flight"), py::arg("survey"), py::arg("bias_model") = nullptr, py::arg("preset") = "defaults",
       py::arg("params") = py::dict(), py::arg("output_period_s") = 0.01, py::arg("tdoa_only") = false,
-      py::arg("airborne_min_z_m") = 0.3,
+      py::arg("airborne_min_z_m") = kAirborneMinZ_m,
       "Runs the localization filter on a flight, with the GP correction when bias_model is given (paper III-B:\n"
       "z − mean, variance added). preset: 'defaults' | 'crazyflie' | 'tdoa-only'; params: EkfParams overrides\n"
       "(field names of uwb/filter/EkfParams.h, enums as strings). Returns {trajectory {t, p, q, sigma_p, v},\n"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Bias-RMSE table of the TDoA bias GP (issue 4, "Done means"): for each kernel and number of inducing points,
+# Bias-RMSE table of the TDoA bias GP (docs/results.md): for each kernel and number of inducing points,
 # train on one set of real flights and apply the model to other flights. The GP inputs come from INPUTS: 'estimate'
 # (default: the uncorrected filter's pose, as at run time) or 'truth' (ground-truth pose); predict-bias uses the same.
 #
@@ -10,8 +10,8 @@
 # (eps - GP mean), pooled over the test flights. Writes OUT_DIR/bias_table.{md,csv} and the per-run JSON.
 set -euo pipefail
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
-OUT="${1:-$ROOT/build-gp/gp-results}"
-UWBTDOA="${UWBTDOA:-$ROOT/build-gp/uwbtdoa}"
+OUT="${1:-$ROOT/build/gp-results}"
+UWBTDOA="${UWBTDOA:-$ROOT/build/uwbtdoa}"
 DATA="${DATA:-$ROOT/../shared/data/real/util-pilot}"
 EPOCHS="${EPOCHS:-15}"
 SEED="${SEED:-1}"

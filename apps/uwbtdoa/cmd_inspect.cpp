@@ -145,9 +145,10 @@ void printHuman(const uwb::FlightSummary& s, const std::string& anchors_path) {
   }
 
   if (s.has_ground_truth) {
-    std::cout << fmt::format("\nground truth: {} pose, airborne (z > 0.3 m) {:.1f} % of samples, glitches excluded: "
+    std::cout << fmt::format("\nground truth: {} pose, airborne (z > {} m) {:.1f} % of samples, glitches excluded: "
                              "{} attitude, {} position\n",
-                             s.pose_has_orientation ? "full" : "position-only", 100.0 * s.airborne_fraction_pose,
+                             s.pose_has_orientation ? "full" : "position-only", uwb::kAirborneMinZ_m,
+                             100.0 * s.airborne_fraction_pose,
                              s.n_pose_glitches_attitude, s.n_pose_glitches_position);
     for (const auto& g : s.pose_glitches) {
       if (g.kind == uwb::PoseGlitchKind::kAttitude) {

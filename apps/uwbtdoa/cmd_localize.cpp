@@ -1,16 +1,16 @@
 /** @file cmd_localize.cpp
  *  @brief `uwbtdoa localize FLIGHT.csv --anchors SURVEY.txt [--out TRAJ.csv] [--json] [--config FILE.json] ...`:
  *         runs the localization filter (IMU-driven ESKF, or TDoA-only without IMU), writes the trajectory and
- *         prints the position RMSE against the flight's ground truth (issue 3, "Command line").
+ *         prints the position RMSE against the flight's ground truth.
  */
 #include <chrono>
+#include <deque>
 #include <ctime>
 #include <fstream>
 #include <iostream>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -18,85 +18,36 @@
 #include "uwb/core/Error.h"
 #include "uwb/eval/BiasModel.h"
 #include "uwb/eval/Localization.h"
+#include "uwb/filter/EkfParamRegistry.h"
 #include "uwb/io/UtilCsv.h"
 
 namespace {
 
 using nlohmann::json;
 
-Eigen::Vector3d parseVec3(const std::string& s, const char* what) {
-  std::stringstream ss(s);
-  std::string item;
-  std::vector<double> v;
-  while (std::getline(ss, item, ',')) {
-    try {
-      v.push_back(std::stod(item));
-    } catch (const std::exception&) {
-      throw std::invalid_argument(std::string(what) + ": expected x,y,z numbers, got '" + s + "'");
-    }
-  }
-  if (v.size() != 3) throw std::invalid_argument(std::string(what) + ": expected three numbers x,y,z, got '" + s + "'");
-  return {v[0], v[1], v[2]};
-}
-
-/// Reads the keys of a JSON object into EkfParams (names as the struct fields); unknown keys are an error.
-void applyConfig(const json& j, uwb::EkfParams& p) {
-  if (!j.is_object()) throw std::invalid_argument("config: expected a JSON object of EkfParams fields");
+/// Reads the keys of a JSON object into EkfParams through the parameter registry (keys = field names, unknown
+/// keys and values of the wrong kind or outside their range are errors naming the file and the key).
+void applyConfig(const json& j, uwb::EkfParams& p, const std::string& file) {
+  if (!j.is_object()) throw uwb::InputError(uwb::SourceLocation{file, 0, 0, ""}, "expected a JSON object of EkfParams fields");
   for (const auto& [key, value] : j.items()) {
-    auto num = [&]() {
-      if (!value.is_number()) throw std::invalid_argument("config: '" + key + "' must be a number");
-      return value.get<double>();
-    };
-    auto vec = [&]() {
-      if (!value.is_array() || value.size() != 3) throw std::invalid_argument("config: '" + key + "' must be [x,y,z]");
-      return Eigen::Vector3d(value[0].get<double>(), value[1].get<double>(), value[2].get<double>());
-    };
-    if (key == "acc_noise_mps2_sqrthz") p.acc_noise_mps2_sqrthz = num();
-    else if (key == "lateral_acc_noise_mps2_sqrthz") p.lateral_acc_noise_mps2_sqrthz = num();
-    else if (key == "gyro_noise_radps_sqrthz") p.gyro_noise_radps_sqrthz = num();
-    else if (key == "acc_bias_rw_mps3_sqrthz") p.acc_bias_rw_mps3_sqrthz = num();
-    else if (key == "gyro_bias_rw_radps2_sqrthz") p.gyro_bias_rw_radps2_sqrthz = num();
-    else if (key == "pos_noise_m_sqrts") p.pos_noise_m_sqrts = num();
-    else if (key == "cv_acc_noise_mps2_sqrthz") p.cv_acc_noise_mps2_sqrthz = num();
-    else if (key == "ca_jerk_noise_mps3_sqrthz") p.ca_jerk_noise_mps3_sqrthz = num();
-    else if (key == "accel_model") p.accel_model = uwb::parseAccelModel(value.get<std::string>());
-    else if (key == "ground_accel_model") p.ground_accel_model = uwb::parseAccelModel(value.get<std::string>());
-    else if (key == "takeoff_acc_bias_sigma_mps2") p.takeoff_acc_bias_sigma_mps2 = num();
-    else if (key == "process_model") p.process_model = uwb::parseProcessModel(value.get<std::string>());
-    else if (key == "init_pos_sigma_m") p.init_pos_sigma_m = num();
-    else if (key == "init_vel_sigma_mps") p.init_vel_sigma_mps = num();
-    else if (key == "init_att_sigma_rad") p.init_att_sigma_rad = num();
-    else if (key == "init_yaw_sigma_rad") p.init_yaw_sigma_rad = num();
-    else if (key == "init_acc_bias_sigma_mps2") p.init_acc_bias_sigma_mps2 = num();
-    else if (key == "init_gyro_bias_sigma_radps") p.init_gyro_bias_sigma_radps = num();
-    else if (key == "b_t_tag") p.b_t_tag = vec();
-    else if (key == "tdoa_sigma_m") p.tdoa_sigma_m = num();
-    else if (key == "anchor_sigma_m") p.anchor_sigma_m = num();
-    else if (key == "gate_sigma") p.gate_sigma = num();
-    else if (key == "robust_loss") p.robust_loss = uwb::parseRobustLoss(value.get<std::string>());
-    else if (key == "robust_k") p.robust_k = num();
-    else if (key == "robust_iterations") p.robust_iterations = static_cast<int>(num());
-    else if (key == "max_lost_s") p.max_lost_s = num();
-    else if (key == "max_predict_dt_s") p.max_predict_dt_s = num();
-    else if (key == "cov_period_s") p.cov_period_s = num();
-    else if (key == "max_gap_s") p.max_gap_s = num();
-    else if (key == "ground_phase") p.ground_phase = uwb::parseGroundPhase(value.get<std::string>());
-    else if (key == "takeoff_climb_mps") p.takeoff_climb_mps = num();
-    else if (key == "acquisition_s") p.acquisition_s = num();
-    else if (key == "acquisition_tdoa_sigma_m") p.acquisition_tdoa_sigma_m = num();
-    else if (key == "start_w_p_b") {
-      p.start_w_p_b = vec();
-      p.has_start_position = true;
-    } else if (key == "ground_z_m") p.ground_z_m = num();
-    else if (key == "fuse_tof") {
-      if (!value.is_boolean()) throw std::invalid_argument("config: 'fuse_tof' must be true or false");
-      p.fuse_tof = value.get<bool>();
-    } else if (key == "tof_sigma_m") p.tof_sigma_m = num();
-    else if (key == "tof_offset_m") p.tof_offset_m = num();
-    else if (key == "floor_z_m") p.floor_z_m = num();
-    else if (key == "tof_max_range_m") p.tof_max_range_m = num();
-    else if (key == "tof_gate_sigma") p.tof_gate_sigma = num();
-    else throw std::invalid_argument("config: unknown key '" + key + "'");
+    const uwb::EkfParamInfo* info = nullptr;
+    try {
+      info = &uwb::ekfParamInfo(key);
+    } catch (const std::invalid_argument& e) {
+      throw uwb::InputError(uwb::SourceLocation{file, 0, 0, key}, e.what());
+    }
+    uwb::EkfParamValue v;
+    if (value.is_boolean()) v = value.get<bool>();
+    else if (value.is_number()) v = value.get<double>();
+    else if (value.is_string()) v = value.get<std::string>();
+    else if (value.is_array() && value.size() == 3 && value[0].is_number() && value[1].is_number() && value[2].is_number())
+      v = Eigen::Vector3d(value[0].get<double>(), value[1].get<double>(), value[2].get<double>());
+    else v = value.dump();
+    try {
+      uwb::setEkfParam(p, *info, v, "");
+    } catch (const std::invalid_argument& e) {
+      throw uwb::InputError(uwb::SourceLocation{file, 0, 0, key}, e.what());
+    }
   }
 }
 
@@ -115,11 +66,12 @@ json statsJson(const uwb::PositionErrorStats& s) {
 
 struct LocalizeArgs {
   std::string flight, anchors, out, config, bias_model;
-  bool json_out = false, tdoa_only = false, no_ground_detect = false, fuse_tof = false;
-  std::optional<double> tdoa_sigma, gate, robust_k, acc_noise, lateral_acc_noise, gyro_noise, acc_bias_rw,
-      gyro_bias_rw, cov_period;
-  std::string robust_loss, accel_model, process_model, tag_offset, start;
+  bool json_out = false, tdoa_only = false, no_ground_detect = false;
   double output_period = 0.01;
+  /// One CLI option per EkfParams field (uwb::ekfParamRegistry(), same order): the text given, or the bool flag.
+  std::deque<std::string> param_text;
+  std::deque<bool> param_flag;
+  std::vector<CLI::Option*> param_option;
 };
 
 void runLocalize(const LocalizeArgs& a) {
@@ -133,29 +85,19 @@ void runLocalize(const LocalizeArgs& a) {
     } catch (const json::parse_error& e) {
       throw uwb::InputError(uwb::SourceLocation{a.config, 0, 0, ""}, std::string("invalid JSON: ") + e.what());
     }
-    applyConfig(j, params);
+    applyConfig(j, params, a.config);
   }
-  if (a.tdoa_sigma) params.tdoa_sigma_m = *a.tdoa_sigma;
-  if (a.gate) params.gate_sigma = *a.gate;
-  if (a.robust_k) params.robust_k = *a.robust_k;
-  if (a.acc_noise) params.acc_noise_mps2_sqrthz = *a.acc_noise;
-  if (a.lateral_acc_noise) params.lateral_acc_noise_mps2_sqrthz = *a.lateral_acc_noise;
-  if (a.gyro_noise) params.gyro_noise_radps_sqrthz = *a.gyro_noise;
-  if (a.acc_bias_rw) params.acc_bias_rw_mps3_sqrthz = *a.acc_bias_rw;
-  if (a.gyro_bias_rw) params.gyro_bias_rw_radps2_sqrthz = *a.gyro_bias_rw;
-  if (a.cov_period) params.cov_period_s = *a.cov_period;
-  if (!a.robust_loss.empty()) params.robust_loss = uwb::parseRobustLoss(a.robust_loss);
-  if (!a.accel_model.empty()) params.accel_model = uwb::parseAccelModel(a.accel_model);
-  if (!a.process_model.empty()) params.process_model = uwb::parseProcessModel(a.process_model);
-  if (!a.tag_offset.empty()) params.b_t_tag = parseVec3(a.tag_offset, "--tag-offset");
-  if (!a.start.empty()) {
-    params.start_w_p_b = parseVec3(a.start, "--start");
-    params.has_start_position = true;
+  // flags override the config file
+  const std::vector<uwb::EkfParamInfo>& registry = uwb::ekfParamRegistry();
+  for (std::size_t k = 0; k < registry.size(); ++k) {
+    if (a.param_option[k]->count() == 0) continue;
+    const uwb::EkfParamInfo& info = registry[k];
+    if (info.kind == uwb::EkfParamKind::kBool) uwb::setEkfParam(params, info, a.param_flag[k], info.flag());
+    else uwb::setEkfParamFromText(params, info, a.param_text[k], info.flag());
   }
   if (a.no_ground_detect) params.ground_phase = uwb::GroundPhase::kNone;
-  if (a.fuse_tof) params.fuse_tof = true;
   params.validate();
-  // issue 5: the GP bias model as a plain BiasPredictor (the filter knows nothing of GPs)
+  // The GP bias model as a plain BiasPredictor (the filter knows nothing of GPs)
   uwb::BiasPredictor bias;
   if (!a.bias_model.empty()) bias = uwb::BiasModel::load(a.bias_model).predictor();
 
@@ -265,24 +207,31 @@ const bool kRegistered = uwb::app::registerCommand(
        sub.add_option("--anchors", a->anchors, "Anchor survey (UTIL survey text)")->required();
        sub.add_option("--out", a->out, "Write the estimated trajectory CSV here");
        sub.add_flag("--json", a->json_out, "Print one JSON object with the results");
-       sub.add_option("--config", a->config, "JSON object of EkfParams fields (flags override it)");
-       sub.add_option("--tdoa-sigma", a->tdoa_sigma, "TDoA noise std used by the filter [m]");
-       sub.add_option("--gate", a->gate, "Mahalanobis gate on the normalised innovation [sigma]; 0 disables");
-       sub.add_option("--robust-loss", a->robust_loss, "none | huber | cauchy");
-       sub.add_option("--robust-k", a->robust_k, "Robust-loss scale on the normalised residual");
-       sub.add_option("--accel-model", a->accel_model, "thrust (Mueller et al.) | full");
-       sub.add_option("--process-model", a->process_model, "imu | cv | ca");
-       sub.add_option("--acc-noise", a->acc_noise, "Accelerometer noise [m/s^2/sqrt(Hz)]");
-       sub.add_option("--lateral-acc-noise", a->lateral_acc_noise, "Lateral acceleration noise [m/s^2/sqrt(Hz)]");
-       sub.add_option("--gyro-noise", a->gyro_noise, "Gyroscope noise [rad/s/sqrt(Hz)]");
-       sub.add_option("--acc-bias-rw", a->acc_bias_rw, "Accelerometer-bias random walk [m/s^3/sqrt(Hz)]");
-       sub.add_option("--gyro-bias-rw", a->gyro_bias_rw, "Gyroscope-bias random walk [rad/s^2/sqrt(Hz)]");
-       sub.add_option("--cov-period", a->cov_period, "Covariance propagation period [s] (0: before every update)");
-       sub.add_option("--tag-offset", a->tag_offset, "Tag position in the body frame x,y,z [m]");
-       sub.add_option("--start", a->start, "Start position of the body x,y,z [m] (default: multilateration)");
+       sub.add_option("--config", a->config,
+                      "JSON file with an object of EkfParams fields, e.g. {\"tdoa_sigma_m\": 0.3} (keys: uwbtdoa "
+                      "params); flags override it");
        sub.add_flag("--tdoa-only", a->tdoa_only, "Ignore the IMU: constant-velocity model");
-       sub.add_flag("--no-ground-detect", a->no_ground_detect, "Use TDoA from the start (no take-off detection)");
-       sub.add_flag("--fuse-tof", a->fuse_tof, "Fuse the downward ToF range as a height update (F21)");
+       sub.add_flag("--no-ground-detect", a->no_ground_detect,
+                    "Use TDoA from the start (no take-off detection; = --ground-phase none)");
+       // one option per filter parameter, from the registry (uwb/filter/EkfParamRegistry.h)
+       for (const uwb::EkfParamInfo& info : uwb::ekfParamRegistry()) {
+         const std::string names = info.flag() + (info.cli_alias.empty() ? "" : ",--" + info.cli_alias);
+         const std::string help = info.doc + " " + uwb::ekfParamHelpSuffix(info);
+         a->param_text.emplace_back();
+         a->param_flag.push_back(false);
+         a->param_option.push_back(info.kind == uwb::EkfParamKind::kBool
+                                       ? sub.add_flag(names, a->param_flag.back(), help)
+                                       : sub.add_option(names, a->param_text.back(), help));
+         a->param_option.back()->group("Filter parameters");
+         if (info.kind == uwb::EkfParamKind::kReal) a->param_option.back()->type_name("FLOAT");
+         if (info.kind == uwb::EkfParamKind::kInteger) a->param_option.back()->type_name("INT");
+         if (info.kind == uwb::EkfParamKind::kVec3) a->param_option.back()->type_name("X,Y,Z");
+         if (info.kind == uwb::EkfParamKind::kChoice) {
+           std::string choices;
+           for (const std::string& c : info.choices) choices += (choices.empty() ? "" : "|") + c;
+           a->param_option.back()->type_name(choices);
+         }
+       }
        sub.add_option("--output-period", a->output_period, "Trajectory sample spacing [s]");
        sub.add_option("--bias-model", a->bias_model, "Bias model JSON (GP) to correct the TDoA");
        sub.callback([a] { runLocalize(*a); });

@@ -1,4 +1,4 @@
-/** @file cmd_version.cpp
+/** @file cmd_paths.cpp
  *  @brief `uwbtdoa paths`: prints where the tool looks for real data (handy when a test skips).
  */
 #include <iostream>

@@ -26,7 +26,7 @@ namespace {
 
 struct Options {
   std::string flight, anchors, model, out;
-  double min_z = 0.3;
+  double min_z = uwb::kAirborneMinZ_m;
   std::string inputs;  ///< "" = from the model file, else "truth" | "estimate"
   bool json_out = false;
 };
@@ -73,7 +73,7 @@ void run(const Options& o) {
   for (const auto& r : residuals) {
     const uwb::TdoaFeature f = uwb::makeTdoaFeature(r.id_a, r.id_b, r.w_p_b, r.w_q_b, survey.position(r.id_a), survey.position(r.id_b));
     const uwb::BiasPrediction p = model.predict(f);
-    const bool air = r.w_p_b.z() > o.min_z;
+    const bool air = uwb::isAirborne(r.w_p_b.z(), o.min_z);
     out << fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},{}\n", r.t_s, r.id_a, r.id_b, r.measured_m, r.residual_m,
                        p.mean_m, std::sqrt(p.variance_m2), air ? 1 : 0);
     if (air && std::abs(r.residual_m) <= 1.0) {

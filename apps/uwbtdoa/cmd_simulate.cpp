@@ -22,7 +22,7 @@
 #include "uwb/core/Error.h"
 #include "uwb/io/UtilCsv.h"
 #include "uwb/sim/FlightSimulator.h"
-#include "uwb/sim/ResidualStats.h"
+#include "uwb/sim/ResidualProfile.h"
 
 namespace {
 
@@ -167,10 +167,10 @@ void run(const Options& o, CLI::App& sub) {
   const auto t_end = std::chrono::steady_clock::now();
 
   const uwb::Flight& f = result.flight;
-  const auto air = uwb::sim::residualStats(f, result.survey, uwb::sim::Phase::kAirborne);
-  const auto ground = uwb::sim::residualStats(f, result.survey, uwb::sim::Phase::kGround);
+  const auto air = uwb::sim::residualProfile(f, result.survey, uwb::sim::Phase::kAirborne);
+  const auto ground = uwb::sim::residualProfile(f, result.survey, uwb::sim::Phase::kGround);
   std::size_t n_airborne_pose = 0;
-  for (const auto& p : f.pose) n_airborne_pose += p.w_p_b.z() >= 0.3 ? 1 : 0;
+  for (const auto& p : f.pose) n_airborne_pose += uwb::isAirborne(p.w_p_b.z()) ? 1 : 0;
   std::size_t n_outliers = 0;
   // RMS of each airborne error part (S17): how much of the error the body-frame directions explain.
   double sq_pattern = 0.0, sq_multipath = 0.0, sq_noise = 0.0, sq_outlier = 0.0, sq_total = 0.0;
@@ -215,17 +215,17 @@ void run(const Options& o, CLI::App& sub) {
                                  {"total", rms(sq_total)},         {"pattern_variance_share", pattern_share}};
     nlohmann::json pairs = nlohmann::json::array();
     for (const auto& [pair, ps] : air.pairs) {
-      pairs.push_back({{"id_a", pair.first}, {"id_b", pair.second}, {"count", ps.count}, {"median_m", ps.median_m},
+      pairs.push_back({{"id_a", pair.first}, {"id_b", pair.second}, {"count", ps.n}, {"median_m", ps.median_m},
                        {"std_m", ps.std_m}});
     }
     nlohmann::json ac = nlohmann::json::object();
     for (const auto& [lag, value] : air.autocorrelation) ac[fmt::format("{:g}s", lag)] = value;
-    j["residual_airborne"] = {{"count", air.count},         {"median_m", air.median_m},
-                              {"mean_abs_dev_m", air.mean_abs_dev_m}, {"std_m", air.std_m},
+    j["residual_airborne"] = {{"count", air.overall.n},         {"median_m", air.overall.median_m},
+                              {"mean_abs_dev_m", air.overall.mean_abs_dev_m}, {"std_m", air.overall.std_m},
                               {"outlier_fraction", air.outlier_fraction}, {"autocorrelation", ac},
                               {"pairs", pairs}};
-    j["residual_ground"] = {{"count", ground.count}, {"median_m", ground.median_m},
-                            {"mean_abs_dev_m", ground.mean_abs_dev_m}};
+    j["residual_ground"] = {{"count", ground.overall.n}, {"median_m", ground.overall.median_m},
+                            {"mean_abs_dev_m", ground.overall.mean_abs_dev_m}};
     j["time_simulate_s"] = sim_s;
     j["time_total_s"] = total_s;
     std::cout << j.dump() << '\n';
@@ -237,10 +237,10 @@ void run(const Options& o, CLI::App& sub) {
   std::cout << fmt::format("  tdoa {:>7} ({:.0f} Hz)   acc/gyro {:>7} ({:.0f} Hz)   pose {:>7} ({:.0f} Hz)\n",
                            f.tdoa.size(), rate(f.tdoa.size(), spanOf(f.tdoa)), f.acc.size(),
                            rate(f.acc.size(), spanOf(f.acc)), f.pose.size(), rate(f.pose.size(), spanOf(f.pose)));
-  std::cout << fmt::format("  on the ground (z < 0.3 m): {:.0f} % of pose samples; outliers: {}\n",
+  std::cout << fmt::format("  on the ground (z ≤ 0.3 m): {:.0f} % of pose samples; outliers: {}\n",
                            100.0 * ground_fraction, n_outliers);
   std::cout << fmt::format("  airborne TDoA residual: median {:+.3f} m, mean abs dev {:.3f} m, std {:.3f} m\n",
-                           air.median_m, air.mean_abs_dev_m, air.std_m);
+                           air.overall.median_m, air.overall.mean_abs_dev_m, air.overall.std_m);
   std::string pair_text;
   for (const auto& [pair, ps] : air.pairs) pair_text += fmt::format(" {}-{}:{:+.3f}", pair.first, pair.second, ps.median_m);
   std::cout << "  per-pair medians [m]:" << pair_text << '\n';
@@ -251,7 +251,7 @@ void run(const Options& o, CLI::App& sub) {
       "  airborne error RMS [m]: body-direction pattern {:.3f}, multipath {:.3f}, noise {:.3f}, outliers {:.3f} "
       "(pattern = {:.0f} % of the variance)\n",
       rms(sq_pattern), rms(sq_multipath), rms(sq_noise), rms(sq_outlier), 100.0 * pattern_share);
-  std::cout << fmt::format("  ground TDoA residual: mean abs dev {:.2f} m\n", ground.mean_abs_dev_m);
+  std::cout << fmt::format("  ground TDoA residual: mean abs dev {:.2f} m\n", ground.overall.mean_abs_dev_m);
   std::cout << fmt::format("wrote {} and {} ({:.2f} s, simulation {:.2f} s)\n", o.out, o.survey_out, total_s, sim_s);
 }
 

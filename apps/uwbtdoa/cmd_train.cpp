@@ -19,6 +19,7 @@
 #include "Command.h"
 #include "uwb/core/Error.h"
 #include "uwb/eval/BiasModel.h"
+#include "uwb/io/Airborne.h"
 #include "uwb/io/UtilCsv.h"
 
 namespace {
@@ -32,7 +33,7 @@ struct TrainOptions {
   std::string dump_arrays;
   std::uint64_t seed = 1;
   double lr = 0.01, lr_inducing = 0.01, natgrad = 0.2, holdout = 0.2, extra_sigma = uwb::BiasTrainParams{}.extra_sigma_m;
-  double min_z = 0.3, max_abs_error = 1.0, mean_scale = 1.0;
+  double min_z = uwb::kAirborneMinZ_m, max_abs_error = 1.0, mean_scale = 1.0;
   bool neighbour_only = false, json_out = false, quiet = false, full_variance = false;
 };
 

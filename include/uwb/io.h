@@ -4,9 +4,11 @@
  */
 #pragma once
 
+#include "uwb/io/Airborne.h"
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/Flight.h"
 #include "uwb/io/FlightSummary.h"
 #include "uwb/io/PoseTrack.h"
+#include "uwb/io/ResidualStats.h"
 #include "uwb/io/TrajectoryCsv.h"
 #include "uwb/io/UtilCsv.h"

@@ -16,8 +16,4 @@ std::string SourceLocation::toString() const {
 InputError::InputError(SourceLocation where, const std::string& what)
     : std::runtime_error(where.toString() + ": " + what), where_(std::move(where)) {}
 
-void assertionFailed(const char* condition, const char* file, int line, const std::string& message) {
-  throw std::logic_error(fmt::format("{}:{}: assertion '{}' failed: {}", file, line, condition, message));
-}
-
 }  // namespace uwb

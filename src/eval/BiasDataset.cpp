@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <optional>
-#include <tuple>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -24,23 +23,6 @@ BiasInputSource biasInputSourceFromString(const std::string& name) {
   if (name == "estimate") return BiasInputSource::kFilterEstimate;
   throw std::invalid_argument("unknown GP input source '" + name + "' (known: truth, estimate)");
 }
-
-namespace {
-
-/// Pose of an estimated trajectory at t (linear position, slerp attitude); nullopt outside it or across a gap.
-std::optional<std::pair<Vec3, Quat>> interpolateTrajectory(const Trajectory& traj, double t_s, double max_gap_s) {
-  if (traj.empty() || t_s < traj.front().t_s || t_s > traj.back().t_s) return std::nullopt;
-  const auto hi = std::lower_bound(traj.begin(), traj.end(), t_s,
-                                   [](const TrajectorySample& s, double t) { return s.t_s < t; });
-  if (hi == traj.begin()) return std::make_pair(hi->w_p_b, hi->w_q_b);
-  const auto lo = hi - 1;
-  const double dt = hi->t_s - lo->t_s;
-  if (dt > max_gap_s) return std::nullopt;
-  const double w = dt > 0 ? (t_s - lo->t_s) / dt : 0.0;
-  return std::make_pair(Vec3((1 - w) * lo->w_p_b + w * hi->w_p_b), lo->w_q_b.slerp(w, hi->w_q_b).normalized());
-}
-
-}  // namespace
 
 void BiasDatasetParams::validate() const {
   if (!std::isfinite(min_z_m)) throw std::invalid_argument("BiasDatasetParams.min_z_m must be finite");
@@ -100,7 +82,7 @@ BiasDataset buildBiasDataset(const std::vector<Flight>& flights, const AnchorSur
         }
       }
       // rule: on the ground (TDoA grossly wrong there, SOURCE.md Caveats)
-      if (r.w_p_b.z() < params.min_z_m) {
+      if (!isAirborne(r.w_p_b.z(), params.min_z_m)) {
         ++rep.n_on_ground;
         continue;
       }
@@ -118,12 +100,13 @@ BiasDataset buildBiasDataset(const std::vector<Flight>& flights, const AnchorSur
       Vec3 w_p_b = r.w_p_b;
       Quat w_q_b = r.w_q_b;
       if (params.inputs == BiasInputSource::kFilterEstimate) {
-        const auto pose = interpolateTrajectory(estimate, r.t_s, 0.1);
+        const std::optional<PoseSample> pose = interpolatePose(estimate, r.t_s, 0.1);  // io/PoseTrack.h
         if (!pose) {
           ++rep.n_no_estimate;
           continue;
         }
-        std::tie(w_p_b, w_q_b) = *pose;
+        w_p_b = pose->w_p_b;
+        w_q_b = pose->w_q_b;
       }
       BiasSample s;
       s.feature = makeTdoaFeature(r.id_a, r.id_b, w_p_b, w_q_b, survey.position(r.id_a), survey.position(r.id_b));

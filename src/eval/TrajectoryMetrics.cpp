@@ -3,8 +3,11 @@
  */
 #include "uwb/eval/TrajectoryMetrics.h"
 
+#include "uwb/io/PoseTrack.h"
+
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 namespace uwb {
@@ -55,31 +58,21 @@ TrajectoryMetrics computeTrajectoryMetrics(const Trajectory& est, const std::vec
   params.validate();
   TrajectoryMetrics m;
   m.samples.reserve(truth.size());
-  std::size_t k = 0;
   for (const PoseSample& gt : truth) {
-    if (est.empty() || gt.t_s < est.front().t_s || gt.t_s > est.back().t_s) {
+    // io/PoseTrack.h: the one pose interpolation (position only here)
+    const std::optional<PoseSample> at = interpolatePose(est, gt.t_s, params.max_interp_gap_s, false);
+    if (!at) {
       ++m.n_truth_not_covered;
       continue;
     }
-    while (k + 1 < est.size() && est[k + 1].t_s < gt.t_s) ++k;
-    const TrajectorySample& a = est[k];
-    const TrajectorySample& b = est[std::min(k + 1, est.size() - 1)];
-    Vec3 p = a.w_p_b;
-    if (b.t_s > a.t_s) {
-      if (b.t_s - a.t_s > params.max_interp_gap_s) {
-        ++m.n_truth_not_covered;
-        continue;
-      }
-      const double f = std::clamp((gt.t_s - a.t_s) / (b.t_s - a.t_s), 0.0, 1.0);
-      p = a.w_p_b + f * (b.w_p_b - a.w_p_b);
-    }
+    const Vec3& p = at->w_p_b;
     PositionErrorSample e;
     e.t_s = gt.t_s;
     e.w_p_true = gt.w_p_b;
     e.w_p_est = p;
     e.error_m = p - gt.w_p_b;
     e.error_norm_m = e.error_m.norm();
-    e.airborne = gt.w_p_b.z() > params.airborne_min_z_m;
+    e.airborne = isAirborne(gt.w_p_b.z(), params.airborne_min_z_m);
     m.samples.push_back(e);
   }
   m.whole = positionErrorStats(m.samples, false);

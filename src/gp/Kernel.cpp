@@ -35,6 +35,41 @@ VecX rowNorms(const MatX& A) {
   return n;
 }
 
+/// The rows of A scaled to unit length, and their norms (P4: γ = xᵀx'/(n n')).
+struct UnitRows {
+  VecX norm;
+  MatX unit;
+};
+UnitRows unitRows(const MatX& A) {
+  UnitRows u;
+  u.norm = rowNorms(A);
+  u.unit = u.norm.cwiseInverse().asDiagonal() * A;
+  return u;
+}
+
+// ---- The part formulas (docs/math/gp.md P1–P4), written once and used by every evaluation path ----
+// (cross/partCross is the reference; crossInto and crossColumn are its batch and one-point forms and are tested
+// against it: Kernel.CrossIntoEqualsCross, Kernel.CrossColumnEqualsCross; the gradients are tested against central
+// differences of it.)
+
+/// (P2) Matérn-5/2 polynomial 1 + √5ρ + 5ρ²/3, in terms of r = √5ρ: k = σ² (1 + r + r²/3) e^{−r}.
+template <class R>
+auto matern52Polynomial(const R& r) {
+  return 1.0 + r + r.square() / 3.0;
+}
+
+/// (P1) One dimension of the periodic exponent sum, sin²(π Δ / T) / l², with c = π/T and il2 = 1/l².
+template <class D>
+auto periodicTerm(const D& delta, double c, double il2) {
+  return il2 * (c * delta).sin().square();
+}
+
+/// (P4) Exponent of the Ledergerber kernel, −(1 − γ)/θ1 − (n − n')²/θ2, with dn = n − n'.
+template <class G, class N>
+auto ledergerberExponent(const G& gamma, const N& dn, double t1, double t2) {
+  return -(1.0 - gamma) / t1 - dn.square() / t2;
+}
+
 // ---- e^x for the batch path: docs/math/gp.md (P32) ----
 // e^x = 2^k e^r, k = round(x log₂e) (by adding 1.5·2⁵², which leaves k in the low mantissa bits), r = x − k ln2 in
 // two FMA steps (fdlibm's split of ln2: k·ln2_hi is exact), e^r by a degree-11 polynomial: the Taylor series to
@@ -412,7 +447,7 @@ MatX Kernel::partCross(int pi, const MatX& X1, const MatX& X2) const {
       // ρ² = Σ_d ((a_d − b_d)/l_d)²  (P2, P3)
       MatX As = A, Bs = B;
       for (Eigen::Index d = 0; d < nd; ++d) {
-        const double l = theta_[p.offset + 1 + (p.n_l == 1 ? 0 : d)];
+        const double l = theta_[p.lengthscaleIndex(d)];
         As.col(d) /= l;
         Bs.col(d) /= l;
       }
@@ -423,7 +458,7 @@ MatX Kernel::partCross(int pi, const MatX& X1, const MatX& X2) const {
         K = s2 * (-0.5 * K.array()).exp();
       } else {
         const Eigen::ArrayXXd r = K.array().sqrt() * kSqrt5;  // √5 ρ
-        K = s2 * (1.0 + r + r.square() / 3.0) * (-r).exp();
+        K = s2 * matern52Polynomial(r) * (-r).exp();
       }
       break;
     }
@@ -431,11 +466,11 @@ MatX Kernel::partCross(int pi, const MatX& X1, const MatX& X2) const {
       // Σ_d sin²(π Δ_d / T_d) / l_d²  (P1)
       K.setZero();
       for (Eigen::Index d = 0; d < nd; ++d) {
-        const double l = theta_[p.offset + 1 + (p.n_l == 1 ? 0 : d)];
-        const double T = theta_[p.offset + 1 + p.n_l + (p.n_T == 1 ? 0 : d)];
+        const double l = theta_[p.lengthscaleIndex(d)];
+        const double T = theta_[p.periodIndex(d)];
         const double c = kPi / T, il2 = 1.0 / (l * l);
         for (Eigen::Index j = 0; j < n2; ++j)
-          K.col(j).array() += il2 * (c * (A.col(d).array() - B(j, d))).sin().square();
+          K.col(j).array() += periodicTerm(A.col(d).array() - B(j, d), c, il2);
       }
       K = s2 * (-2.0 * K.array()).exp();
       break;
@@ -443,12 +478,11 @@ MatX Kernel::partCross(int pi, const MatX& X1, const MatX& X2) const {
     case PartType::kLedergerber: {
       // θ0 exp(−(1 − γ)/θ1 − (n − n')²/θ2), γ = xᵀx'/(n n')  (P4)
       const double t1 = theta_[p.offset + 1], t2 = theta_[p.offset + 2];
-      const VecX na = rowNorms(A), nb = rowNorms(B);
-      const MatX Ua = na.cwiseInverse().asDiagonal() * A;
-      const MatX Ub = nb.cwiseInverse().asDiagonal() * B;
-      K.noalias() = Ua * Ub.transpose();  // γ
+      const UnitRows ua = unitRows(A), ub = unitRows(B);
+      const VecX &na = ua.norm, &nb = ub.norm;
+      K.noalias() = ua.unit * ub.unit.transpose();  // γ
       for (Eigen::Index j = 0; j < n2; ++j)
-        K.col(j).array() = -(1.0 - K.col(j).array()) / t1 - (na.array() - nb[j]).square() / t2;
+        K.col(j).array() = ledergerberExponent(K.col(j).array(), na.array() - nb[j], t1, t2);
       K = s2 * K.array().exp();
       break;
     }
@@ -507,17 +541,16 @@ void Kernel::crossInto(const MatX& X1, const MatX& X2, Eigen::Ref<MatX> K) const
     q.B = activeCols(X2, p.active_dims);
     if (p.type == PartType::kRbf || p.type == PartType::kMatern52) {
       for (Eigen::Index d = 0; d < q.A.cols(); ++d) {
-        const double l = theta_[p.offset + 1 + (p.n_l == 1 ? 0 : d)];
+        const double l = theta_[p.lengthscaleIndex(d)];
         q.A.col(d) /= l;
         q.B.col(d) /= l;
       }
       q.Bt = q.B.transpose();
       q.cf = ScaledExpCoefs(theta_[p.offset]);
     } else if (p.type == PartType::kLedergerber) {
-      q.na = rowNorms(q.A);
-      q.nb = rowNorms(q.B);
-      q.A = q.na.cwiseInverse().asDiagonal() * q.A;
-      q.B = q.nb.cwiseInverse().asDiagonal() * q.B;
+      UnitRows ua = unitRows(q.A), ub = unitRows(q.B);
+      q.na = std::move(ua.norm), q.A = std::move(ua.unit);
+      q.nb = std::move(ub.norm), q.B = std::move(ub.unit);
     }
   }
   Eigen::ArrayXd term(n1), part(n1), scratch(n1);
@@ -540,17 +573,17 @@ void Kernel::crossInto(const MatX& X1, const MatX& X2, Eigen::Ref<MatX> K) const
           scratch = out.sqrt() * kSqrt5;  // √5 ρ
           out = scratch;
           scaledExpInPlace(out.data(), n1, -1.0, 1.0);
-          out *= s2 * (1.0 + scratch + scratch.square() / 3.0);
+          out *= s2 * matern52Polynomial(scratch);
         }
         break;
       }
       case PartType::kPeriodic: {  // Σ_d sin²(π Δ_d / T_d) / l_d²  (P1)
         out.setZero();
         for (Eigen::Index d = 0; d < nd; ++d) {
-          const double l = theta_[p.offset + 1 + (p.n_l == 1 ? 0 : d)];
-          const double T = theta_[p.offset + 1 + p.n_l + (p.n_T == 1 ? 0 : d)];
+          const double l = theta_[p.lengthscaleIndex(d)];
+          const double T = theta_[p.periodIndex(d)];
           const double c = kPi / T, il2 = 1.0 / (l * l);
-          out += il2 * (c * (q.A.col(d).array() - q.B(j, d))).sin().square();
+          out += periodicTerm(q.A.col(d).array() - q.B(j, d), c, il2);
         }
         scaledExpInPlace(out.data(), n1, -2.0, s2);
         break;
@@ -559,7 +592,7 @@ void Kernel::crossInto(const MatX& X1, const MatX& X2, Eigen::Ref<MatX> K) const
         const double t1 = theta_[p.offset + 1], t2 = theta_[p.offset + 2];
         const auto gamma = q.A.col(0).array() * q.B(j, 0) + q.A.col(1).array() * q.B(j, 1) +
                            q.A.col(2).array() * q.B(j, 2);
-        out = -(1.0 - gamma) / t1 - (q.na.array() - q.nb[j]).square() / t2;
+        out = ledergerberExponent(gamma, q.na.array() - q.nb[j], t1, t2);
         scaledExpInPlace(out.data(), n1, 1.0, s2);
         break;
       }
@@ -604,23 +637,23 @@ void Kernel::crossColumn(const MatX& X1, const Eigen::Ref<const RowVecX>& x, Eig
           case PartType::kMatern52: {  // P2, P3
             for (Eigen::Index d = 0; d < nd; ++d) {
               const int dim = p.active_dims[static_cast<std::size_t>(d)];
-              const double il = 1.0 / theta_[p.offset + 1 + (p.n_l == 1 ? 0 : d)];
+              const double il = 1.0 / theta_[p.lengthscaleIndex(d)];
               acc += ((X1.col(dim).segment(i0, c).array() - x[dim]) * il).square();
             }
             if (p.type == PartType::kRbf) {
               prod *= s2 * (-0.5 * acc).exp();
             } else {
               const Chunk r = acc.sqrt() * kSqrt5;
-              prod *= s2 * (1.0 + r + r.square() / 3.0) * (-r).exp();
+              prod *= s2 * matern52Polynomial(r) * (-r).exp();
             }
             break;
           }
           case PartType::kPeriodic: {  // P1
             for (Eigen::Index d = 0; d < nd; ++d) {
               const int dim = p.active_dims[static_cast<std::size_t>(d)];
-              const double l = theta_[p.offset + 1 + (p.n_l == 1 ? 0 : d)];
-              const double T = theta_[p.offset + 1 + p.n_l + (p.n_T == 1 ? 0 : d)];
-              acc += (1.0 / (l * l)) * ((kPi / T) * (X1.col(dim).segment(i0, c).array() - x[dim])).sin().square();
+              const double l = theta_[p.lengthscaleIndex(d)];
+              const double T = theta_[p.periodIndex(d)];
+              acc += periodicTerm(X1.col(dim).segment(i0, c).array() - x[dim], kPi / T, 1.0 / (l * l));
             }
             prod *= s2 * (-2.0 * acc).exp();
             break;
@@ -635,7 +668,7 @@ void Kernel::crossColumn(const MatX& X1, const Eigen::Ref<const RowVecX>& x, Eig
             if (nb < 1e-12 || na.minCoeff() < 1e-12)
               throw std::invalid_argument("ledergerber kernel: input vector of zero norm (k_L is undefined at x = 0)");
             const Chunk gamma = (a0 * x[d0] + a1 * x[d1] + a2 * x[d2]) / (na * nb);
-            prod *= s2 * (-(1.0 - gamma) / t1 - (na - nb).square() / t2).exp();
+            prod *= s2 * ledergerberExponent(gamma, na - nb, t1, t2).exp();
             break;
           }
         }
@@ -709,7 +742,7 @@ void Kernel::partGradient(int pi, const MatX& X1, const MatX& X2, const MatX& H,
         // P9: Matérn-5/2, g = (5/3) σ² (1 + √5ρ) e^{−√5ρ}
         MatX R2 = MatX::Zero(A.rows(), n2);
         for (Eigen::Index d = 0; d < nd; ++d) {
-          const double l = theta_[p.offset + 1 + (p.n_l == 1 ? 0 : d)];
+          const double l = theta_[p.lengthscaleIndex(d)];
           for (Eigen::Index j = 0; j < n2; ++j) R2.col(j).array() += ((A.col(d).array() - B(j, d)) / l).square();
         }
         const Eigen::ArrayXXd r = R2.array().sqrt() * kSqrt5;
@@ -730,7 +763,7 @@ void Kernel::partGradient(int pi, const MatX& X1, const MatX& X2, const MatX& H,
       MatX WB(A.rows(), nd);
       WB.noalias() = Wg * Bc;
       for (Eigen::Index d = 0; d < nd; ++d) {
-        const Eigen::Index li = p.offset + 1 + (p.n_l == 1 ? 0 : d);
+        const Eigen::Index li = p.lengthscaleIndex(d);
         const double l = theta_[li];
         const auto a = Ac.col(d).array();
         const double acc = (rs.array() * a.square()).sum() - 2.0 * (a * WB.col(d).array()).sum() +
@@ -744,8 +777,8 @@ void Kernel::partGradient(int pi, const MatX& X1, const MatX& X2, const MatX& H,
       // P7: u = πΔ/T; ∂k/∂l = 4k sin²u / l³; ∂k/∂T = k (2/l²) sin 2u · πΔ/T²; ∂k/∂x = −k (2/l²) sin 2u · π/T
       Eigen::ArrayXd gx(A.rows()), delta(A.rows()), su(A.rows()), ws2(A.rows());
       for (Eigen::Index d = 0; d < nd; ++d) {
-        const Eigen::Index li = p.offset + 1 + (p.n_l == 1 ? 0 : d);
-        const Eigen::Index ti = p.offset + 1 + p.n_l + (p.n_T == 1 ? 0 : d);
+        const Eigen::Index li = p.lengthscaleIndex(d);
+        const Eigen::Index ti = p.periodIndex(d);
         const double l = theta_[li], T = theta_[ti], c = kPi / T;
         double acc_l = 0.0, acc_T = 0.0;
         gx.setZero();
@@ -766,9 +799,9 @@ void Kernel::partGradient(int pi, const MatX& X1, const MatX& X2, const MatX& H,
     case PartType::kLedergerber: {
       // P10: ∂k/∂θ1 = k(1−γ)/θ1², ∂k/∂θ2 = k(n−n')²/θ2², ∂k/∂x = k[(x'/(nn') − γx/n²)/θ1 − 2(n−n')/θ2 · x/n]
       const double t1 = theta_[p.offset + 1], t2 = theta_[p.offset + 2];
-      const VecX na = rowNorms(A), nb = rowNorms(B);
-      const MatX Ua = na.cwiseInverse().asDiagonal() * A;
-      const MatX Ub = nb.cwiseInverse().asDiagonal() * B;
+      const UnitRows ua = unitRows(A), ub = unitRows(B);
+      const VecX &na = ua.norm, &nb = ub.norm;
+      const MatX &Ua = ua.unit, &Ub = ub.unit;
       const MatX gamma = Ua * Ub.transpose();
       MatX dn2(A.rows(), n2);  // (n − n')
       for (Eigen::Index j = 0; j < n2; ++j) dn2.col(j) = na.array() - nb[j];

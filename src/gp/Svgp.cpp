@@ -3,6 +3,8 @@
  */
 #include "uwb/gp/Svgp.h"
 
+#include "uwb/gp/PredictTile.h"
+
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <atomic>
@@ -15,9 +17,6 @@
 #include <vector>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
-#if defined(__AVX2__) && defined(__FMA__)
-#include <immintrin.h>
-#endif
 
 namespace uwb::gp {
 
@@ -318,118 +317,11 @@ SvgpPredictor::SvgpPredictor(const Svgp& gp)
   kdiag_ = kernel_.diagValue();
 }
 
+void SvgpPredictor::packQu() { qpack_ = packQuPanels(Q_); }  // P33 (gp/PredictTile.h)
+
 namespace {
+
 constexpr Eigen::Index kPredictBlock = 128;  ///< rows of test points per kernel block (≈ 175 kB at M = 170)
-constexpr Eigen::Index kTilePoints = 8;      ///< points per fused quadratic-form tile (P33): two AVX2 registers
-constexpr Eigen::Index kQuPanel = 6;         ///< columns of Q_u per panel (P33): 6 × 2 accumulator registers
-
-/// docs/math/gp.md (P33): mean and kᵀQ_u k for the kTilePoints points whose kernel values are
-/// K[j·ld + 0..7], j < M (one column of the column-major kernel block per inducing point):
-///   mean_i = Σ_j k_ij α_j,   var_i = Σ_l k_il t_il,   t_il = Σ_{j≤l} k_ij (Q_u)_jl,
-/// with t computed for a panel of kQuPanel columns l in registers (12 accumulators: 8 points × 6 columns) and
-/// folded into var at once, so K Q_u is never stored. `qpack` holds the panels one after the other, each as rows
-/// j = 0 … min(l0 + kQuPanel, M) − 1 of kQuPanel values (zeros below the diagonal and past column M − 1). Each
-/// point's value is computed in its own lane by the same sequence of operations, so it does not depend on the
-/// other points of the tile.
-void tileMeanQuadForm(const double* K, Eigen::Index ld, Eigen::Index M, const double* qpack, const double* alpha,
-                      double* mean, double* var) {
-#if defined(__AVX2__) && defined(__FMA__)
-  {  // mean: 4 partial sums per half (j mod 4), added at the end
-    __m256d m0[4], m1[4];
-    for (int r = 0; r < 4; ++r) m0[r] = m1[r] = _mm256_setzero_pd();
-    Eigen::Index j = 0;
-    for (; j + 4 <= M; j += 4) {
-#pragma GCC unroll 4
-      for (int r = 0; r < 4; ++r) {
-        const __m256d a = _mm256_broadcast_sd(alpha + j + r);
-        m0[r] = _mm256_fmadd_pd(_mm256_loadu_pd(K + (j + r) * ld), a, m0[r]);
-        m1[r] = _mm256_fmadd_pd(_mm256_loadu_pd(K + (j + r) * ld + 4), a, m1[r]);
-      }
-    }
-#pragma GCC unroll 3
-    for (int r = 0; r < 3; ++r) {  // constant indices keep the partial sums in registers
-      if (j + r < M) {
-        const __m256d a = _mm256_broadcast_sd(alpha + j + r);
-        m0[r] = _mm256_fmadd_pd(_mm256_loadu_pd(K + (j + r) * ld), a, m0[r]);
-        m1[r] = _mm256_fmadd_pd(_mm256_loadu_pd(K + (j + r) * ld + 4), a, m1[r]);
-      }
-    }
-    _mm256_storeu_pd(mean, _mm256_add_pd(_mm256_add_pd(m0[0], m0[1]), _mm256_add_pd(m0[2], m0[3])));
-    _mm256_storeu_pd(mean + 4, _mm256_add_pd(_mm256_add_pd(m1[0], m1[1]), _mm256_add_pd(m1[2], m1[3])));
-  }
-  if (!var) return;
-  __m256d v0 = _mm256_setzero_pd(), v1 = _mm256_setzero_pd();
-  const double* q = qpack;
-  for (Eigen::Index l0 = 0; l0 < M; l0 += kQuPanel) {
-    const Eigen::Index jend = std::min(l0 + kQuPanel, M);
-    __m256d t0[kQuPanel], t1[kQuPanel];
-#pragma GCC unroll 6
-    for (int c = 0; c < kQuPanel; ++c) t0[c] = t1[c] = _mm256_setzero_pd();
-    for (Eigen::Index j = 0; j < jend; ++j, q += kQuPanel) {
-      const __m256d k0 = _mm256_loadu_pd(K + j * ld), k1 = _mm256_loadu_pd(K + j * ld + 4);
-#pragma GCC unroll 6
-      for (int c = 0; c < kQuPanel; ++c) {
-        const __m256d qc = _mm256_broadcast_sd(q + c);
-        t0[c] = _mm256_fmadd_pd(k0, qc, t0[c]);
-        t1[c] = _mm256_fmadd_pd(k1, qc, t1[c]);
-      }
-    }
-    // constant c (registers stay registers); past column M − 1, t is 0 and any column may be read: take M − 1
-#pragma GCC unroll 6
-    for (int c = 0; c < kQuPanel; ++c) {
-      const double* kc = K + std::min<Eigen::Index>(l0 + c, M - 1) * ld;
-      v0 = _mm256_fmadd_pd(t0[c], _mm256_loadu_pd(kc), v0);
-      v1 = _mm256_fmadd_pd(t1[c], _mm256_loadu_pd(kc + 4), v1);
-    }
-  }
-  _mm256_storeu_pd(var, v0);
-  _mm256_storeu_pd(var + 4, v1);
-#else
-  // Portable version of the same arithmetic (plain multiply-adds; the compiler may vectorize the lanes).
-  double m[4][kTilePoints] = {};
-  Eigen::Index j = 0;
-  for (; j + 4 <= M; j += 4)
-    for (int r = 0; r < 4; ++r)
-      for (int i = 0; i < kTilePoints; ++i) m[r][i] += K[(j + r) * ld + i] * alpha[j + r];
-  for (int r = 0; j < M; ++j, ++r)
-    for (int i = 0; i < kTilePoints; ++i) m[r][i] += K[j * ld + i] * alpha[j];
-  for (int i = 0; i < kTilePoints; ++i) mean[i] = (m[0][i] + m[1][i]) + (m[2][i] + m[3][i]);
-  if (!var) return;
-  double v[kTilePoints] = {};
-  const double* q = qpack;
-  for (Eigen::Index l0 = 0; l0 < M; l0 += kQuPanel) {
-    const Eigen::Index jend = std::min(l0 + kQuPanel, M);
-    double t[kQuPanel][kTilePoints] = {};
-    for (Eigen::Index jj = 0; jj < jend; ++jj, q += kQuPanel)
-      for (int c = 0; c < kQuPanel; ++c)
-        for (int i = 0; i < kTilePoints; ++i) t[c][i] += K[jj * ld + i] * q[c];
-    for (int c = 0; c < kQuPanel; ++c) {
-      const double* kc = K + std::min<Eigen::Index>(l0 + c, M - 1) * ld;
-      for (int i = 0; i < kTilePoints; ++i) v[i] += t[c][i] * kc[i];
-    }
-  }
-  for (int i = 0; i < kTilePoints; ++i) var[i] = v[i];
-#endif
-}
-}  // namespace
-
-void SvgpPredictor::packQu() {
-  // P33: Q_u = triu(Q) with the off-diagonal doubled (kᵀQk = kᵀQ_u k, P20), cut into panels of kQuPanel columns;
-  // panel l0 holds rows j < min(l0 + kQuPanel, M), the rows below are zero in Q_u and skipped.
-  const Eigen::Index M = Q_.rows();
-  qpack_.clear();
-  for (Eigen::Index l0 = 0; l0 < M; l0 += kQuPanel) {
-    const Eigen::Index jend = std::min(l0 + kQuPanel, M);
-    for (Eigen::Index j = 0; j < jend; ++j) {
-      for (Eigen::Index c = 0; c < kQuPanel; ++c) {
-        const Eigen::Index l = l0 + c;
-        qpack_.push_back(l >= M || j > l ? 0.0 : (j == l ? Q_(j, l) : 2.0 * Q_(j, l)));
-      }
-    }
-  }
-}
-
-namespace {
 
 /// Runs worker() on min(num_threads, blocks) threads (0: one per hardware thread; the calling thread is one of
 /// them). The workers share the rows by taking kPredictBlock-row blocks from one atomic counter, so a thread slowed
@@ -474,9 +366,8 @@ void SvgpPredictor::predictRows(const MatX& X_raw, std::atomic<Eigen::Index>& ne
   // Kernel block: rows padded to a whole number of tiles (copies of the last row, whose results are dropped),
   // column-major with the leading dimension ld, 64-byte aligned so that a tile's column is one cache line.
   MatX Xb(kPredictBlock, X_raw.cols());
-  const std::unique_ptr<double[]> kbuf(new double[static_cast<std::size_t>(kPredictBlock * M + 8)]);
-  double* kdata = kbuf.get();
-  while (reinterpret_cast<std::uintptr_t>(kdata) % 64 != 0) ++kdata;
+  AlignedDoubles kbuf(static_cast<std::size_t>(kPredictBlock * M));
+  double* kdata = kbuf.data();
   double tmean[kTilePoints], tvar[kTilePoints];
   for (Eigen::Index start = next_block++ * kPredictBlock; start < N; start = next_block++ * kPredictBlock) {
     const Eigen::Index n = std::min(kPredictBlock, N - start);

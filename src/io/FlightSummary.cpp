@@ -13,16 +13,6 @@ namespace uwb {
 
 namespace {
 
-double medianInPlace(std::vector<double>& v) {
-  const std::size_t n = v.size();
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(n / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  const double hi = *mid;
-  if (n % 2 == 1) return hi;
-  const double lo = *std::max_element(v.begin(), mid);
-  return 0.5 * (lo + hi);
-}
-
 template <class Samples>
 StreamSummary summarizeStream(Stream s, const Samples& samples, bool present) {
   StreamSummary out;
@@ -45,37 +35,6 @@ bool columnsMention(const Flight& f, Stream s) {
 }
 
 }  // namespace
-
-ResidualStats residualStats(std::vector<double> values, double gross_residual_m) {
-  ResidualStats st;
-  st.n = values.size();
-  if (values.empty()) return st;
-  double sum = 0.0;
-  double sum2 = 0.0;
-  for (double v : values) {
-    sum += v;
-    sum2 += v * v;
-  }
-  st.mean_m = sum / static_cast<double>(st.n);
-  st.rms_m = std::sqrt(sum2 / static_cast<double>(st.n));
-  st.median_m = medianInPlace(values);
-  double abs_sum = 0.0;
-  double kept_sum = 0.0;
-  std::size_t n_kept = 0;
-  for (double& v : values) {
-    v = std::abs(v - st.median_m);
-    abs_sum += v;
-    if (v < gross_residual_m) {
-      kept_sum += v;
-      ++n_kept;
-    }
-  }
-  st.mean_abs_dev_m = abs_sum / static_cast<double>(st.n);
-  st.n_gross = st.n - n_kept;
-  st.mad_m = n_kept > 0 ? kept_sum / static_cast<double>(n_kept) : 0.0;
-  st.median_abs_dev_m = medianInPlace(values);
-  return st;
-}
 
 bool isNeighbourPair(int id_a, int id_b, const std::vector<int>& sorted_ids) {
   const auto it = std::lower_bound(sorted_ids.begin(), sorted_ids.end(), id_a);
@@ -148,7 +107,7 @@ FlightSummary summarizeFlight(const Flight& flight, const AnchorSurvey* survey, 
     out.n_pose_glitches_position = track.countGlitches(PoseGlitchKind::kPosition);
     if (!track.empty()) {
       const auto n_air = std::count_if(track.samples().begin(), track.samples().end(), [&](const PoseSample& s) {
-        return s.w_p_b.z() > params.residual.airborne_min_z_m;
+        return isAirborne(s.w_p_b.z(), params.residual.airborne_min_z_m);
       });
       out.airborne_fraction_pose = static_cast<double>(n_air) / static_cast<double>(track.samples().size());
     }

@@ -144,24 +144,7 @@ std::size_t PoseTrack::countGlitches(PoseGlitchKind kind) const {
 }
 
 std::optional<PoseSample> PoseTrack::interpolate(double t_s) const {
-  if (samples_.empty() || !(t_s >= samples_.front().t_s) || !(t_s <= samples_.back().t_s)) return std::nullopt;
-  const auto it = std::upper_bound(samples_.begin(), samples_.end(), t_s,
-                                   [](double t, const PoseSample& s) { return t < s.t_s; });
-  if (it == samples_.end()) {  // t_s == last sample time
-    PoseSample out = samples_.back();
-    out.t_s = t_s;
-    return out;
-  }
-  const PoseSample& b = *it;
-  const PoseSample& a = *(it - 1);  // it != begin since t_s >= front().t_s
-  const double dt = b.t_s - a.t_s;
-  if (dt > params_.max_gap_s) return std::nullopt;
-  const double u = dt > 0.0 ? (t_s - a.t_s) / dt : 0.0;
-  PoseSample out;
-  out.t_s = t_s;
-  out.w_p_b = a.w_p_b + u * (b.w_p_b - a.w_p_b);
-  out.w_q_b = has_orientation_ ? a.w_q_b.slerp(u, b.w_q_b).normalized() : Quat::Identity();
-  return out;
+  return interpolatePose(samples_, t_s, params_.max_gap_s, has_orientation_);
 }
 
 std::vector<TdoaResidual> tdoaResiduals(const Flight& flight, const AnchorSurvey& survey, const PoseTrack& track,
@@ -196,7 +179,7 @@ std::vector<TdoaResidual> tdoaResiduals(const Flight& flight, const AnchorSurvey
     // docs/math/measurement.md (M2), paper eq. (2): |p_tag − a_B| − |p_tag − a_A|
     r.predicted_m = predictTdoa(r.w_p_b, r.w_q_b, params.b_t_tag, ia->second, ib->second);
     r.residual_m = r.measured_m - r.predicted_m;
-    r.airborne = r.w_p_b.z() > params.airborne_min_z_m;
+    r.airborne = isAirborne(r.w_p_b.z(), params.airborne_min_z_m);
     out.push_back(r);
   }
   rep.n_residuals = out.size();

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "uwb/io/Airborne.h"
 #include "uwb/model/TdoaModel.h"
 #include "uwb/sim/Kinematics.h"
 
@@ -58,7 +59,7 @@ SimResult simulateFlight(const Scenario& scenario, const SimParams& params, std:
   // (S12) the hardware and room from bias.field_seed when set, else from the flight's seed
   std::mt19937_64 field_rng =
       params.bias.field_seed != 0 ? makeStreams(params.bias.field_seed).bias_field : std::mt19937_64{};
-  const BiasModel bias(params.bias, survey, params.bias.field_seed != 0 ? field_rng : rng.bias_field, rng.bias_field);
+  const SimulatedBias bias(params.bias, survey, params.bias.field_seed != 0 ? field_rng : rng.bias_field, rng.bias_field);
   const double duration = trajectory.duration_s();
   const double ground_z = scenario.trajectory.ground_z_m;
 
@@ -138,7 +139,7 @@ SimResult simulateFlight(const Scenario& scenario, const SimParams& params, std:
       truth.tdoa_true_m = range(w_p_tag, anchor_b.w_p) - range(w_p_tag, anchor_a.w_p);  // (S20)
       truth.error = bias.sample(t, anchor_a.id, anchor_b.id, w_p_tag, s.w_q_b, s.w_p.z() - ground_z, rng.tdoa_error);
       truth.on_ground = s.on_ground;
-      truth.airborne = s.w_p.z() >= 0.3;
+      truth.airborne = isAirborne(s.w_p.z());
       flight.tdoa.push_back({t, anchor_a.id, anchor_b.id, truth.tdoa_true_m + truth.error.total()});
       out.tdoa_truth.push_back(truth);
       slot = (slot + 1) % n_anchors;

@@ -3,6 +3,9 @@
  */
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <stdexcept>
+
 #include "uwb/core.h"
 #include "uwb/eval.h"
 #include "uwb/filter.h"
@@ -24,8 +27,11 @@ TEST(UmbrellaHeaders, GiveEachModuleTogether) {
   AnchorTable anchors;                                                                   // filter
   anchors.set(3, Vec3(1, 0, 0));
   EXPECT_NE(anchors.find(3), nullptr);
-  EXPECT_TRUE(Flight{}.tdoa.empty());                                                    // io
-  EXPECT_NO_THROW(BiasDatasetParams{});                                                  // eval
+  EXPECT_DOUBLE_EQ(residualStats({1.0, 4.0, 2.0}).median_m, 2.0);                       // io
+  BiasDatasetParams bias_params;                                                         // eval
+  EXPECT_NO_THROW(bias_params.validate());
+  bias_params.min_z_m = std::nan("");
+  EXPECT_THROW(bias_params.validate(), std::invalid_argument);
   EXPECT_GT(sim::SimParams{}.imu.rate_hz, 0.0);                                          // sim
 }
 

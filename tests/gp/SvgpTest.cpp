@@ -5,8 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
+#include <functional>
 #include <random>
+#include <utility>
+#include <vector>
 
+#include "support/DerivativeChecker.h"
 #include "uwb/gp/SvgpTrainer.h"
 
 namespace uwb::gp {
@@ -52,11 +56,6 @@ Problem makeProblem(std::uint64_t seed, int N = 40, int M = 7) {
   return p;
 }
 
-double fd4(const std::function<double(double)>& f, double x) {
-  const double h = 1e-4 * std::max(std::abs(x), 0.1);
-  return (-f(x + 2 * h) + 8 * f(x + h) - 8 * f(x - h) + f(x - 2 * h)) / (12 * h);
-}
-
 void checkGradient(ElboMode mode) {
   // GIVEN a random SVGP state and batch
   const Problem p = makeProblem(7);
@@ -67,30 +66,41 @@ void checkGradient(ElboMode mode) {
     edit(q);
     return q.elbo(p.X, p.y, p.num_data, nullptr, ElboMode::kExact).elbo;
   };
-  const double tol = 1e-6;
-  auto near = [&](double a, double b, const std::string& what) { EXPECT_NEAR(a, b, tol * std::max(1.0, std::abs(b))) << what; };
-  // THEN every gradient matches 4th-order central differences
-  const VecX theta = p.gp.kernel().theta();
-  for (int i = 0; i < theta.size(); ++i) {
-    const double fd = fd4([&](double v) { return elboWith([&](Svgp& q) { VecX t = theta; t[i] = v; q.kernel().setTheta(t); }); }, theta[i]);
-    near(g.kernel[i], fd, p.gp.kernel().paramNames()[i]);
-  }
-  near(g.noise, fd4([&](double v) { return elboWith([&](Svgp& q) { q.setNoiseVariance(v); }); }, p.gp.noiseVariance()), "noise");
-  near(g.mean, fd4([&](double v) { return elboWith([&](Svgp& q) { q.setMean(v); }); }, p.gp.meanConstant()), "mean");
+  // THEN every gradient matches 4th-order central differences (test::checkGradient), block by block
+  const test::DifferenceOptions fd4{1e-4, 0.1, 4};
+  const auto expectMatches = [&](const std::function<void(Svgp&, const VecX&)>& set, const VecX& x, const VecX& g_x,
+                                 const std::string& what) {
+    const test::JacobianCheck c =
+        test::checkGradient([&](const VecX& v) { return elboWith([&](Svgp& q) { set(q, v); }); }, x, g_x, fd4);
+    EXPECT_LT(c.max_scaled_error, 1e-6) << what << ": " << c;
+  };
+  expectMatches([](Svgp& q, const VecX& v) { q.kernel().setTheta(v); }, p.gp.kernel().theta(), g.kernel, "kernel θ");
+  expectMatches([](Svgp& q, const VecX& v) { q.setNoiseVariance(v[0]); }, VecX::Constant(1, p.gp.noiseVariance()),
+                VecX::Constant(1, g.noise), "noise");
+  expectMatches([](Svgp& q, const VecX& v) { q.setMean(v[0]); }, VecX::Constant(1, p.gp.meanConstant()),
+                VecX::Constant(1, g.mean), "mean");
   const MatX Z = p.gp.inducing();
-  for (Eigen::Index i = 0; i < Z.rows(); ++i)
-    for (Eigen::Index d = 0; d < Z.cols(); ++d)
-      near(g.Z(i, d), fd4([&](double v) { return elboWith([&](Svgp& q) { MatX Zq = Z; Zq(i, d) = v; q.setInducing(Zq); }); }, Z(i, d)),
-           "Z(" + std::to_string(i) + "," + std::to_string(d) + ")");
+  expectMatches([&](Svgp& q, const VecX& v) { q.setInducing(Eigen::Map<const MatX>(v.data(), Z.rows(), Z.cols())); },
+                Eigen::Map<const VecX>(Z.data(), Z.size()), Eigen::Map<const VecX>(g.Z.data(), g.Z.size()), "Z");
   const VecX m = p.gp.variationalMean();
   const MatX L = p.gp.variationalCholesky();
-  for (Eigen::Index i = 0; i < m.size(); ++i)
-    near(g.m[i], fd4([&](double v) { return elboWith([&](Svgp& q) { VecX mq = m; mq[i] = v; q.setVariational(mq, L); }); }, m[i]),
-         "m" + std::to_string(i));
-  for (Eigen::Index i = 0; i < L.rows(); ++i)
-    for (Eigen::Index j = 0; j <= i; ++j)
-      near(g.L(i, j), fd4([&](double v) { return elboWith([&](Svgp& q) { MatX Lq = L; Lq(i, j) = v; q.setVariational(m, Lq); }); }, L(i, j)),
-           "L(" + std::to_string(i) + "," + std::to_string(j) + ")");
+  expectMatches([&](Svgp& q, const VecX& v) { q.setVariational(v, L); }, m, g.m, "m");
+  // L: its lower triangle, column by column
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> lower;
+  for (Eigen::Index j = 0; j < L.cols(); ++j)
+    for (Eigen::Index i = j; i < L.rows(); ++i) lower.emplace_back(i, j);
+  VecX l(static_cast<Eigen::Index>(lower.size())), g_l(l.size());
+  for (std::size_t k = 0; k < lower.size(); ++k) {
+    l[static_cast<Eigen::Index>(k)] = L(lower[k].first, lower[k].second);
+    g_l[static_cast<Eigen::Index>(k)] = g.L(lower[k].first, lower[k].second);
+  }
+  expectMatches(
+      [&](Svgp& q, const VecX& v) {
+        MatX Lq = L;
+        for (std::size_t k = 0; k < lower.size(); ++k) Lq(lower[k].first, lower[k].second) = v[static_cast<Eigen::Index>(k)];
+        q.setVariational(m, Lq);
+      },
+      l, g_l, "L (lower triangle, column-major)");
   EXPECT_EQ(g.L.triangularView<Eigen::StrictlyUpper>().toDenseMatrix().cwiseAbs().maxCoeff(), 0.0);
 }
 

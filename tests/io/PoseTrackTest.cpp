@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
+#include <vector>
 
 #include "IoTestHelpers.h"
 #include "uwb/io/UtilCsv.h"
@@ -49,6 +51,41 @@ TEST(PoseTrack, InterpolatesPositionLinearlyAndAttitudeBySlerp) {
   // and the end points are reproduced
   EXPECT_TRUE(track.interpolate(1.0)->w_p_b.isApprox(s[0].w_p_b));
   EXPECT_TRUE(track.interpolate(1.01)->w_p_b.isApprox(s[1].w_p_b));
+}
+
+TEST(InterpolatePose, AnySampleTypeIsInterpolatedTheSameWay) {
+  // GIVEN filter output samples (TrajectorySample-like: t_s, w_p_b, w_q_b) 0.1 s apart, yawing by 90°
+  struct Sample {
+    double t_s;
+    Vec3 w_p_b;
+    Quat w_q_b;
+  };
+  const std::vector<Sample> s = {{1.0, Vec3(0, 0, 1), yaw(0.0)}, {1.1, Vec3(1, 2, 1), yaw(std::numbers::pi / 2)}};
+  // WHEN interpolating a quarter of the way, at a sample, and outside
+  const auto q = interpolatePose(s, 1.025, 0.2);
+  const auto at_first = interpolatePose(s, 1.0, 0.2);
+  const auto at_last = interpolatePose(s, 1.1, 0.2);
+  // THEN the position is linear and the attitude the slerp (yaw 22.5°), samples are returned as they are
+  ASSERT_TRUE(q && at_first && at_last);
+  EXPECT_LT((q->w_p_b - Vec3(0.25, 0.5, 1)).norm(), 1e-12);
+  EXPECT_NEAR(q->w_q_b.angularDistance(yaw(std::numbers::pi / 8)), 0.0, 1e-12);
+  EXPECT_EQ(at_first->w_p_b, s[0].w_p_b);
+  EXPECT_EQ(at_last->w_p_b, s[1].w_p_b);
+  EXPECT_FALSE(interpolatePose(s, 0.99, 0.2));
+  EXPECT_FALSE(interpolatePose(s, 1.11, 0.2));
+  EXPECT_FALSE(interpolatePose(s, 1.05, 0.05));  // the samples are 0.1 s apart: a gap for max_gap_s = 0.05
+  // AND without orientation the attitude is the identity
+  EXPECT_EQ(interpolatePose(s, 1.05, 0.2, false)->w_q_b.coeffs(), Quat::Identity().coeffs());
+}
+
+TEST(Airborne, IsStrictlyAboveTheThreshold) {
+  // GIVEN the one airborne definition, THEN z = 0.3 m is on the ground and anything above is airborne
+  EXPECT_DOUBLE_EQ(kAirborneMinZ_m, 0.3);
+  EXPECT_FALSE(isAirborne(0.3));
+  EXPECT_TRUE(isAirborne(std::nextafter(0.3, 1.0)));
+  EXPECT_FALSE(isAirborne(-1.0));
+  EXPECT_TRUE(isAirborne(0.5, 0.4));
+  EXPECT_FALSE(isAirborne(0.35, 0.4));
 }
 
 TEST(PoseTrack, NoGroundTruthOutsideTheTrackOrAcrossAGap) {

@@ -2,9 +2,9 @@
  *  @brief Change indication on real flights (STYLE §10): replays UTIL pilot flights through the default filter and
  *         checks the airborne RMSE stays under committed bounds. Skips when the data is absent.
  *
- *  Bounds = the value at the time of commit (scripts/localize_all.sh) + margin; a PR that changes the filter
+ *  Bounds = the value of scripts/localize_all.sh for the committed filter + margin; a change to the filter
  *  updates them deliberately. Reference (default params): 0425-traj2 0.211 m, 0426-traj11 0.260 m, median of the
- *  16 TDoA2 pilot flights 0.260 m (issue 3: vertical accelerometer noise 0.05, take-off bias inflation, F20),
+ *  16 TDoA2 pilot flights 0.260 m (docs/results.md),
  *  const4-trial1-tdoa2-traj2 (TDoA-only) 0.169 m.
  */
 #include <gtest/gtest.h>
@@ -85,7 +85,7 @@ TEST(RealDataLocalization, PilotTdoa2MedianAirborneRmseUnderBound) {
     EXPECT_LT(run.metrics->airborne.rmse_m, 0.40) << name;
     rmse.push_back(run.metrics->airborne.rmse_m);
   }
-  // THEN the median airborne RMSE stays under the committed bound (0.260 m at commit; 0.279 m before issue 3)
+  // THEN the median airborne RMSE stays under the committed bound (0.260 m with the defaults)
   std::sort(rmse.begin(), rmse.end());
   EXPECT_LT(0.5 * (rmse[7] + rmse[8]), 0.275);
 }

@@ -13,7 +13,7 @@
 #include "uwb/io/UtilCsv.h"
 #include "uwb/model/TdoaModel.h"
 #include "uwb/sim/FlightSimulator.h"
-#include "uwb/sim/ResidualStats.h"
+#include "uwb/sim/ResidualProfile.h"
 
 namespace uwb::sim {
 namespace {
@@ -182,7 +182,7 @@ TEST(FlightSimulator, NlosBurstsLastOneBinAndHitTheConfiguredFraction) {
   // GIVEN the bias model of a flight
   const BiasParams bp;
   std::mt19937_64 rng(12);
-  const BiasModel model(bp, paperAnchors(), rng);
+  const SimulatedBias model(bp, paperAnchors(), rng);
   // WHEN we sample anchor 2's burst excess over many time bins
   std::size_t bins_in_burst = 0;
   const std::size_t n_bins = 20000;
@@ -239,11 +239,11 @@ TEST_P(AirborneResiduals, ResembleTheRealFlights) {
   SCOPED_TRACE(toString(shape) + " seed " + std::to_string(seed));
   const SimResult r = defaultFlight(shape, 120.0, seed);
   // WHEN we compute the airborne residual statistics against the (quantized) pose stream
-  const ResidualStats s = residualStats(r.flight, r.survey, Phase::kAirborne);
+  const ResidualProfile s = residualProfile(r.flight, r.survey, Phase::kAirborne);
   // THEN they fall in the documented ranges of the util-pilot flights (docs/math/simulation.md, Calibration)
-  EXPECT_LT(std::abs(s.median_m), 0.03);
-  EXPECT_GT(s.mean_abs_dev_m, 0.13);
-  EXPECT_LT(s.mean_abs_dev_m, 0.27);
+  EXPECT_LT(std::abs(s.overall.median_m), 0.03);
+  EXPECT_GT(s.overall.mean_abs_dev_m, 0.13);
+  EXPECT_LT(s.overall.mean_abs_dev_m, 0.27);
   for (const auto& [pair, ps] : s.pairs) EXPECT_LT(std::abs(ps.median_m), 0.25) << pair.first << "-" << pair.second;
   ASSERT_EQ(s.autocorrelation.size(), 4u);
   EXPECT_GT(s.autocorrelation[0].second, 0.45);  // 0.1 s

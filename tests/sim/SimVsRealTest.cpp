@@ -12,7 +12,7 @@
 #include "support/TestSupport.h"
 #include "uwb/io/UtilCsv.h"
 #include "uwb/sim/FlightSimulator.h"
-#include "uwb/sim/ResidualStats.h"
+#include "uwb/sim/ResidualProfile.h"
 
 namespace uwb::sim {
 namespace {
@@ -23,18 +23,18 @@ struct RealFlight {
   double omega_rps;
 };
 
-double largestPairMedian(const ResidualStats& s) {
+double largestPairMedian(const ResidualProfile& s) {
   double m = 0.0;
   for (const auto& [pair, ps] : s.pairs) {
-    if (ps.count >= 50) m = std::max(m, std::abs(ps.median_m));
+    if (ps.n >= 50) m = std::max(m, std::abs(ps.median_m));
   }
   return m;
 }
 
-std::string row(const std::string& label, const ResidualStats& s) {
+std::string row(const std::string& label, const ResidualProfile& s) {
   char buf[256];
   std::snprintf(buf, sizeof buf, "| %-22s | %+.3f | %.3f | %.3f | %.3f | %.2f | %.2f | %.2f | %.4f |", label.c_str(),
-                s.median_m, s.mean_abs_dev_m, s.std_m, largestPairMedian(s), s.autocorrelation[0].second,
+                s.overall.median_m, s.overall.mean_abs_dev_m, s.overall.std_m, largestPairMedian(s), s.autocorrelation[0].second,
                 s.autocorrelation[1].second, s.autocorrelation[2].second, s.outlier_fraction);
   return buf;
 }
@@ -63,17 +63,17 @@ TEST(SimVsReal, AirborneResidualStatisticsAreOfTheSameSize) {
     sc.trajectory.yaw_mode = YawMode::kConstant;
     const SimResult sim = simulateFlight(sc, SimParams{}, seed++);
     // WHEN we compute the airborne residual statistics of both the same way
-    const ResidualStats r = residualStats(real, survey, Phase::kAirborne);
-    const ResidualStats s = residualStats(sim.flight, sim.survey, Phase::kAirborne);
+    const ResidualProfile r = residualProfile(real, survey, Phase::kAirborne);
+    const ResidualProfile s = residualProfile(sim.flight, sim.survey, Phase::kAirborne);
     std::printf("%s\n%s\n", row(std::string("real ") + rf.name, r).c_str(),
                 row(std::string("sim  ") + toString(rf.shape) + " ω=" + std::to_string(rf.omega_rps).substr(0, 3), s)
                     .c_str());
     // THEN the simulated flight is within the real range
-    EXPECT_LT(std::abs(s.median_m), 0.03) << rf.name;
-    EXPECT_GT(s.mean_abs_dev_m, 0.5 * r.mean_abs_dev_m) << rf.name;
-    EXPECT_LT(s.mean_abs_dev_m, 2.0 * r.mean_abs_dev_m) << rf.name;
-    real_mad_sum += r.mean_abs_dev_m;
-    sim_mad_sum += s.mean_abs_dev_m;
+    EXPECT_LT(std::abs(s.overall.median_m), 0.03) << rf.name;
+    EXPECT_GT(s.overall.mean_abs_dev_m, 0.5 * r.overall.mean_abs_dev_m) << rf.name;
+    EXPECT_LT(s.overall.mean_abs_dev_m, 2.0 * r.overall.mean_abs_dev_m) << rf.name;
+    real_mad_sum += r.overall.mean_abs_dev_m;
+    sim_mad_sum += s.overall.mean_abs_dev_m;
   }
   std::printf("mean MAD: real %.3f m, simulated %.3f m\n", real_mad_sum / 5.0, sim_mad_sum / 5.0);
 }

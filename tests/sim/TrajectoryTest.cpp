@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "support/DerivativeChecker.h"
 #include "uwb/sim/Trajectory.h"
 
 namespace uwb::sim {
@@ -23,16 +24,18 @@ TEST_P(EveryShape, VelocityAndAccelerationMatchCentralDifferences) {
   // GIVEN a flight of each shape
   const Trajectory traj(shortFlight(GetParam()));
   SCOPED_TRACE(toString(GetParam()));
-  const double h = 1e-4;
+  const test::DifferenceOptions step{1e-4};  // the time offset δ is differentiated at 0: steps of ±0.1 ms
   // WHEN we sample it densely, including the phase joins
   for (double t = 0.0; t <= traj.duration_s(); t += 0.0137) {
     const FlatState s = traj.evaluate(t);
-    const Vec3 v_num = (traj.evaluate(t + h).w_p - traj.evaluate(t - h).w_p) / (2 * h);
-    const Vec3 a_num = (traj.evaluate(t + h).w_v - traj.evaluate(t - h).w_v) / (2 * h);
     // THEN the analytic derivatives agree with the numerical ones
-    if (t > h && t < traj.duration_s() - h) {
-      EXPECT_LT((s.w_v - v_num).norm(), 1e-6) << "t = " << t;
-      EXPECT_LT((s.w_a - a_num).norm(), 1e-5) << "t = " << t;
+    if (t > step.h && t < traj.duration_s() - step.h) {
+      const auto p_at = [&](const VecX& d) { return VecX(traj.evaluate(t + d[0]).w_p); };
+      const auto v_at = [&](const VecX& d) { return VecX(traj.evaluate(t + d[0]).w_v); };
+      const test::JacobianCheck c_v = test::checkJacobian(p_at, VecX::Zero(1), s.w_v, step);
+      const test::JacobianCheck c_a = test::checkJacobian(v_at, VecX::Zero(1), s.w_a, step);
+      EXPECT_LT(c_v.max_abs_error, 1e-6) << "t = " << t << ": " << c_v;
+      EXPECT_LT(c_a.max_abs_error, 1e-5) << "t = " << t << ": " << c_a;
     }
     EXPECT_LT(s.w_a.norm(), 0.5 * kGravity_mps2) << "t = " << t;  // a real quadrotor manoeuvre
   }
@@ -132,10 +135,11 @@ TEST(Smoothstep7, HasVanishingDerivativesAtBothEnds) {
   EXPECT_DOUBLE_EQ(smoothstep7(1.0, &d1, &d2), 1.0);
   EXPECT_NEAR(d1, 0.0, 1e-12);
   EXPECT_NEAR(d2, 0.0, 1e-12);
-  const double h = 1e-6;
   for (double x : {0.1, 0.37, 0.5, 0.81}) {
     smoothstep7(x, &d1, &d2);
-    EXPECT_NEAR(d1, (smoothstep7(x + h) - smoothstep7(x - h)) / (2 * h), 1e-6);
+    const test::JacobianCheck c = test::checkGradient([](const VecX& v) { return smoothstep7(v[0]); },
+                                                      VecX::Constant(1, x), VecX::Constant(1, d1));
+    EXPECT_LT(c.max_abs_error, 1e-6) << c;
   }
 }
 

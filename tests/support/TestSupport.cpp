@@ -48,30 +48,6 @@ CliResult runCli(const std::string& args) {
   return r;
 }
 
-MatX numericalJacobian(const std::function<VecX(const VecX&)>& f, const VecX& x, double h) {
-  const VecX f0 = f(x);
-  MatX J(f0.size(), x.size());
-  for (Eigen::Index i = 0; i < x.size(); ++i) {
-    const double step = h * std::max(1.0, std::abs(x[i]));
-    VecX xp = x, xm = x;
-    xp[i] += step;
-    xm[i] -= step;
-    J.col(i) = (f(xp) - f(xm)) / (2.0 * step);
-  }
-  return J;
-}
-
-MatX numericalJacobianRotation(const std::function<VecX(const Quat&)>& f, const Quat& q, double h) {
-  const VecX f0 = f(q);
-  MatX J(f0.size(), 3);
-  for (int i = 0; i < 3; ++i) {
-    const Quat qp = (q * Quat(Eigen::AngleAxisd(h, Vec3::Unit(i)))).normalized();
-    const Quat qm = (q * Quat(Eigen::AngleAxisd(-h, Vec3::Unit(i)))).normalized();
-    J.col(i) = (f(qp) - f(qm)) / (2.0 * h);
-  }
-  return J;
-}
-
 double relativeError(const MatX& a, const MatX& b) {
   const double denom = b.cwiseAbs().maxCoeff();
   const double num = (a - b).cwiseAbs().maxCoeff();

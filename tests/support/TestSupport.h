@@ -1,5 +1,6 @@
 /** @file TestSupport.h
- *  @brief Shared test helpers: where real data lives, and central-difference derivatives (STYLE §10).
+ *  @brief Shared test helpers: where real data lives, running the CLI, relative errors; the derivative checker is
+ *         support/DerivativeChecker.h (included here).
  */
 #pragma once
 
@@ -8,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "support/DerivativeChecker.h"
 #include "uwb/core/Types.h"
 
 namespace uwb::test {
@@ -36,13 +38,6 @@ CliResult runCli(const std::string& args);
     if (!(path_opt)) GTEST_SKIP() << "real flight data not found under " << ::uwb::test::dataDir() \
                                   << " (set UWBTDOA_DATA to the shared/data folder)";            \
   } while (0)
-
-/// Central-difference Jacobian of f: R^n → R^m at x, step h (relative to max(|x_i|, 1)).
-MatX numericalJacobian(const std::function<VecX(const VecX&)>& f, const VecX& x, double h = 1e-6);
-
-/// Central-difference Jacobian of f(q ⊞ δθ) w.r.t. the rotation-vector perturbation δθ (right, body frame):
-/// q ⊞ δθ = q ⊗ exp(δθ). Returns m×3.
-MatX numericalJacobianRotation(const std::function<VecX(const Quat&)>& f, const Quat& q, double h = 1e-6);
 
 /// max_i |a_i − b_i| / max_i |b_i| (the fixture definition of relative error).
 double relativeError(const MatX& a, const MatX& b);

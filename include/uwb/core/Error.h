@@ -3,7 +3,7 @@
  *
  *  - InputError: malformed or inconsistent data (maps to Python ValueError).
  *  - FileError: a file that cannot be opened, read or written (maps to Python OSError).
- *  Programmer errors use UWB_ASSERT (always evaluated) or std::invalid_argument at public boundaries.
+ *  Programmer errors at public boundaries throw std::invalid_argument.
  */
 #pragma once
 
@@ -40,12 +40,4 @@ class FileError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-[[noreturn]] void assertionFailed(const char* condition, const char* file, int line, const std::string& message);
-
 }  // namespace uwb
-
-/// Programmer-error check; the condition is always evaluated (also in Release builds).
-#define UWB_ASSERT(cond, msg)                                      \
-  do {                                                             \
-    if (!(cond)) ::uwb::assertionFailed(#cond, __FILE__, __LINE__, (msg)); \
-  } while (0)

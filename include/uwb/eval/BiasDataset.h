@@ -41,7 +41,7 @@ struct BiasDatasetParams {
   /// model, so the GP inputs carry the error of the corrected filter that will use the model (docs/math/gp.md P30).
   BiasPredictor estimate_bias;
   Vec3 b_t_tag = kUtilTagOffset_b;  ///< tag (antenna) offset in the body frame [m]
-  double min_z_m = 0.3;             ///< on the ground: ground-truth body z below this is excluded [m]
+  double min_z_m = kAirborneMinZ_m;  ///< samples not isAirborne(ground-truth z, min_z_m) are excluded [m]
   double glitch_margin_s = 0.05;    ///< measurements within this time of a rejected (glitch) pose sample [s]
   double max_abs_error_m = 1.0;     ///< gross outliers: |ε| above this [m]; ≤ 0 disables the rule
   bool neighbour_pairs_only = false;  ///< keep only cyclic neighbour pairs (0,1)…(7,0) (UTIL TDoA2)
@@ -66,7 +66,7 @@ struct BiasFlightReport {
   std::size_t n_no_ground_truth = 0;   ///< outside the pose track or in a pose gap
   std::size_t n_no_estimate = 0;       ///< outside the filter's trajectory (kFilterEstimate only)
   std::size_t n_pose_glitch = 0;       ///< within glitch_margin_s of a rejected pose sample
-  std::size_t n_on_ground = 0;         ///< ground-truth z < min_z_m
+  std::size_t n_on_ground = 0;         ///< not isAirborne(ground-truth z, min_z_m)
   std::size_t n_non_neighbour = 0;     ///< non-neighbour pair (only when neighbour_pairs_only)
   std::size_t n_outlier = 0;           ///< |ε| > max_abs_error_m
   std::size_t n_used = 0;

@@ -1,7 +1,7 @@
 /** @file TrajectoryMetrics.h
  *  @brief Position error of an estimated trajectory against ground truth: the estimate is interpolated at the
- *         ground-truth timestamps and the body origins are compared (issue 3, "Command line").
- *         RMSE per axis and 3D, 50/90/99 % percentiles, whole flight and airborne (ground-truth z > 0.3 m).
+ *         ground-truth timestamps and the body origins are compared.
+ *         RMSE per axis and 3D, 50/90/99 % percentiles, whole flight and airborne (io/Airborne.h).
  */
 #pragma once
 
@@ -9,14 +9,15 @@
 #include <vector>
 
 #include "uwb/core/Types.h"
+#include "uwb/io/Airborne.h"
 #include "uwb/io/Flight.h"
 #include "uwb/io/TrajectoryCsv.h"
 
 namespace uwb {
 
 struct TrajectoryMetricsParams {
-  double airborne_min_z_m = 0.3;  ///< airborne when the ground-truth body z is above this [m]
-  double max_interp_gap_s = 0.1;  ///< no comparison where estimate samples are farther apart than this [s]
+  double airborne_min_z_m = kAirborneMinZ_m;  ///< isAirborne threshold on the ground-truth body z [m]
+  double max_interp_gap_s = 0.1;              ///< no comparison where estimate samples are farther apart [s]
   void validate() const;
 };
 
@@ -49,7 +50,8 @@ struct TrajectoryMetrics {
 /// Statistics of a list of error samples (percentiles by linear interpolation of the sorted errors).
 PositionErrorStats positionErrorStats(const std::vector<PositionErrorSample>& samples, bool airborne_only);
 
-/// Interpolates `estimate` (sorted by time) linearly at each ground-truth time and compares body origins.
+/// Interpolates `estimate` (sorted by time) at each ground-truth time (io/PoseTrack.h interpolatePose, position
+/// only) and compares body origins.
 /// `truth` should be glitch-free (e.g. PoseTrack::samples()).
 TrajectoryMetrics computeTrajectoryMetrics(const Trajectory& estimate, const std::vector<PoseSample>& truth,
                                            const TrajectoryMetricsParams& params = {});

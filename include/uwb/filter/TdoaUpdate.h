@@ -1,6 +1,6 @@
 /** @file TdoaUpdate.h
  *  @brief One TDoA correction of the filter through the graph's TDoA node (paper III-A, Fig. 2–3):
- *         bias correction (issue 5, paper III-B), χ² gate, robust IRLS weight, equality node, reset.
+ *         bias correction (paper III-B), χ² gate, robust IRLS weight, equality node, reset.
  *         docs/math/filter.md F10–F13; docs/math/message-passing.md G11–G18.
  */
 #pragma once

@@ -123,6 +123,10 @@ class Kernel {
     int offset = 0;  ///< index of σ² in theta_; then l (n_l), then T (n_T) or t1, t2
     int n_l = 0;
     int n_T = 0;
+    /// theta_ index of the lengthscale of active dimension d (one shared, or one per dimension).
+    Eigen::Index lengthscaleIndex(Eigen::Index d) const { return offset + 1 + (n_l == 1 ? 0 : d); }
+    /// theta_ index of the period of active dimension d (periodic parts).
+    Eigen::Index periodIndex(Eigen::Index d) const { return offset + 1 + n_l + (n_T == 1 ? 0 : d); }
   };
   void build(const std::vector<PartSpec>& parts, const std::vector<std::vector<int>>& terms);
   MatX partCross(int p, const MatX& X1, const MatX& X2) const;

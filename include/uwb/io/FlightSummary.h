@@ -11,6 +11,7 @@
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/Flight.h"
 #include "uwb/io/PoseTrack.h"
+#include "uwb/io/ResidualStats.h"
 #include "uwb/io/UtilCsv.h"
 
 namespace uwb {
@@ -26,29 +27,7 @@ struct StreamSummary {
   double rate_hz = 0.0;  ///< (count − 1) / (t_last − t_first); 0 with fewer than 2 samples
 };
 
-/// Residuals farther than this from their median are gross errors for ResidualStats::mad_m [m].
-inline constexpr double kGrossResidual_m = 1.0;
-
-/// Statistics of a set of residuals r_k [m]. The median and `mad_m` reproduce util-pilot/MANIFEST.csv
-/// (resid_median_m, resid_mad_m; checked on all 17 flights to ≤ 0.001 m, docs/io.md "Residual statistics").
-struct ResidualStats {
-  std::size_t n = 0;
-  double median_m = 0.0;  ///< median of all r_k
-  /// Mean absolute deviation from the median over the residuals within kGrossResidual_m of it:
-  /// mean_{k: |r_k − median| < 1 m} |r_k − median|. The MANIFEST's "mad" (gross errors, e.g. the ground phase
-  /// or TDoA3 outliers, would otherwise dominate it).
-  double mad_m = 0.0;
-  std::size_t n_gross = 0;           ///< residuals excluded from mad_m (|r − median| ≥ kGrossResidual_m)
-  double mean_abs_dev_m = 0.0;       ///< mean_k |r_k − median| over all residuals
-  double median_abs_dev_m = 0.0;     ///< median_k |r_k − median| (the robust-statistics MAD, unscaled)
-  double mean_m = 0.0;
-  double rms_m = 0.0;
-};
-
-/// Statistics of `values` (empty → all zero, n = 0).
-ResidualStats residualStats(std::vector<double> values, double gross_residual_m = kGrossResidual_m);
-
-/// Residual statistics split by flight phase (airborne: ground-truth z > airborne_min_z_m).
+/// Residual statistics split by flight phase (airborne: isAirborne(ground-truth z, airborne_min_z_m)).
 struct PhaseResiduals {
   ResidualStats all;
   ResidualStats airborne;
@@ -81,7 +60,7 @@ struct FlightSummary {
   std::size_t n_pose_glitches_attitude = 0;
   std::size_t n_pose_glitches_position = 0;
   std::vector<PoseGlitch> pose_glitches;
-  double airborne_fraction_pose = 0.0;  ///< share of accepted pose samples with z > airborne_min_z_m
+  double airborne_fraction_pose = 0.0;  ///< share of accepted pose samples that are isAirborne
 
   // Residuals (only with ground truth and a survey).
   bool has_residuals = false;

@@ -1,8 +1,12 @@
 /** @file PoseTrack.h
  *  @brief Ground-truth pose track of a flight (Vicon pose logged on board) and TDoA residuals against it.
  *
- *  - PoseTrack: the flight's pose samples minus detected glitches; interpolation at any time t (linear in position,
- *    slerp in attitude), nullopt outside the track or across a gap longer than PoseTrackParams::max_gap_s.
+ *  - interpolatePose / bracketPose: the one pose interpolation of the project (linear in position, slerp in
+ *    attitude) between the two samples around a time, for any sorted sequence of samples with t_s, w_p_b and w_q_b
+ *    (ground-truth PoseSample, the filter's TrajectorySample). Used by PoseTrack, the GP training data
+ *    (eval/BiasDataset), the trajectory metrics (eval/TrajectoryMetrics) and the simulator's residual statistics.
+ *  - PoseTrack: the flight's pose samples minus detected glitches; interpolation at any time t, nullopt outside the
+ *    track or across a gap longer than PoseTrackParams::max_gap_s.
  *  - Glitches (util-pilot SOURCE.md, "Caveats"): Vicon occasionally reports a flipped attitude (roll ≈ ±170°) for
  *    one or a few samples, and single-sample position spikes up to 0.23 m. They are detected, counted, reported
  *    and excluded from interpolation (docs/io.md, "Ground truth").
@@ -14,16 +18,69 @@
  */
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "uwb/core/Types.h"
+#include "uwb/io/Airborne.h"
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/Flight.h"
 
 namespace uwb {
+
+/// Position a + u (b − a) at the fraction u ∈ [0, 1] between two positions.
+inline Vec3 interpolatePosition(const Vec3& w_p_a, const Vec3& w_p_b, double u) { return w_p_a + u * (w_p_b - w_p_a); }
+
+/// Attitude slerp(q_a, q_b, u), renormalised, at the fraction u ∈ [0, 1] between two attitudes.
+inline Quat interpolateAttitude(const Quat& w_q_a, const Quat& w_q_b, double u) {
+  return w_q_a.slerp(u, w_q_b).normalized();
+}
+
+/// The two samples around a time and the fraction between them (u = 0 at `a`, 1 at `b`).
+template <class Sample>
+struct PoseBracket {
+  const Sample* a = nullptr;
+  const Sample* b = nullptr;
+  double u = 0.0;
+};
+
+/// Brackets t_s in `samples` (sorted by t_s): a is the last sample with a.t_s ≤ t_s, b the next one (b = a at the
+/// last sample). nullopt when `samples` is empty, t_s lies outside [front().t_s, back().t_s], or a and b are more
+/// than max_gap_s apart.
+template <class Sample>
+std::optional<PoseBracket<Sample>> bracketPose(const std::vector<Sample>& samples, double t_s, double max_gap_s) {
+  if (samples.empty() || !(t_s >= samples.front().t_s) || !(t_s <= samples.back().t_s)) return std::nullopt;
+  const auto it =
+      std::upper_bound(samples.begin(), samples.end(), t_s, [](double t, const Sample& s) { return t < s.t_s; });
+  if (it == samples.end()) return PoseBracket<Sample>{&samples.back(), &samples.back(), 0.0};  // t_s == last time
+  const Sample& b = *it;
+  const Sample& a = *(it - 1);  // it != begin since t_s >= front().t_s
+  const double dt = b.t_s - a.t_s;
+  if (dt > max_gap_s) return std::nullopt;
+  return PoseBracket<Sample>{&a, &b, dt > 0.0 ? (t_s - a.t_s) / dt : 0.0};
+}
+
+/// Pose at t_s between the samples of `samples` (sorted by t_s): interpolatePosition and, when has_orientation,
+/// interpolateAttitude (identity otherwise). nullopt as for bracketPose.
+template <class Sample>
+std::optional<PoseSample> interpolatePose(const std::vector<Sample>& samples, double t_s, double max_gap_s,
+                                          bool has_orientation = true) {
+  const auto br = bracketPose(samples, t_s, max_gap_s);
+  if (!br) return std::nullopt;
+  PoseSample out;
+  out.t_s = t_s;
+  if (br->a == br->b) {
+    out.w_p_b = br->a->w_p_b;
+    out.w_q_b = has_orientation ? br->a->w_q_b : Quat::Identity();
+    return out;
+  }
+  out.w_p_b = interpolatePosition(br->a->w_p_b, br->b->w_p_b, br->u);
+  out.w_q_b = has_orientation ? interpolateAttitude(br->a->w_q_b, br->b->w_q_b, br->u) : Quat::Identity();
+  return out;
+}
 
 /// Glitch detection and interpolation settings. Defaults fit the UTIL pilot logs (200–300 Hz Vicon).
 struct PoseTrackParams {
@@ -92,7 +149,7 @@ class PoseTrack {
 /// Settings of the residual computation.
 struct TdoaResidualParams {
   Vec3 b_t_tag = kUtilTagOffset_b;  ///< tag (antenna) offset in the body frame [m]
-  double airborne_min_z_m = 0.3;    ///< airborne when the ground-truth body z is above this [m]
+  double airborne_min_z_m = kAirborneMinZ_m;  ///< isAirborne threshold on the ground-truth body z [m]
 };
 
 /// One TDoA measurement compared with the ground truth.
@@ -106,7 +163,7 @@ struct TdoaResidual {
   double residual_m = 0.0;   ///< measured_m − predicted_m (the measurement bias + noise the GP learns)
   Vec3 w_p_b = Vec3::Zero();      ///< interpolated ground-truth body position [m]
   Quat w_q_b = Quat::Identity();  ///< interpolated ground-truth attitude (identity for position-only tracks)
-  bool airborne = false;          ///< w_p_b.z() > airborne_min_z_m
+  bool airborne = false;          ///< isAirborne(w_p_b.z(), airborne_min_z_m)
 };
 
 /// What tdoaResiduals could not compare (nothing is dropped silently).

@@ -11,7 +11,7 @@
 
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/Flight.h"
-#include "uwb/sim/BiasModel.h"
+#include "uwb/sim/SimulatedBias.h"
 #include "uwb/sim/Scenario.h"
 #include "uwb/sim/SimParams.h"
 
@@ -22,7 +22,7 @@ struct TdoaTruth {
   double tdoa_true_m = 0.0;  ///< |p_tag − a_B| − |p_tag − a_A| at the exact pose (S20)
   TdoaErrorParts error;      ///< measured = tdoa_true_m + error.total()
   bool on_ground = false;    ///< in a ground phase of the trajectory
-  bool airborne = false;     ///< body z ≥ 0.3 m in the world frame (the evaluation convention of SOURCE.md)
+  bool airborne = false;     ///< isAirborne(body z in the world frame), io/Airborne.h
 };
 
 /// IMU truth of one sample (same index as Flight::acc and Flight::gyro).

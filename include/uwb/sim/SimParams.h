@@ -8,7 +8,7 @@
 #pragma once
 
 #include "uwb/core/Types.h"
-#include "uwb/sim/BiasModel.h"
+#include "uwb/sim/SimulatedBias.h"
 
 namespace uwb::sim {
 

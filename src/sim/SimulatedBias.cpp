@@ -1,7 +1,7 @@
-/** @file BiasModel.cpp
+/** @file SimulatedBias.cpp
  *  @brief Range bias field of each anchor and the TDoA error: docs/math/simulation.md (S12)–(S18).
  */
-#include "uwb/sim/BiasModel.h"
+#include "uwb/sim/SimulatedBias.h"
 
 #include <algorithm>
 #include <cmath>
@@ -122,11 +122,11 @@ std::array<double, 16> realSphericalHarmonics(const Vec3& u) {
           0.5900435899266435 * x * (x * x - 3.0 * y * y)};
 }
 
-BiasModel::BiasModel(const BiasParams& params, const AnchorSurvey& survey, std::mt19937_64& field_rng,
+SimulatedBias::SimulatedBias(const BiasParams& params, const AnchorSurvey& survey, std::mt19937_64& field_rng,
                      std::mt19937_64& flight_rng)
     : params_(params) {
   params_.validate();
-  if (survey.anchors.empty()) throw std::invalid_argument("BiasModel: the survey has no anchors");
+  if (survey.anchors.empty()) throw std::invalid_argument("SimulatedBias: the survey has no anchors");
   std::normal_distribution<double> normal(0.0, 1.0);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   tag_coeffs_ = drawPattern(params_.antenna_degree, params_.antenna_rms_m, field_rng);
@@ -155,14 +155,14 @@ BiasModel::BiasModel(const BiasParams& params, const AnchorSurvey& survey, std::
   }
 }
 
-const BiasModel::AnchorTerms& BiasModel::terms(int id) const {
+const SimulatedBias::AnchorTerms& SimulatedBias::terms(int id) const {
   for (const AnchorTerms& t : anchors_) {
     if (t.id == id) return t;
   }
-  throw std::invalid_argument("BiasModel: anchor id " + std::to_string(id) + " is not in the survey");
+  throw std::invalid_argument("SimulatedBias: anchor id " + std::to_string(id) + " is not in the survey");
 }
 
-double BiasModel::patternBias(int anchor_id, const Vec3& b_u) const {
+double SimulatedBias::patternBias(int anchor_id, const Vec3& b_u) const {
   const AnchorTerms& t = terms(anchor_id);
   const std::array<double, 16> Y = realSphericalHarmonics(b_u);
   // (S12) c_i + h_tag(u) + h_i(u) + n(u)
@@ -177,7 +177,7 @@ double BiasModel::patternBias(int anchor_id, const Vec3& b_u) const {
   return bias;
 }
 
-double BiasModel::multipathBias(int anchor_id, const Vec3& w_p_tag) const {
+double SimulatedBias::multipathBias(int anchor_id, const Vec3& w_p_tag) const {
   const AnchorTerms& t = terms(anchor_id);
   if (params_.multipath_std_m == 0.0) return 0.0;
   // (S15) m_i(p) = σ √(2/K) Σ cos(ω_k·p + φ_k)
@@ -186,7 +186,7 @@ double BiasModel::multipathBias(int anchor_id, const Vec3& w_p_tag) const {
   return params_.multipath_std_m * std::sqrt(2.0 / static_cast<double>(t.mp_freq.size())) * sum;
 }
 
-double BiasModel::burstBias(int anchor_id, double t_s) const {
+double SimulatedBias::burstBias(int anchor_id, double t_s) const {
   const AnchorTerms& t = terms(anchor_id);
   if (params_.burst_probability == 0.0 || params_.burst_scale_m == 0.0) return 0.0;
   // (S16b) time bin k = ⌊t / L + φ_i⌋; a burst with probability p_b; excess s_b |t₂| with the closed-form
@@ -199,14 +199,14 @@ double BiasModel::burstBias(int anchor_id, double t_s) const {
   return std::min(params_.burst_scale_m * std::abs(t2), params_.outlier_max_m);
 }
 
-double BiasModel::groundBias(int anchor_id) const { return terms(anchor_id).ground_m; }
+double SimulatedBias::groundBias(int anchor_id) const { return terms(anchor_id).ground_m; }
 
-double BiasModel::groundWeight(double height_m) const {
+double SimulatedBias::groundWeight(double height_m) const {
   // (S18) w(h) = 1 − smoothstep(h / h_blend)
   return 1.0 - smoothstep3(height_m / params_.ground_blend_height_m);
 }
 
-TdoaErrorParts BiasModel::sample(double t_s, int id_a, int id_b, const Vec3& w_p_tag, const Quat& w_q_b, double height_m,
+TdoaErrorParts SimulatedBias::sample(double t_s, int id_a, int id_b, const Vec3& w_p_tag, const Quat& w_q_b, double height_m,
                                  std::mt19937_64& rng) const {
   TdoaErrorParts e;
   if (!params_.enabled) return e;

@@ -1,4 +1,4 @@
-/** @file BiasModel.h
+/** @file SimulatedBias.h
  *  @brief Simulated UWB range bias of each anchor and the TDoA error built from it.
  *
  *  Range bias of anchor i seen from the tag (u = unit direction tag→anchor in the body frame):
@@ -81,15 +81,15 @@ struct TdoaErrorParts {
 };
 
 /// Random draw of the bias field (coefficients, offsets, ground offsets); immutable afterwards.
-class BiasModel {
+class SimulatedBias {
  public:
   /// Draws all coefficients from `rng` (seeded by the caller). Anchors are addressed by survey id.
-  BiasModel(const BiasParams& params, const AnchorSurvey& survey, std::mt19937_64& rng)
-      : BiasModel(params, survey, rng, rng) {}
+  SimulatedBias(const BiasParams& params, const AnchorSurvey& survey, std::mt19937_64& rng)
+      : SimulatedBias(params, survey, rng, rng) {}
   /// The hardware and room terms (patterns, offsets, multipath: S12–S15) from `field_rng`, the flight's own terms
   /// (ground offsets S18, burst schedule S16b) from `flight_rng`. With one generator for both, the draws are those
   /// of the constructor above.
-  BiasModel(const BiasParams& params, const AnchorSurvey& survey, std::mt19937_64& field_rng,
+  SimulatedBias(const BiasParams& params, const AnchorSurvey& survey, std::mt19937_64& field_rng,
             std::mt19937_64& flight_rng);
 
   /// Deterministic range bias part (c_i + h_tag + h_i + n) for anchor id seen along body-frame unit vector

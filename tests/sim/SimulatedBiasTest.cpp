@@ -1,4 +1,4 @@
-/** @file BiasModelTest.cpp
+/** @file SimulatedBiasTest.cpp
  *  @brief The range-bias field: orthonormal harmonics, dependence on body-frame direction only, NLOS sign.
  */
 #include <gtest/gtest.h>
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "uwb/sim/BiasModel.h"
+#include "uwb/sim/SimulatedBias.h"
 #include "uwb/sim/Scenario.h"
 
 namespace uwb::sim {
@@ -32,14 +32,14 @@ TEST(SphericalHarmonics, AreOrthonormalOnTheSphere) {
   EXPECT_LT((G - Eigen::Matrix<double, 16, 16>::Identity()).cwiseAbs().maxCoeff(), 0.03);
 }
 
-TEST(BiasModel, PatternRmsMatchesTheParameter) {
+TEST(SimulatedBias, PatternRmsMatchesTheParameter) {
   // GIVEN a model with only the tag antenna pattern
   BiasParams p;
   p.anchor_pattern_rms_m = 0.0;
   p.anchor_offset_std_m = 0.0;
   p.nlos_bias_m = 0.0;
   std::mt19937_64 rng(3);
-  const BiasModel model(p, paperAnchors(), rng);
+  const SimulatedBias model(p, paperAnchors(), rng);
   // WHEN we average its square over the sphere
   double sq = 0.0;
   const int n = 100000;
@@ -51,7 +51,7 @@ TEST(BiasModel, PatternRmsMatchesTheParameter) {
   EXPECT_NEAR(std::sqrt(sq / n), p.antenna_rms_m, 0.03 * p.antenna_rms_m);
 }
 
-TEST(BiasModel, PatternDependsOnlyOnTheBodyFrameDirection) {
+TEST(SimulatedBias, PatternDependsOnlyOnTheBodyFrameDirection) {
   // GIVEN a model and two poses from which anchor 3 is seen along the same body-frame direction
   BiasParams p;
   p.multipath_std_m = 0.0;
@@ -61,7 +61,7 @@ TEST(BiasModel, PatternDependsOnlyOnTheBodyFrameDirection) {
   p.ground_effect = false;
   std::mt19937_64 rng(5);
   const AnchorSurvey survey = paperAnchors();
-  const BiasModel model(p, survey, rng);
+  const SimulatedBias model(p, survey, rng);
   const Vec3 a3 = survey.position(3);
   const Vec3 a4 = survey.position(4);
   const Quat q1(Eigen::AngleAxisd(0.4, Vec3::UnitZ()));
@@ -85,14 +85,14 @@ TEST(BiasModel, PatternDependsOnlyOnTheBodyFrameDirection) {
   EXPECT_NEAR(e.total(), model.patternBias(4, v1) - model.patternBias(3, u1), 1e-6);  // tag lever arm excluded
 }
 
-TEST(BiasModel, BodyOcclusionAddsPositiveBiasBelowTheRotorPlane) {
+TEST(SimulatedBias, BodyOcclusionAddsPositiveBiasBelowTheRotorPlane) {
   // GIVEN a model whose only term is the NLOS shadow
   BiasParams p;
   p.antenna_rms_m = 0.0;
   p.anchor_pattern_rms_m = 0.0;
   p.anchor_offset_std_m = 0.0;
   std::mt19937_64 rng(7);
-  const BiasModel model(p, paperAnchors(), rng);
+  const SimulatedBias model(p, paperAnchors(), rng);
   // THEN directions above the plane get no bias, far below get the full positive bias (more toward the battery)
   EXPECT_EQ(model.patternBias(0, Vec3(1, 0, 0.5).normalized()), 0.0);
   const double below_front = model.patternBias(0, Vec3(1, 0, -1).normalized());
@@ -101,10 +101,10 @@ TEST(BiasModel, BodyOcclusionAddsPositiveBiasBelowTheRotorPlane) {
   EXPECT_NEAR(below_back, p.nlos_bias_m * (1.0 + p.nlos_azimuth_gain), 1e-12);
 }
 
-TEST(BiasModel, MultipathFieldHasTheConfiguredSpreadAndLength) {
+TEST(SimulatedBias, MultipathFieldHasTheConfiguredSpreadAndLength) {
   BiasParams p;
   std::mt19937_64 rng(9);
-  const BiasModel model(p, paperAnchors(), rng);
+  const SimulatedBias model(p, paperAnchors(), rng);
   std::mt19937_64 pts(2);
   std::uniform_real_distribution<double> u(-2.0, 2.0);
   double sq = 0.0, near_corr = 0.0;
@@ -120,12 +120,12 @@ TEST(BiasModel, MultipathFieldHasTheConfiguredSpreadAndLength) {
   EXPECT_GT(near_corr / sq, 0.9);
 }
 
-TEST(BiasModel, SharedFieldGeneratorGivesTheSameHardwareAndRoomButOwnGroundOffsets) {
+TEST(SimulatedBias, SharedFieldGeneratorGivesTheSameHardwareAndRoomButOwnGroundOffsets) {
   // GIVEN two models whose hardware/room terms come from equally seeded generators, flight terms from different ones
   const BiasParams p;
   std::mt19937_64 field_a(5), field_b(5), flight_a(1), flight_b(2);
-  const BiasModel a(p, paperAnchors(), field_a, flight_a);
-  const BiasModel b(p, paperAnchors(), field_b, flight_b);
+  const SimulatedBias a(p, paperAnchors(), field_a, flight_a);
+  const SimulatedBias b(p, paperAnchors(), field_b, flight_b);
   // THEN patterns, offsets and multipath agree everywhere, ground offsets (a per-flight draw) do not
   std::mt19937_64 dirs(3);
   for (int k = 0; k < 50; ++k) {
@@ -141,14 +141,14 @@ TEST(BiasModel, SharedFieldGeneratorGivesTheSameHardwareAndRoomButOwnGroundOffse
   EXPECT_EQ(same_ground, 0);
   // AND one generator for both reproduces the one-generator constructor exactly
   std::mt19937_64 one(7), two(7);
-  const BiasModel c(p, paperAnchors(), one);
-  const BiasModel d(p, paperAnchors(), two, two);
+  const SimulatedBias c(p, paperAnchors(), one);
+  const SimulatedBias d(p, paperAnchors(), two, two);
   const Vec3 u = randomUnit(dirs);
   EXPECT_EQ(c.patternBias(1, u), d.patternBias(1, u));
   EXPECT_EQ(c.groundBias(2), d.groundBias(2));
 }
 
-TEST(BiasModel, RejectsInvalidParameters) {
+TEST(SimulatedBias, RejectsInvalidParameters) {
   BiasParams p;
   p.antenna_degree = 5;
   EXPECT_THROW(p.validate(), std::invalid_argument);

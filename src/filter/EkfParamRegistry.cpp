@@ -1,0 +1,361 @@
+/** @file EkfParamRegistry.cpp
+ *  @brief The EkfParams fields, each once (name, unit, range, doc, accessors), and what is built on them.
+ */
+#include "uwb/filter/EkfParamRegistry.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace uwb {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+const EkfParamRange kPositive{0.0, kInf, true, true};
+const EkfParamRange kNonNegative{0.0, kInf, false, true};
+const EkfParamRange kFinite{-kInf, kInf, true, true};
+
+EkfParamInfo real(std::string name, double EkfParams::*field, std::string unit, EkfParamRange range, std::string doc,
+                  std::string alias = "") {
+  EkfParamInfo i;
+  i.name = std::move(name), i.cli_alias = std::move(alias), i.unit = std::move(unit), i.doc = std::move(doc);
+  i.kind = EkfParamKind::kReal;
+  i.range = range;
+  i.get = [field](const EkfParams& p) { return EkfParamValue(p.*field); };
+  i.set = [field](EkfParams& p, const EkfParamValue& v) { p.*field = std::get<double>(v); };
+  return i;
+}
+
+EkfParamInfo integer(std::string name, int EkfParams::*field, EkfParamRange range, std::string doc) {
+  EkfParamInfo i;
+  i.name = std::move(name), i.doc = std::move(doc);
+  i.kind = EkfParamKind::kInteger;
+  i.range = range;
+  i.get = [field](const EkfParams& p) { return EkfParamValue(static_cast<double>(p.*field)); };
+  i.set = [field](EkfParams& p, const EkfParamValue& v) { p.*field = static_cast<int>(std::get<double>(v)); };
+  return i;
+}
+
+EkfParamInfo boolean(std::string name, bool EkfParams::*field, std::string doc) {
+  EkfParamInfo i;
+  i.name = std::move(name), i.doc = std::move(doc);
+  i.kind = EkfParamKind::kBool;
+  i.get = [field](const EkfParams& p) { return EkfParamValue(p.*field); };
+  i.set = [field](EkfParams& p, const EkfParamValue& v) { p.*field = std::get<bool>(v); };
+  return i;
+}
+
+EkfParamInfo vec3(std::string name, Vec3 EkfParams::*field, std::string unit, std::string doc, std::string alias = "",
+                  bool EkfParams::*flag_when_set = nullptr) {
+  EkfParamInfo i;
+  i.name = std::move(name), i.cli_alias = std::move(alias), i.unit = std::move(unit), i.doc = std::move(doc);
+  i.kind = EkfParamKind::kVec3;
+  i.range = kFinite;
+  i.get = [field](const EkfParams& p) { return EkfParamValue(p.*field); };
+  i.set = [field, flag_when_set](EkfParams& p, const EkfParamValue& v) {
+    p.*field = std::get<Vec3>(v);
+    if (flag_when_set != nullptr) p.*flag_when_set = true;
+  };
+  return i;
+}
+
+template <class E>
+EkfParamInfo choice(std::string name, E EkfParams::*field, std::vector<std::string> choices,
+                    E (*parse)(const std::string&), std::string (*text)(E), std::string doc, std::string alias = "") {
+  EkfParamInfo i;
+  i.name = std::move(name), i.cli_alias = std::move(alias), i.doc = std::move(doc);
+  i.kind = EkfParamKind::kChoice;
+  i.choices = std::move(choices);
+  i.get = [field, text](const EkfParams& p) { return EkfParamValue(text(p.*field)); };
+  i.set = [field, parse](EkfParams& p, const EkfParamValue& v) { p.*field = parse(std::get<std::string>(v)); };
+  return i;
+}
+
+std::vector<EkfParamInfo> makeRegistry() {
+  using P = EkfParams;
+  const char* sd = "m/s^2/sqrt(Hz)";
+  return {
+      // --- process noise (continuous-time spectral densities, docs/math/filter.md F5) ---
+      real("acc_noise_mps2_sqrthz", &P::acc_noise_mps2_sqrthz, sd, kNonNegative,
+           "Accelerometer white noise (thrust axis; all axes with the full model)", "acc-noise"),
+      real("lateral_acc_noise_mps2_sqrthz", &P::lateral_acc_noise_mps2_sqrthz, sd, kNonNegative,
+           "Extra white acceleration on the horizontal velocity (drag; thrust model)", "lateral-acc-noise"),
+      real("gyro_noise_radps_sqrthz", &P::gyro_noise_radps_sqrthz, "rad/s/sqrt(Hz)", kNonNegative,
+           "Gyroscope white noise on the attitude error", "gyro-noise"),
+      real("acc_bias_rw_mps3_sqrthz", &P::acc_bias_rw_mps3_sqrthz, "m/s^3/sqrt(Hz)", kNonNegative,
+           "Accelerometer-bias random walk", "acc-bias-rw"),
+      real("gyro_bias_rw_radps2_sqrthz", &P::gyro_bias_rw_radps2_sqrthz, "rad/s^2/sqrt(Hz)", kNonNegative,
+           "Gyroscope-bias random walk", "gyro-bias-rw"),
+      real("pos_noise_m_sqrts", &P::pos_noise_m_sqrts, "m/sqrt(s)", kNonNegative,
+           "Direct position random walk (Crazyflie procNoisePos)"),
+      real("cv_acc_noise_mps2_sqrthz", &P::cv_acc_noise_mps2_sqrthz, sd, kPositive,
+           "TDoA-only constant-velocity model: white acceleration"),
+      real("ca_jerk_noise_mps3_sqrthz", &P::ca_jerk_noise_mps3_sqrthz, "m/s^3/sqrt(Hz)", kPositive,
+           "TDoA-only constant-acceleration model: white jerk"),
+      choice("accel_model", &P::accel_model, {"thrust", "full"}, parseAccelModel, toString,
+             "Accelerometer model in flight: thrust axis only (Mueller et al.) or all three axes"),
+      choice("ground_accel_model", &P::ground_accel_model, {"thrust", "full"}, parseAccelModel, toString,
+             "Accelerometer model before take-off"),
+      choice("process_model", &P::process_model, {"imu", "cv", "ca"}, parseProcessModel, toString,
+             "IMU-driven model, or TDoA only with constant velocity / constant acceleration"),
+      // --- initial uncertainty ---
+      real("init_pos_sigma_m", &P::init_pos_sigma_m, "m", kPositive, "Initial position std"),
+      real("init_vel_sigma_mps", &P::init_vel_sigma_mps, "m/s", kPositive, "Initial velocity std"),
+      real("init_att_sigma_rad", &P::init_att_sigma_rad, "rad", kPositive, "Initial roll/pitch std"),
+      real("init_yaw_sigma_rad", &P::init_yaw_sigma_rad, "rad", kPositive, "Initial yaw std"),
+      real("init_acc_bias_sigma_mps2", &P::init_acc_bias_sigma_mps2, "m/s^2", kPositive,
+           "Initial accelerometer-bias std"),
+      real("init_gyro_bias_sigma_radps", &P::init_gyro_bias_sigma_radps, "rad/s", kPositive,
+           "Initial gyroscope-bias std"),
+      // --- TDoA measurement ---
+      vec3("b_t_tag", &P::b_t_tag, "m", "Tag (antenna) position in the body frame x,y,z", "tag-offset"),
+      real("tdoa_sigma_m", &P::tdoa_sigma_m, "m", kPositive,
+           "TDoA noise std used by the filter (inflated for correlation, F12)", "tdoa-sigma"),
+      real("anchor_sigma_m", &P::anchor_sigma_m, "m", kNonNegative, "Std of each surveyed anchor coordinate"),
+      real("gate_sigma", &P::gate_sigma, "", kPositive, "Mahalanobis gate on the normalised innovation (sigmas)",
+           "gate"),
+      choice("robust_loss", &P::robust_loss, {"none", "huber", "cauchy"}, parseRobustLoss, toString,
+             "Robust loss of the TDoA update (IRLS)"),
+      real("robust_k", &P::robust_k, "", kPositive, "Robust-loss scale on the normalised innovation"),
+      integer("robust_iterations", &P::robust_iterations, EkfParamRange{1, 20}, "IRLS iterations per TDoA update"),
+      real("pair_bias_tau_s", &P::pair_bias_tau_s, "s", kNonNegative,
+           "Per-pair TDoA offset learned from innovations with this time constant; 0 off (F19)"),
+      real("max_lost_s", &P::max_lost_s, "s", kPositive,
+           "All TDoA rejected this long: re-acquire (inflate P, open the gate)"),
+      // --- scheduling ---
+      real("max_predict_dt_s", &P::max_predict_dt_s, "s", kPositive, "IMU samples are averaged over at most this"),
+      real("update_predict_dt_s", &P::update_predict_dt_s, "s", kNonNegative,
+           "A TDoA update first predicts to its stamp when the state lags more than this"),
+      real("cov_period_s", &P::cov_period_s, "s", kNonNegative,
+           "Covariance propagation period (0: before every update)", "cov-period"),
+      real("max_gap_s", &P::max_gap_s, "s", kPositive, "A sensor gap longer than this is reported"),
+      // --- ground phase and start ---
+      choice("ground_phase", &P::ground_phase, {"detect", "none"}, parseGroundPhase, toString,
+             "Use the IMU's evidence of the ground (rest, floor contact): zero-velocity updates, floor height, TDoA "
+             "down-weighted (F14, F18)"),
+      real("takeoff_climb_mps", &P::takeoff_climb_mps, "m/s", kPositive,
+           "Take-off: vertical velocity from the accelerometer above this (F15)"),
+      real("takeoff_acc_bias_sigma_mps2", &P::takeoff_acc_bias_sigma_mps2, "m/s^2", kNonNegative,
+           "Thrust-axis accelerometer-bias std added at take-off (F20)"),
+      real("acquisition_s", &P::acquisition_s, "s", kNonNegative,
+           "Robust, gate-free acquisition after a position fix (F16)"),
+      real("acquisition_tdoa_sigma_m", &P::acquisition_tdoa_sigma_m, "m", kPositive,
+           "TDoA std used during acquisition"),
+      boolean("has_start_position", &P::has_start_position,
+              "Start at start_w_p_b instead of multilateration (set by start_w_p_b)"),
+      vec3("start_w_p_b", &P::start_w_p_b, "m", "Start position of the body origin x,y,z (default: multilateration)",
+           "start", &P::has_start_position),
+      real("ground_z_m", &P::ground_z_m, "m", kFinite, "World z of the body origin resting on the floor (F22)"),
+      boolean("floor_constraint", &P::floor_constraint,
+              "The body is not below the floor; on the ground its height is ground_z_m (F22)"),
+      real("floor_margin_m", &P::floor_margin_m, "m", kNonNegative,
+           "Tolerance below ground_z_m before the floor constraint acts (F22)"),
+      real("rest_tdoa_sigma_m", &P::rest_tdoa_sigma_m, "m", kPositive,
+           "TDoA std on the ground and just above it (F14)"),
+      real("leave_rest_pos_sigma_m", &P::leave_rest_pos_sigma_m, "m", kNonNegative,
+           "Horizontal position std added when the body leaves the ground (F15)"),
+      real("start_window_s", &P::start_window_s, "s", kPositive,
+           "Multilateration window of the start and of a re-acquisition (F16)"),
+      real("moving_start_vel_sigma_mps", &P::moving_start_vel_sigma_mps, "m/s", kPositive,
+           "Velocity std when the IMU starts while moving (F15)"),
+      real("moving_start_att_sigma_rad", &P::moving_start_att_sigma_rad, "rad", kPositive,
+           "Roll/pitch std when the IMU starts while moving (F15)"),
+      real("moving_start_yaw_sigma_rad", &P::moving_start_yaw_sigma_rad, "rad", kPositive,
+           "Yaw std when the IMU starts while moving (yaw 0 assumed, F15)"),
+      real("output_bias_sigma_m", &P::output_bias_sigma_m, "m", kNonNegative,
+           "Slow TDoA bias std mapped into the reported position covariance (F23)"),
+      // --- downward ToF range (Flow deck VL53L1x, F21) ---
+      boolean("fuse_tof", &P::fuse_tof, "Fuse the downward ToF range as a height update (F21)"),
+      real("tof_sigma_m", &P::tof_sigma_m, "m", kPositive, "ToF range noise std"),
+      real("tof_offset_m", &P::tof_offset_m, "m", kFinite, "ToF sensor below the body origin along body z"),
+      real("floor_z_m", &P::floor_z_m, "m", kFinite, "Height of the flat floor the ToF sees (world z)"),
+      real("tof_max_range_m", &P::tof_max_range_m, "m", kPositive,
+           "ToF readings above this, <= 0 or non-finite are ignored"),
+      real("tof_gate_sigma", &P::tof_gate_sigma, "", kFinite,
+           "Mahalanobis gate on the ToF innovation (sigmas); <= 0 disables"),
+  };
+}
+
+std::string number(double v) { return fmt::format("{}", v); }
+
+/// "where: " in front of a message, nothing when `where` is empty.
+std::string prefix(const std::string& where) { return where.empty() ? std::string() : where + ": "; }
+
+std::string valueText(const EkfParamInfo& info, const EkfParamValue& v) {
+  switch (info.kind) {
+    case EkfParamKind::kReal: return number(std::get<double>(v));
+    case EkfParamKind::kInteger: return number(std::get<double>(v));
+    case EkfParamKind::kBool: return std::get<bool>(v) ? "true" : "false";
+    case EkfParamKind::kVec3: {
+      const Vec3& x = std::get<Vec3>(v);
+      return number(x.x()) + "," + number(x.y()) + "," + number(x.z());
+    }
+    case EkfParamKind::kChoice: return std::get<std::string>(v);
+  }
+  return "?";
+}
+
+std::string kindName(const EkfParamInfo& info) {
+  switch (info.kind) {
+    case EkfParamKind::kReal: return "a number";
+    case EkfParamKind::kInteger: return "a whole number";
+    case EkfParamKind::kBool: return "true or false";
+    case EkfParamKind::kVec3: return "three numbers x,y,z";
+    case EkfParamKind::kChoice: {
+      std::string s = "one of ";
+      for (std::size_t k = 0; k < info.choices.size(); ++k) s += (k ? ", " : "") + info.choices[k];
+      return s;
+    }
+  }
+  return "?";
+}
+
+/// Throws unless `v` has the entry's kind and lies in its range / choices.
+void check(const EkfParamInfo& info, const EkfParamValue& v, const std::string& where) {
+  const auto fail = [&](const std::string& what) {
+    throw std::invalid_argument(fmt::format("{}{} must be {} (got {})", prefix(where), info.name, what,
+                                            std::holds_alternative<std::string>(v) ? std::get<std::string>(v)
+                                            : std::holds_alternative<double>(v)     ? number(std::get<double>(v))
+                                            : std::holds_alternative<bool>(v)       ? (std::get<bool>(v) ? "true" : "false")
+                                                                                    : "a vector"));
+  };
+  switch (info.kind) {
+    case EkfParamKind::kReal:
+    case EkfParamKind::kInteger: {
+      if (!std::holds_alternative<double>(v)) fail(kindName(info));
+      const double x = std::get<double>(v);
+      if (info.kind == EkfParamKind::kInteger && !(std::isfinite(x) && x == std::round(x))) fail(kindName(info));
+      if (!info.range.contains(x)) fail(info.range.toString());
+      return;
+    }
+    case EkfParamKind::kBool:
+      if (!std::holds_alternative<bool>(v)) fail(kindName(info));
+      return;
+    case EkfParamKind::kVec3:
+      if (!std::holds_alternative<Vec3>(v)) fail(kindName(info));
+      if (!std::get<Vec3>(v).allFinite()) fail("finite");
+      return;
+    case EkfParamKind::kChoice: {
+      if (!std::holds_alternative<std::string>(v)) fail(kindName(info));
+      for (const std::string& c : info.choices)
+        if (c == std::get<std::string>(v)) return;
+      fail(kindName(info));
+    }
+  }
+}
+
+double parseNumber(const std::string& text, const EkfParamInfo& info, const std::string& where) {
+  std::size_t used = 0;
+  double x = 0.0;
+  try {
+    x = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size())
+    throw std::invalid_argument(fmt::format("{}{} must be {} (got '{}')", prefix(where), info.name, kindName(info), text));
+  return x;
+}
+
+}  // namespace
+
+bool EkfParamRange::contains(double v) const {
+  if (!std::isfinite(v)) return false;
+  if (lo_open ? !(v > lo) : !(v >= lo)) return false;
+  if (hi_open ? !(v < hi) : !(v <= hi)) return false;
+  return true;
+}
+
+std::string EkfParamRange::toString() const {
+  const bool lo_inf = std::isinf(lo), hi_inf = std::isinf(hi);
+  if (lo_inf && hi_inf) return "finite";
+  if (hi_inf) return fmt::format("{} {}", lo_open ? ">" : "≥", number(lo));
+  if (lo_inf) return fmt::format("{} {}", hi_open ? "<" : "≤", number(hi));
+  return fmt::format("in {}{}, {}{}", lo_open ? "(" : "[", number(lo), number(hi), hi_open ? ")" : "]");
+}
+
+std::string EkfParamInfo::flag() const {
+  std::string f = "--" + name;
+  for (char& c : f)
+    if (c == '_') c = '-';
+  return f;
+}
+
+const std::vector<EkfParamInfo>& ekfParamRegistry() {
+  static const std::vector<EkfParamInfo> registry = makeRegistry();
+  return registry;
+}
+
+const EkfParamInfo& ekfParamInfo(const std::string& name) {
+  for (const EkfParamInfo& i : ekfParamRegistry())
+    if (i.name == name) return i;
+  std::string known;
+  for (const EkfParamInfo& i : ekfParamRegistry()) known += (known.empty() ? "" : ", ") + i.name;
+  throw std::invalid_argument("unknown filter parameter '" + name + "' (known: " + known + ")");
+}
+
+void setEkfParam(EkfParams& p, const EkfParamInfo& info, const EkfParamValue& value, const std::string& where) {
+  check(info, value, where);
+  info.set(p, value);
+}
+
+void setEkfParamFromText(EkfParams& p, const EkfParamInfo& info, const std::string& text, const std::string& where) {
+  switch (info.kind) {
+    case EkfParamKind::kReal:
+    case EkfParamKind::kInteger: setEkfParam(p, info, parseNumber(text, info, where), where); return;
+    case EkfParamKind::kBool:
+      if (text == "true" || text == "1") return setEkfParam(p, info, true, where);
+      if (text == "false" || text == "0") return setEkfParam(p, info, false, where);
+      throw std::invalid_argument(fmt::format("{}{} must be true or false (got '{}')", prefix(where), info.name, text));
+    case EkfParamKind::kVec3: {
+      std::vector<double> v;
+      std::stringstream ss(text);
+      std::string item;
+      while (std::getline(ss, item, ',')) v.push_back(parseNumber(item, info, where));
+      if (v.size() != 3)
+        throw std::invalid_argument(
+            fmt::format("{}{} must be three numbers x,y,z (got '{}')", prefix(where), info.name, text));
+      return setEkfParam(p, info, Vec3(v[0], v[1], v[2]), where);
+    }
+    case EkfParamKind::kChoice: setEkfParam(p, info, text, where); return;
+  }
+}
+
+std::string ekfParamText(const EkfParams& p, const EkfParamInfo& info) { return valueText(info, info.get(p)); }
+
+std::string ekfParamHelpSuffix(const EkfParamInfo& info) {
+  std::string s;
+  if (!info.unit.empty()) s += "[" + info.unit + "] ";
+  s += "(default " + ekfParamText(EkfParams{}, info);
+  if (info.kind == EkfParamKind::kReal || info.kind == EkfParamKind::kInteger) s += ", " + info.range.toString();
+  if (info.kind == EkfParamKind::kChoice) s += "; " + kindName(info);
+  return s + ")";
+}
+
+void validateEkfParamRanges(const EkfParams& p) {
+  for (const EkfParamInfo& info : ekfParamRegistry()) check(info, info.get(p), "EkfParams");
+}
+
+std::string ekfParamMarkdownTable() {
+  std::string out =
+      "| name (config key, Python key) | CLI flag | unit | default | valid | description |\n"
+      "|---|---|---|---|---|---|\n";
+  for (const EkfParamInfo& i : ekfParamRegistry()) {
+    std::string flags = "`" + i.flag() + "`";
+    if (!i.cli_alias.empty()) flags += ", `--" + i.cli_alias + "`";
+    std::string valid;
+    if (i.kind == EkfParamKind::kReal || i.kind == EkfParamKind::kInteger) valid = i.range.toString();
+    if (i.kind == EkfParamKind::kChoice) valid = kindName(i);
+    if (i.kind == EkfParamKind::kBool) valid = "true, false";
+    if (i.kind == EkfParamKind::kVec3) valid = "finite x,y,z";
+    out += fmt::format("| `{}` | {} | {} | `{}` | {} | {} |\n", i.name, flags, i.unit.empty() ? "–" : i.unit,
+                       ekfParamText(EkfParams{}, i), valid, i.doc);
+  }
+  return out;
+}
+
+}  // namespace uwb
