@@ -18,6 +18,8 @@
 #include "Command.h"
 #include "uwb/core/Error.h"
 #include "uwb/eval/EstimateChecks.h"
+#include "uwb/eval/FaultInjection.h"
+#include "uwb/filter/EkfParamRegistry.h"
 #include "uwb/eval/Localization.h"
 #include "uwb/eval/ProtocolScenarios.h"
 #include "uwb/io/FlightWindow.h"
@@ -33,7 +35,7 @@ struct ProtocolArgs {
   std::string data_dir;
   std::vector<double> cuts{5.0, 10.0, 20.0};
   std::vector<std::string> sets;
-  bool json_out = false, no_real = false, no_sim = false, no_cuts = false;
+  bool json_out = false, no_real = false, no_sim = false, no_cuts = false, faults = false;
   std::string only;
 };
 
@@ -59,42 +61,11 @@ std::vector<RealFlight> realFlights(const std::string& data_dir) {
   return out;
 }
 
-/// Applies --set name=value overrides (the numeric filter parameters the protocol is used to choose).
+/// Applies a --set name=value override through the parameter registry (every EkfParams field, its range checked).
 void applySet(const std::string& kv, uwb::EkfParams& p) {
   const auto eq = kv.find('=');
   if (eq == std::string::npos) throw std::invalid_argument("--set: expected name=value, got '" + kv + "'");
-  const std::string name = kv.substr(0, eq);
-  double v = 0.0;
-  try {
-    std::size_t used = 0;
-    v = std::stod(kv.substr(eq + 1), &used);
-    if (used != kv.size() - eq - 1) throw std::invalid_argument("trailing characters");
-  } catch (const std::exception&) {
-    throw std::invalid_argument("--set " + name + ": '" + kv.substr(eq + 1) + "' is not a number");
-  }
-  const std::map<std::string, double*> fields = {
-      {"tdoa_sigma_m", &p.tdoa_sigma_m},
-      {"rest_tdoa_sigma_m", &p.rest_tdoa_sigma_m},
-      {"leave_rest_pos_sigma_m", &p.leave_rest_pos_sigma_m},
-      {"output_bias_sigma_m", &p.output_bias_sigma_m},
-      {"acquisition_tdoa_sigma_m", &p.acquisition_tdoa_sigma_m},
-      {"acquisition_s", &p.acquisition_s},
-      {"start_window_s", &p.start_window_s},
-      {"gate_sigma", &p.gate_sigma},
-      {"robust_k", &p.robust_k},
-      {"pos_noise_m_sqrts", &p.pos_noise_m_sqrts},
-      {"acc_noise_mps2_sqrthz", &p.acc_noise_mps2_sqrthz},
-      {"lateral_acc_noise_mps2_sqrthz", &p.lateral_acc_noise_mps2_sqrthz},
-      {"moving_start_vel_sigma_mps", &p.moving_start_vel_sigma_mps},
-      {"moving_start_att_sigma_rad", &p.moving_start_att_sigma_rad},
-      {"moving_start_yaw_sigma_rad", &p.moving_start_yaw_sigma_rad},
-      {"takeoff_acc_bias_sigma_mps2", &p.takeoff_acc_bias_sigma_mps2},
-      {"init_yaw_sigma_rad", &p.init_yaw_sigma_rad},
-      {"max_lost_s", &p.max_lost_s},
-  };
-  const auto it = fields.find(name);
-  if (it == fields.end()) throw std::invalid_argument("--set: unknown parameter '" + name + "'");
-  *it->second = v;
+  uwb::setEkfParamFromText(p, uwb::ekfParamInfo(kv.substr(0, eq)), kv.substr(eq + 1), "--set");
 }
 
 double median(std::vector<double> v) {
@@ -235,9 +206,12 @@ void printTable(const std::string& title, const std::vector<Row>& rows, bool cut
 
 json summarize(const std::vector<Row>& rows, const std::string& label, bool print) {
   std::map<std::string, std::vector<const Row*>> by_session;
-  for (const Row& r : rows) by_session[r.session].push_back(&r);
-  by_session["all"];
-  for (const Row& r : rows) by_session["all"].push_back(&r);
+  for (const Row& r : rows) {
+    by_session[r.session].push_back(&r);
+    by_session["all"].push_back(&r);
+    // the development flights: the util-pilot TDoA2 sessions with IMU
+    if (r.session == "0425" || r.session == "0426") by_session["dev (0425+0426)"].push_back(&r);
+  }
   json out = json::object();
   if (print)
     std::cout << "\n" << label << " — per session: median / worst airborne RMSE [m], worst max step [m], median 1σ "
@@ -264,12 +238,89 @@ json summarize(const std::vector<Row>& rows, const std::string& label, bool prin
   return out;
 }
 
+/// Error after a fault: the largest airborne error in [t1 + 3, t1 + 6] s and the time from t1 until the error stays
+/// below 0.5 m for 1 s (NaN: never).
+void recovery(const uwb::TrajectoryMetrics& m, double t1, double* err_after, double* t_recover) {
+  *err_after = 0.0;
+  *t_recover = std::nan("");
+  double t_good_since = std::nan("");
+  for (const uwb::PositionErrorSample& e : m.samples) {
+    if (!e.airborne || e.t_s < t1) continue;
+    if (e.t_s >= t1 + 3.0 && e.t_s <= t1 + 6.0) *err_after = std::max(*err_after, e.error_norm_m);
+    if (e.error_norm_m < 0.5) {
+      if (std::isnan(t_good_since)) t_good_since = e.t_s;
+      if (std::isnan(*t_recover) && e.t_s - t_good_since >= 1.0) *t_recover = t_good_since - t1;
+    } else {
+      t_good_since = std::nan("");
+      *t_recover = std::nan("");
+    }
+  }
+}
+
+/// The fault-injection suite on real dev flights (issue "Nothing a flight or a file can do makes it lie").
+void runFaults(const ProtocolArgs& a, const uwb::LocalizationOptions& opt) {
+  const std::string data = a.data_dir.empty() ? uwb::app::defaultDataDir() : a.data_dir;
+  const std::vector<std::string> names = {"0425-traj2", "0425-traj6", "0426-traj1", "0426-traj11"};
+  json rows = json::array();
+  if (!a.json_out)
+    std::cout << "## Fault injection\n\n| flight | fault | RMSE air clean [m] | RMSE air faulted [m] | ratio | max err 3–6 s "
+                 "after [m] | back below 0.5 m after [s] | reacq | note |\n|---|---|---|---|---|---|---|---|---|\n";
+  for (const RealFlight& f : realFlights(data)) {
+    if (std::find(names.begin(), names.end(), f.name) == names.end()) continue;
+    if (!a.only.empty() && f.name.find(a.only) == std::string::npos) continue;
+    if (!fs::is_regular_file(f.path)) continue;
+    const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(f.survey);
+    const uwb::Flight flight = uwb::readFlightCsv(f.path);
+    const uwb::LocalizationRun clean = uwb::localizeFlight(flight, survey, opt);
+    if (!clean.metrics) continue;
+    double t_air0 = std::nan(""), t_air1 = 0.0;
+    for (const uwb::PositionErrorSample& e : clean.metrics->samples)
+      if (e.airborne) {
+        if (std::isnan(t_air0)) t_air0 = e.t_s;
+        t_air1 = e.t_s;
+      }
+    for (const uwb::FaultSpec& spec : uwb::standardFaults(t_air0 + 3.0, t_air1 - 3.0, survey.anchors.front().id)) {
+      uwb::Flight fl = flight;
+      uwb::AnchorSurvey sv = survey;
+      uwb::injectFault(spec, fl, sv);
+      // the localization uses the faulted survey; the truth is the flight's own (the survey fault is the estimator's)
+      const uwb::LocalizationRun run = uwb::localizeFlight(fl, sv, opt);
+      const double t_end = spec.kind == uwb::FaultKind::kClockJumpAll ? spec.t1_s + 5.0 : spec.t1_s;
+      double err_after = std::nan(""), t_rec = std::nan("");
+      if (run.metrics) recovery(*run.metrics, t_end, &err_after, &t_rec);
+      const double faulted = run.metrics ? run.metrics->airborne.rmse_m : std::nan("");
+      std::string note;
+      for (const std::string& n : run.summary.merge.notes()) note += (note.empty() ? "" : "; ") + n;
+      if (run.summary.n_time_jumps) note += (note.empty() ? "" : "; ") + std::to_string(run.summary.n_time_jumps) + " time jump(s)";
+      if (spec.kind == uwb::FaultKind::kAnchorSurveyOff) t_rec = std::nan("");
+      if (!a.json_out)
+        std::cout << "| " << f.name << " | " << uwb::toString(spec.kind) << " | " << fmt3(clean.metrics->airborne.rmse_m)
+                  << " | " << fmt3(faulted) << " | " << fmt2(faulted / clean.metrics->airborne.rmse_m) << " | "
+                  << fmt3(err_after) << " | " << fmt2(t_rec) << " | " << run.summary.n_reacquisitions << " | " << note
+                  << " |\n";
+      rows.push_back({{"flight", f.name},
+                      {"fault", uwb::toString(spec.kind)},
+                      {"rmse_airborne_clean_m", clean.metrics->airborne.rmse_m},
+                      {"rmse_airborne_faulted_m", std::isfinite(faulted) ? json(faulted) : json(nullptr)},
+                      {"max_error_3_to_6s_after_m", std::isfinite(err_after) ? json(err_after) : json(nullptr)},
+                      {"recover_below_0_5m_s", std::isfinite(t_rec) ? json(t_rec) : json(nullptr)},
+                      {"n_reacquisitions", run.summary.n_reacquisitions},
+                      {"notes", note}});
+    }
+  }
+  if (a.json_out) std::cout << json{{"faults", rows}}.dump() << '\n';
+}
+
 void runProtocol(const ProtocolArgs& a) {
   uwb::EkfParams params;
   for (const std::string& kv : a.sets) applySet(kv, params);
   params.validate();
   uwb::LocalizationOptions opt;
   opt.params = params;
+  if (a.faults) {
+    runFaults(a, opt);
+    return;
+  }
   json j;
   std::vector<Row> full_rows, cut_rows, sim_rows, sim_cut_rows;
 
@@ -391,6 +442,9 @@ const bool kRegistered = uwb::app::registerCommand(
        sub.add_flag("--no-real", a->no_real, "skip the real flights");
        sub.add_flag("--no-sim", a->no_sim, "skip the simulated scenarios");
        sub.add_flag("--no-cuts", a->no_cuts, "skip the mid-air cuts of the real flights");
+       sub.add_flag("--faults", a->faults,
+                    "run the fault-injection suite on four dev flights instead (outliers, garbage, dead anchor, "
+                    "anchor off, IMU dropout, clipping, clock jumps)");
        sub.add_flag("--json", a->json_out, "print one JSON object instead of tables");
        sub.callback([a] { runProtocol(*a); });
      }});

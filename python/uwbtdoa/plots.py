@@ -405,6 +405,57 @@ def per_flight_bars(flights: Sequence[str], rmse_uncorrected, rmse_corrected, co
 
 
 # ------------------------------------------------------------------------------------ report data files
+def position_vs_time(t, est_xyz, sigma_xyz, gt_t=None, gt_xyz=None, path: str | None = None,
+                     title: str | None = None):
+    """x, y, z of the estimate against time with its ±2σ band (the reported σ, docs/math/filter.md F23) and the
+    ground truth when given: the figure to look at first."""
+    t = np.asarray(t, float)
+    est = np.asarray(est_xyz, float).reshape(-1, 3)
+    sig = np.asarray(sigma_xyz, float).reshape(-1, 3)
+    fig, axes = plt.subplots(3, 1, figsize=(10, 7), sharex=True)
+    for k, (ax, name) in enumerate(zip(axes, "xyz")):
+        ax.fill_between(t, est[:, k] - 2 * sig[:, k], est[:, k] + 2 * sig[:, k], color="tab:blue", alpha=0.2,
+                        linewidth=0, label="±2σ")
+        ax.plot(t, est[:, k], color="tab:blue", linewidth=1.0, label="estimate")
+        if gt_t is not None and gt_xyz is not None and len(gt_t):
+            g = np.asarray(gt_xyz, float).reshape(-1, 3)
+            ax.plot(np.asarray(gt_t, float), g[:, k], color="black", linewidth=0.8, label="ground truth")
+        ax.set_ylabel(f"{name} [m]")
+        ax.grid(alpha=0.3)
+    axes[0].legend(loc="upper right", ncol=3, fontsize=8)
+    axes[-1].set_xlabel("t [s]")
+    if title:
+        axes[0].set_title(title)
+    return _finish(fig, path)
+
+
+def load_trajectory_csv(path: str) -> dict[str, np.ndarray]:
+    """A trajectory CSV written by `uwbtdoa localize --out` (t, x, y, z, …, std_x, std_y, std_z, …)."""
+    cols = _read_csv(path, ["t", "x", "y", "z", "std_x", "std_y", "std_z"])
+    return {k: _floats(path, cols, k) for k in ["t", "x", "y", "z", "std_x", "std_y", "std_z"]}
+
+
+def load_flight_truth(path: str) -> tuple[np.ndarray, np.ndarray]:
+    """Ground-truth position (t_pose, pose_x/y/z) of a UTIL flight CSV (column-stacked streams: empty cells are
+    skipped); empty arrays when the flight has no pose columns."""
+    with open(path, newline="") as f:
+        reader = csv.reader(f)
+        header = next(reader, [])
+        if not {"t_pose", "pose_x", "pose_y", "pose_z"} <= set(header):
+            return np.zeros(0), np.zeros((0, 3))
+        i = [header.index(c) for c in ("t_pose", "pose_x", "pose_y", "pose_z")]
+        rows = []
+        for line_no, row in enumerate(reader, start=2):
+            if len(row) <= max(i) or row[i[0]] == "":
+                continue
+            try:
+                rows.append([float(row[j]) for j in i])
+            except ValueError:
+                raise ReportDataError(f"{path}:{line_no}: pose columns are not numbers") from None
+    a = np.asarray(rows, float).reshape(-1, 4)
+    return a[:, 0], a[:, 1:]
+
+
 def _read_csv(path: str, required: Sequence[str]) -> dict[str, list[str]]:
     """Reads a CSV with a header into columns of strings; errors name file and line."""
     with open(path, newline="") as f:
@@ -659,8 +710,22 @@ def render_report(out_dir: str, log=sys.stderr) -> list[str]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
+    if len(argv) == 4 and argv[0] == "position":
+        # python3 -m uwbtdoa.plots position TRAJECTORY.csv FLIGHT.csv OUT.png
+        try:
+            tr = load_trajectory_csv(argv[1])
+            gt_t, gt = load_flight_truth(argv[2])
+            position_vs_time(tr["t"], np.column_stack([tr["x"], tr["y"], tr["z"]]),
+                             np.column_stack([tr["std_x"], tr["std_y"], tr["std_z"]]), gt_t, gt, path=argv[3],
+                             title=os.path.basename(argv[2]))
+        except (ReportDataError, OSError, KeyError, ValueError) as e:
+            print(f"error: {e}", file=sys.stderr)
+            return 2
+        print(argv[3])
+        return 0
     if len(argv) != 2 or argv[0] != "report":
-        print("usage: python3 -m uwbtdoa.plots report DIR", file=sys.stderr)
+        print("usage: python3 -m uwbtdoa.plots report DIR | position TRAJECTORY.csv FLIGHT.csv OUT.png",
+              file=sys.stderr)
         return 2
     try:
         for p in render_report(argv[1]):
