@@ -5,7 +5,6 @@
  */
 #include <chrono>
 #include <ctime>
-#include <fstream>
 #include <iostream>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -18,7 +17,13 @@
 #include "uwb/core/Error.h"
 #include "uwb/eval/BiasModel.h"
 #include "uwb/eval/Localization.h"
+#include "uwb/io/FileAccess.h"
+#include "uwb/io/InputChecks.h"
+#include "uwb/io/JsonFile.h"
+#include "uwb/io/TrajectoryCsv.h"
 #include "uwb/io/UtilCsv.h"
+#include "EkfConfig.h"
+#include "InputGuards.h"
 
 namespace {
 
@@ -37,70 +42,6 @@ Eigen::Vector3d parseVec3(const std::string& s, const char* what) {
   }
   if (v.size() != 3) throw std::invalid_argument(std::string(what) + ": expected three numbers x,y,z, got '" + s + "'");
   return {v[0], v[1], v[2]};
-}
-
-/// Reads the keys of a JSON object into EkfParams (names as the struct fields); unknown keys are an error.
-void applyConfig(const json& j, uwb::EkfParams& p) {
-  if (!j.is_object()) throw std::invalid_argument("config: expected a JSON object of EkfParams fields");
-  for (const auto& [key, value] : j.items()) {
-    auto num = [&]() {
-      if (!value.is_number()) throw std::invalid_argument("config: '" + key + "' must be a number");
-      return value.get<double>();
-    };
-    auto vec = [&]() {
-      if (!value.is_array() || value.size() != 3) throw std::invalid_argument("config: '" + key + "' must be [x,y,z]");
-      return Eigen::Vector3d(value[0].get<double>(), value[1].get<double>(), value[2].get<double>());
-    };
-    if (key == "acc_noise_mps2_sqrthz") p.acc_noise_mps2_sqrthz = num();
-    else if (key == "lateral_acc_noise_mps2_sqrthz") p.lateral_acc_noise_mps2_sqrthz = num();
-    else if (key == "gyro_noise_radps_sqrthz") p.gyro_noise_radps_sqrthz = num();
-    else if (key == "acc_bias_rw_mps3_sqrthz") p.acc_bias_rw_mps3_sqrthz = num();
-    else if (key == "gyro_bias_rw_radps2_sqrthz") p.gyro_bias_rw_radps2_sqrthz = num();
-    else if (key == "pos_noise_m_sqrts") p.pos_noise_m_sqrts = num();
-    else if (key == "cv_acc_noise_mps2_sqrthz") p.cv_acc_noise_mps2_sqrthz = num();
-    else if (key == "ca_jerk_noise_mps3_sqrthz") p.ca_jerk_noise_mps3_sqrthz = num();
-    else if (key == "accel_model") p.accel_model = uwb::parseAccelModel(value.get<std::string>());
-    else if (key == "ground_accel_model") p.ground_accel_model = uwb::parseAccelModel(value.get<std::string>());
-    else if (key == "takeoff_acc_bias_sigma_mps2") p.takeoff_acc_bias_sigma_mps2 = num();
-    else if (key == "process_model") p.process_model = uwb::parseProcessModel(value.get<std::string>());
-    else if (key == "init_pos_sigma_m") p.init_pos_sigma_m = num();
-    else if (key == "init_vel_sigma_mps") p.init_vel_sigma_mps = num();
-    else if (key == "init_att_sigma_rad") p.init_att_sigma_rad = num();
-    else if (key == "init_yaw_sigma_rad") p.init_yaw_sigma_rad = num();
-    else if (key == "init_acc_bias_sigma_mps2") p.init_acc_bias_sigma_mps2 = num();
-    else if (key == "init_gyro_bias_sigma_radps") p.init_gyro_bias_sigma_radps = num();
-    else if (key == "b_t_tag") p.b_t_tag = vec();
-    else if (key == "tdoa_sigma_m") p.tdoa_sigma_m = num();
-    else if (key == "anchor_sigma_m") p.anchor_sigma_m = num();
-    else if (key == "gate_sigma") p.gate_sigma = num();
-    else if (key == "robust_loss") p.robust_loss = uwb::parseRobustLoss(value.get<std::string>());
-    else if (key == "robust_k") p.robust_k = num();
-    else if (key == "robust_iterations") p.robust_iterations = static_cast<int>(num());
-    else if (key == "max_lost_s") p.max_lost_s = num();
-    else if (key == "max_predict_dt_s") p.max_predict_dt_s = num();
-    else if (key == "cov_period_s") p.cov_period_s = num();
-    else if (key == "max_gap_s") p.max_gap_s = num();
-    else if (key == "ground_phase") p.ground_phase = uwb::parseGroundPhase(value.get<std::string>());
-    else if (key == "takeoff_climb_mps") p.takeoff_climb_mps = num();
-    else if (key == "takeoff_acc_mps2") p.takeoff_acc_mps2 = num();
-    else if (key == "landing_height_m") p.landing_height_m = num();
-    else if (key == "landing_hold_s") p.landing_hold_s = num();
-    else if (key == "acquisition_s") p.acquisition_s = num();
-    else if (key == "acquisition_tdoa_sigma_m") p.acquisition_tdoa_sigma_m = num();
-    else if (key == "start_w_p_b") {
-      p.start_w_p_b = vec();
-      p.has_start_position = true;
-    } else if (key == "ground_z_m") p.ground_z_m = num();
-    else if (key == "fuse_tof") {
-      if (!value.is_boolean()) throw std::invalid_argument("config: 'fuse_tof' must be true or false");
-      p.fuse_tof = value.get<bool>();
-    } else if (key == "tof_sigma_m") p.tof_sigma_m = num();
-    else if (key == "tof_offset_m") p.tof_offset_m = num();
-    else if (key == "floor_z_m") p.floor_z_m = num();
-    else if (key == "tof_max_range_m") p.tof_max_range_m = num();
-    else if (key == "tof_gate_sigma") p.tof_gate_sigma = num();
-    else throw std::invalid_argument("config: unknown key '" + key + "'");
-  }
 }
 
 json statsJson(const uwb::PositionErrorStats& s) {
@@ -125,18 +66,25 @@ struct LocalizeArgs {
   double output_period = 0.01;
 };
 
+/// Largest --output-period [s]: one sample a minute still draws a trajectory.
+constexpr double kMaxOutputPeriod_s = 60.0;
+
 void runLocalize(const LocalizeArgs& a) {
+  uwb::app::Warnings warnings;
+  // Outputs first: a run of minutes must not end in "cannot write".
+  if (!a.out.empty()) uwb::checkOutputFile(a.out, "trajectory file");
+  uwb::app::checkPeriod(a.output_period, "--output-period", kMaxOutputPeriod_s);
   uwb::EkfParams params;
+  bool process_model_given = false;
   if (!a.config.empty()) {
-    std::ifstream in(a.config);
-    if (!in) throw uwb::FileError("cannot open config file '" + a.config + "'");
-    json j;
+    const json j = uwb::readJsonFile(a.config, "config file");
+    uwb::app::applyEkfConfig(j, a.config, params);
+    process_model_given = j.is_object() && j.contains("process_model");
     try {
-      in >> j;
-    } catch (const json::parse_error& e) {
-      throw uwb::InputError(uwb::SourceLocation{a.config, 0, 0, ""}, std::string("invalid JSON: ") + e.what());
+      params.validate();
+    } catch (const std::invalid_argument& e) {
+      throw uwb::InputError(uwb::SourceLocation{a.config, 0, 0, ""}, e.what());
     }
-    applyConfig(j, params);
   }
   if (a.tdoa_sigma) params.tdoa_sigma_m = *a.tdoa_sigma;
   if (a.gate) params.gate_sigma = *a.gate;
@@ -149,7 +97,10 @@ void runLocalize(const LocalizeArgs& a) {
   if (a.cov_period) params.cov_period_s = *a.cov_period;
   if (!a.robust_loss.empty()) params.robust_loss = uwb::parseRobustLoss(a.robust_loss);
   if (!a.accel_model.empty()) params.accel_model = uwb::parseAccelModel(a.accel_model);
-  if (!a.process_model.empty()) params.process_model = uwb::parseProcessModel(a.process_model);
+  if (!a.process_model.empty()) {
+    params.process_model = uwb::parseProcessModel(a.process_model);
+    process_model_given = true;
+  }
   if (!a.tag_offset.empty()) params.b_t_tag = parseVec3(a.tag_offset, "--tag-offset");
   if (!a.start.empty()) {
     params.start_w_p_b = parseVec3(a.start, "--start");
@@ -158,16 +109,36 @@ void runLocalize(const LocalizeArgs& a) {
   if (a.no_ground_detect) params.ground_phase = uwb::GroundPhase::kNone;
   if (a.fuse_tof) params.fuse_tof = true;
   params.validate();
+  if (!params.b_t_tag.allFinite() || params.b_t_tag.norm() > 1.0)
+    throw uwb::InputError("--tag-offset / b_t_tag: the tag must sit within 1 m of the body origin, got " +
+                          std::to_string(params.b_t_tag.norm()) + " m");
   // issue 5: the GP bias model as a plain BiasPredictor (the filter knows nothing of GPs)
   uwb::BiasPredictor bias;
   if (!a.bias_model.empty()) bias = uwb::BiasModel::load(a.bias_model).predictor();
 
   const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(a.anchors);
+  warnings.addIssues(uwb::checkSurveyGeometry(survey));
+  if (params.has_start_position)
+    uwb::app::checkNearAnchors(params.start_w_p_b, survey, a.start.empty() ? a.config + " (start_w_p_b)" : "--start");
   uwb::FlightReadOptions read_opt;
   read_opt.required = {uwb::Stream::kTdoa};
   read_opt.survey = &survey;
   uwb::ReadReport read_report;
   const uwb::Flight flight = uwb::readFlightCsv(a.flight, read_opt, &read_report);
+  const bool use_imu = params.process_model == uwb::ProcessModel::kImu && !a.tdoa_only;
+  if (use_imu && process_model_given && !flight.hasImu()) {
+    throw uwb::InputError(uwb::SourceLocation{a.flight, 1, 0, "t_acc"},
+                          "process model 'imu' was asked for but the flight has no IMU streams (acc and gyro); use "
+                          "--process-model cv or ca, or leave it out for the TDoA-only default");
+  }
+  {
+    std::vector<uwb::InputIssue> issues = uwb::checkStreamRates(flight);
+    for (uwb::InputIssue& i : issues) {  // an IMU that the run ignores only warrants a warning
+      const bool imu_field = i.where.field == "t_acc" || i.where.field == "t_gyro";
+      if (imu_field && !use_imu) i.severity = uwb::IssueSeverity::kWarning;
+    }
+    warnings.addIssues(issues);
+  }
 
   uwb::LocalizationOptions opt;
   opt.params = params;
@@ -178,7 +149,10 @@ void runLocalize(const LocalizeArgs& a) {
   const uwb::LocalizationRun run = uwb::localizeFlight(flight, survey, opt, bias);
   const double cpu_s = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (!a.out.empty()) uwb::writeTrajectoryCsv(run.trajectory, a.out);
+  if (use_imu && !flight.hasImu() && run.summary.process_model != uwb::ProcessModel::kImu) {
+    warnings.add(std::string("the flight has no IMU: the TDoA-only '") + uwb::toString(run.summary.process_model) +
+                 "' model ran instead of 'imu'");
+  }
 
   const uwb::LocalizerSummary& s = run.summary;
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -206,6 +180,7 @@ void runLocalize(const LocalizeArgs& a) {
   j["start_position_m"] = {s.start_w_p_b.x(), s.start_w_p_b.y(), s.start_w_p_b.z()};
   j["merge_notes"] = s.merge.notes();
   j["read_notes"] = read_report.notes;
+  j["warnings"] = warnings.list();
   j["wall_time_s"] = wall_s;
   j["real_time_factor"] = wall_s > 0 ? run.duration_s / wall_s : nan;  // wall clock: slower on a loaded machine
   j["cpu_time_s"] = cpu_s;
@@ -221,8 +196,11 @@ void runLocalize(const LocalizeArgs& a) {
     j["rmse_m"] = nullptr;
     j["rmse_airborne_m"] = nullptr;
   }
+  // The JSON text is made before the trajectory file appears, so a failure here leaves no output behind.
+  const std::string json_text = uwb::app::dumpJson(j);
+  if (!a.out.empty()) uwb::writeTrajectoryCsv(run.trajectory, a.out);
   if (a.json_out) {
-    std::cout << j.dump() << '\n';
+    std::cout << json_text << '\n';
     return;
   }
   std::cout << "flight " << a.flight << ": " << run.duration_s << " s, model " << uwb::toString(s.process_model)

@@ -15,7 +15,9 @@
 
 #include "Command.h"
 #include "uwb/eval/BiasModel.h"
+#include "uwb/io/FileAccess.h"
 #include "uwb/io/UtilCsv.h"
+#include "InputGuards.h"
 
 namespace {
 
@@ -44,6 +46,8 @@ void progressBar(int model, int models, const uwb::gp::EpochReport& r) {
 }
 
 void run(const TrainOptions& o) {
+  uwb::checkOutputFile(o.out, "bias model");  // before minutes of training
+  if (o.passes > 1 && o.inputs != "estimate") throw std::invalid_argument("--passes > 1 needs --inputs estimate");
   const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(o.anchors);
   std::vector<uwb::Flight> flights;
   uwb::FlightReadOptions ro;
@@ -112,11 +116,11 @@ void run(const TrainOptions& o) {
                     {"no_ground_truth", f.n_no_ground_truth}, {"pose_glitch", f.n_pose_glitch}, {"on_ground", f.n_on_ground},
                     {"non_neighbour", f.n_non_neighbour}, {"outlier", f.n_outlier}, {"used", f.n_used}});
   summary["exclusions"] = excl;
-  model.metadata_json = summary.dump();
+  model.metadata_json = uwb::app::dumpJson(summary);
   model.save(o.out);
 
   if (o.json_out) {
-    std::cout << summary.dump() << '\n';
+    std::cout << uwb::app::dumpJson(summary) << '\n';
     return;
   }
   std::cout << fmt::format("trained {} ({} GP{}, M = {}) on {} samples in {:.1f} s; held out {} samples\n", o.kernel,

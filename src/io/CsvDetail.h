@@ -19,9 +19,10 @@
 
 namespace uwb::io_detail {
 
-/// Whole file as one string; FileError when it cannot be opened or read.
+/// Whole file as one string; FileError when it cannot be opened or read, or is a directory or device
+/// (uwb::readTextFile).
 std::string readWholeFile(const std::string& path, const char* what);
-/// Writes `text` to `path` (truncating); FileError on failure.
+/// Writes `text` to `path` atomically (uwb::writeFileAtomically); FileError on failure.
 void writeWholeFile(const std::string& path, std::string_view text, const char* what);
 
 inline bool isBlank(char c) { return c == ' ' || c == '\t'; }

@@ -399,9 +399,10 @@ Flight parseFlightCsv(std::string_view text, const std::string& source, const Fl
       const auto anchorId = [&](int f) -> int {
         const double x = v[f];
         const int c = col[f];
-        if (x != std::floor(x) || x < std::numeric_limits<int>::min() || x > std::numeric_limits<int>::max()) {
+        if (x != std::floor(x) || x < 0 || x > kMaxAnchorId) {
           failAt(line, c + 1, names[c],
-                 fmt::format("anchor id must be an integer: '{}'", std::string_view(cell_b[c], cell_e[c] - cell_b[c])));
+                 fmt::format("anchor id must be an integer in [0, {}]: '{}'", kMaxAnchorId,
+                             std::string_view(cell_b[c], cell_e[c] - cell_b[c])));
         }
         const int id = static_cast<int>(x);
         if (options.survey != nullptr && !options.survey->contains(id)) {
