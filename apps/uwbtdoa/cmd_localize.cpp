@@ -149,9 +149,10 @@ void runLocalize(const LocalizeArgs& a) {
   const uwb::LocalizationRun run = uwb::localizeFlight(flight, survey, opt, bias);
   const double cpu_s = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::vector<std::string> notes;  // expected behaviour worth stating (warnings are for doubtful input)
   if (use_imu && !flight.hasImu() && run.summary.process_model != uwb::ProcessModel::kImu) {
-    warnings.add(std::string("the flight has no IMU: the TDoA-only '") + uwb::toString(run.summary.process_model) +
-                 "' model ran instead of 'imu'");
+    notes.push_back(std::string("the flight has no IMU: the TDoA-only '") + uwb::toString(run.summary.process_model) +
+                    "' model ran (the default without IMU)");
   }
 
   const uwb::LocalizerSummary& s = run.summary;
@@ -181,6 +182,7 @@ void runLocalize(const LocalizeArgs& a) {
   j["merge_notes"] = s.merge.notes();
   j["read_notes"] = read_report.notes;
   j["warnings"] = warnings.list();
+  j["notes"] = notes;
   j["wall_time_s"] = wall_s;
   j["real_time_factor"] = wall_s > 0 ? run.duration_s / wall_s : nan;  // wall clock: slower on a loaded machine
   j["cpu_time_s"] = cpu_s;
@@ -213,6 +215,7 @@ void runLocalize(const LocalizeArgs& a) {
   }
   if (!std::isnan(s.takeoff_t_s)) std::cout << "take-off detected at " << s.takeoff_t_s << " s\n";
   for (const std::string& n : s.merge.notes()) std::cout << "note: " << n << "\n";
+  for (const std::string& n : notes) std::cout << "note: " << n << "\n";
   if (run.metrics) {
     const auto print = [](const char* name, const uwb::PositionErrorStats& st) {
       std::printf("%-9s n=%6zu  RMSE 3D %.3f m  (x %.3f, y %.3f, z %.3f)  p50 %.3f  p90 %.3f  p99 %.3f m\n", name,

@@ -159,12 +159,12 @@ TEST_F(RobustCli, ProcessModelImuOnAFlightWithoutImuIsAnErrorAndTheDefaultWarns)
   writeFlightCsv(f, no_imu);
   // WHEN the IMU model is asked for explicitly THEN it is an error (it used to fall back to cv silently)
   expectFailure(test::runCli(localizeArgs(no_imu, survey_) + " --process-model imu"), 2, {"no IMU"});
-  // WHEN nothing is asked THEN the TDoA-only model runs and --json says so
+  // WHEN nothing is asked THEN the TDoA-only model runs (the documented default) and --json says so
   const test::CliResult r = test::runCli(localizeArgs(no_imu, survey_));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_NE(j["process_model"], "imu");
-  EXPECT_THAT(j["warnings"].dump(), HasSubstr("no IMU"));
+  EXPECT_THAT(j["notes"].dump(), HasSubstr("no IMU"));
 }
 
 TEST_F(RobustCli, ImplausibleCommandLineValuesAreRefusedWithTheOptionName) {
