@@ -146,7 +146,7 @@ TEST_F(RobustCli, ImuStampsInMillisecondsAreAnErrorNamingTheColumn) {
   EXPECT_THAT(nlohmann::json::parse(r.out)["warnings"].dump(), HasSubstr("t_acc"));
 }
 
-TEST_F(RobustCli, ProcessModelImuOnAFlightWithoutImuIsAnErrorAndTheDefaultWarns) {
+TEST_F(RobustCli, ProcessModelImuOnAFlightWithoutImuIsAnErrorAndTheDefaultSaysSo) {
   Flight f = readFlightCsv(flight_);
   f.acc.clear();
   f.gyro.clear();
