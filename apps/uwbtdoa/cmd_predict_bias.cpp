@@ -19,6 +19,7 @@
 #include "uwb/eval/BiasDataset.h"
 #include "uwb/eval/BiasModel.h"
 #include "uwb/io/FileAccess.h"
+#include "uwb/io/InputChecks.h"
 #include "InputGuards.h"
 #include "uwb/io/PoseTrack.h"
 #include "uwb/io/UtilCsv.h"
@@ -35,6 +36,7 @@ struct Options {
 void run(const Options& o) {
   uwb::checkOutputFile(o.out, "bias CSV");
   const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(o.anchors);
+  uwb::app::Warnings().addIssues(uwb::checkSurveyGeometry(survey));  // errors stop, warnings go to stderr
   uwb::FlightReadOptions ro;
   ro.required = {uwb::Stream::kTdoa};
   const uwb::Flight flight = uwb::readFlightCsv(o.flight, ro);

@@ -16,6 +16,7 @@
 #include "Command.h"
 #include "uwb/eval/BiasModel.h"
 #include "uwb/io/FileAccess.h"
+#include "uwb/io/InputChecks.h"
 #include "uwb/io/UtilCsv.h"
 #include "InputGuards.h"
 
@@ -49,6 +50,7 @@ void run(const TrainOptions& o) {
   uwb::checkOutputFile(o.out, "bias model");  // before minutes of training
   if (o.passes > 1 && o.inputs != "estimate") throw std::invalid_argument("--passes > 1 needs --inputs estimate");
   const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(o.anchors);
+  uwb::app::Warnings().addIssues(uwb::checkSurveyGeometry(survey));  // errors stop, warnings go to stderr
   std::vector<uwb::Flight> flights;
   uwb::FlightReadOptions ro;
   ro.required = {uwb::Stream::kTdoa};
