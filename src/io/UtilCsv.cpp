@@ -257,9 +257,13 @@ Header readHeader(io_detail::LineCursor& lines, const std::string& source) {
   return h;
 }
 
-/// Capacity: no stream is longer than the number of lines left (one vectorised pass over the buffer).
+/// Capacity: no stream is longer than the number of lines left (one vectorised pass over the buffer). Capped, so
+/// that a file of mostly blank lines cannot make the reader reserve gigabytes; longer streams simply grow.
+constexpr std::size_t kMaxReservedRows = std::size_t{1} << 21;
+
 void reserveStreams(const Layout& layout, std::string_view rest, Flight& flight) {
-  const std::size_t approx_rows = static_cast<std::size_t>(std::count(rest.begin(), rest.end(), '\n')) + 1;
+  const std::size_t approx_rows = std::min(
+      static_cast<std::size_t>(std::count(rest.begin(), rest.end(), '\n')) + 1, kMaxReservedRows);
   for (Stream s : allStreams()) {
     if (!layout.present[streamIndex(s)]) continue;
     switch (s) {
