@@ -50,17 +50,24 @@ LOG="$BUILD_DIR/build.log"
 what="${UWB_TARGETS:-everything}"
 echo "[setup] building $what with $JOBS job(s); log: $LOG"
 set +e
-NINJA_STATUS="[%f/%t %e] " cmake --build "$BUILD_DIR" -j "$JOBS" "${TARGET_ARGS[@]}" 2>&1 | tee "$LOG" |
-  awk -v what="$what" '
-    /^\[[0-9]+\/[0-9]+ [0-9.]+\] / {
-      split(substr($1, 2), a, "/"); done = a[1] + 0; total = a[2] + 0; t = $2; sub(/\]/, "", t); t += 0
-      if (done == total || t - last >= 15 || done == 1) {
-        left = done > 0 ? t / done * (total - done) : 0
-        printf "[setup] %s: step %d of %d, %d s elapsed, about %d s left\n", what, done, total, t, left
-        last = t; fflush()
-      }
-    }
-    /^ninja: no work to do/ { printf "[setup] %s is up to date\n", what }'
+# Progress from ninja's status prefix "[done/total elapsed]" (a bash loop: awk would buffer its input).
+progress() {
+  local last=-100 line done total t left
+  while IFS= read -r line; do
+    if [[ $line =~ ^\[([0-9]+)/([0-9]+)\ ([0-9]+)(\.[0-9]+)?\]\  ]]; then
+      done=${BASH_REMATCH[1]}; total=${BASH_REMATCH[2]}; t=${BASH_REMATCH[3]}
+      ((done == 0)) && continue
+      if ((done == total || t - last >= 15)); then
+        left=$((done > 0 ? t * (total - done) / done : 0))
+        echo "[setup] $what: step $done of $total, ${t} s elapsed, about ${left} s left"
+        last=$t
+      fi
+    elif [[ $line == "ninja: no work to do." ]]; then
+      echo "[setup] $what is up to date"
+    fi
+  done
+}
+NINJA_STATUS="[%f/%t %e] " cmake --build "$BUILD_DIR" -j "$JOBS" "${TARGET_ARGS[@]}" 2>&1 | tee "$LOG" | progress
 status=${PIPESTATUS[0]}
 set -e
 if [ "$status" -ne 0 ]; then
