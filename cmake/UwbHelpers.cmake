@@ -1,8 +1,30 @@
 # Helpers shared by every module: warnings, sanitizers, one static library per concept folder.
 
-set(UWB_WARNINGS -Wall -Wextra -Wpedantic -Wshadow=local -Wnon-virtual-dtor)
+# Developer builds print warnings (-Wshadow=local is GCC's; clang has no 'local' variant). User builds
+# (UWB_DEV_WARNINGS=OFF, scripts/demo.sh) print none: GCC 12 reports false positives inside Eigen and std::string.
+if(UWB_DEV_WARNINGS)
+  set(UWB_WARNINGS -Wall -Wextra -Wpedantic -Wnon-virtual-dtor $<$<CXX_COMPILER_ID:GNU>:-Wshadow=local>)
+else()
+  set(UWB_WARNINGS -w)
+  add_compile_options(-w)
+endif()
+if(UWB_SANITIZE AND UWB_TSAN)
+  message(FATAL_ERROR "UWB_SANITIZE (ASan/UBSan) and UWB_TSAN cannot be combined; use two build folders")
+endif()
 if(UWB_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all)
+  add_link_options(-fsanitize=address,undefined)
+endif()
+if(UWB_TSAN)
+  add_compile_options(-fsanitize=thread -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=thread)
+endif()
+# Fuzzing (fuzz/): every library is instrumented for coverage; the harnesses add libFuzzer's main. Needs clang.
+if(UWB_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    message(FATAL_ERROR "UWB_FUZZ needs clang (e.g. CXX=clang++-14); the compiler is ${CMAKE_CXX_COMPILER_ID}")
+  endif()
+  add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all)
   add_link_options(-fsanitize=address,undefined)
 endif()
 

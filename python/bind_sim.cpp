@@ -50,8 +50,9 @@ Setters<TrajectoryParams> trajectorySetters() {
 Setters<SimParams> simSetters() {
   Setters<SimParams> s;
   const auto sub = [&s](const std::string& prefix, auto member, auto fields) {
-    for (const auto& [n, f] : fields) {
-      s[prefix + n] = [member, f](SimParams& p, const py::handle& v) {  // cast errors: applyOverrides
+    for (const auto& field : fields) {  // no structured binding: clang 14 cannot capture one in the lambda
+      const auto f = field.second;
+      s[prefix + field.first] = [member, f](SimParams& p, const py::handle& v) {  // cast errors: applyOverrides
         (p.*member).*f = py::cast<std::remove_reference_t<decltype((p.*member).*f)>>(v);
       };
     }

@@ -11,7 +11,9 @@
 #include <sstream>
 
 #include "Command.h"
+#include "InputGuards.h"
 #include "uwb/core/Error.h"
+#include "uwb/io/FileAccess.h"
 
 namespace uwb::app {
 
@@ -73,6 +75,7 @@ std::vector<std::string> renderFigures(const std::string& dir) {
 
 void runAndReport(const std::vector<NamedFlight>& train, const std::vector<NamedFlight>& test,
                   const AnchorSurvey& survey, const EvaluationCliOptions& options) {
+  checkOutputDirectory(options.out_dir, "report folder");  // before the (long) evaluation
   const EvaluationParams params = options.toParams();
   const EvaluationResult result =
       runEvaluation(train, test, survey, params, [](const std::string& line) { std::cerr << line << std::endl; });
@@ -93,7 +96,7 @@ void runAndReport(const std::vector<NamedFlight>& train, const std::vector<Named
                               {"best_inducing", result.best_inducing},
                               {"n_train_samples", result.n_train_samples},
                               {"seconds", result.seconds}};
-    std::cout << j.dump(2) << std::endl;
+    std::cout << dumpJson(j, 2) << std::endl;
     return;
   }
   std::cout << toMarkdown(result.rows) << '\n';

@@ -8,6 +8,9 @@
 
 #include "Command.h"
 #include "Report.h"
+#include "InputGuards.h"
+#include "uwb/io/FileAccess.h"
+#include "uwb/io/InputChecks.h"
 #include "uwb/io/UtilCsv.h"
 
 namespace uwb::app {
@@ -38,7 +41,9 @@ void setup(CLI::App& sub) {
   sub.add_option("--out", opt->eval.out_dir, "Output directory for the report")->required();
   opt->eval.addTo(sub);
   sub.callback([opt] {
+    checkOutputDirectory(opt->eval.out_dir, "report folder");  // before reading and training
     const AnchorSurvey survey = readAnchorSurvey(opt->anchors);
+    Warnings().addIssues(checkSurveyGeometry(survey));
     runAndReport(readFlights(opt->train, survey), readFlights(opt->test, survey), survey, opt->eval);
   });
 }

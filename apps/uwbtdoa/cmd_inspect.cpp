@@ -11,7 +11,9 @@
 
 #include "Command.h"
 #include "uwb/io/FlightSummary.h"
+#include "uwb/io/InputChecks.h"
 #include "uwb/io/UtilCsv.h"
+#include "InputGuards.h"
 
 namespace {
 
@@ -186,10 +188,24 @@ void setup(CLI::App& sub) {
     uwb::ReadReport report;
     const uwb::Flight flight = uwb::readFlightCsv(*flight_path, options, &report);
     const uwb::FlightSummary summary = uwb::summarizeFlight(flight, have_survey ? &survey : nullptr, &report);
+    // inspect is the diagnostic tool: implausible geometry or rates are reported, never fatal here.
+    std::vector<uwb::InputIssue> issues = uwb::checkStreamRates(flight);
+    if (have_survey) {
+      const auto geometry = uwb::checkSurveyGeometry(survey);
+      issues.insert(issues.end(), geometry.begin(), geometry.end());
+    }
+    std::vector<std::string> warnings;
+    for (const uwb::InputIssue& i : issues) warnings.push_back(i.text());
     if (*as_json) {
-      std::cout << summaryJson(summary, *anchors_path).dump(2) << '\n';
+      json j = summaryJson(summary, *anchors_path);
+      j["warnings"] = warnings;
+      std::cout << uwb::app::dumpJson(j, 2) << '\n';
     } else {
       printHuman(summary, *anchors_path);
+      if (!warnings.empty()) {
+        std::cout << "\nwarnings:\n";
+        for (const auto& w : warnings) std::cout << "  - " << w << '\n';
+      }
     }
   });
 }

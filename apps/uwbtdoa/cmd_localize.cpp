@@ -6,7 +6,6 @@
 #include <chrono>
 #include <deque>
 #include <ctime>
-#include <fstream>
 #include <iostream>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -19,36 +18,18 @@
 #include "uwb/eval/BiasModel.h"
 #include "uwb/eval/Localization.h"
 #include "uwb/filter/EkfParamRegistry.h"
+#include "uwb/io/FileAccess.h"
+#include "uwb/io/InputChecks.h"
+#include "uwb/io/JsonFile.h"
+#include "uwb/io/TrajectoryCsv.h"
 #include "uwb/io/UtilCsv.h"
+#include "EkfConfig.h"
+#include "InputGuards.h"
 
 namespace {
 
 using nlohmann::json;
 
-/// Reads the keys of a JSON object into EkfParams through the parameter registry (keys = field names, unknown
-/// keys and values of the wrong kind or outside their range are errors naming the file and the key).
-void applyConfig(const json& j, uwb::EkfParams& p, const std::string& file) {
-  if (!j.is_object()) throw uwb::InputError(uwb::SourceLocation{file, 0, 0, ""}, "expected a JSON object of EkfParams fields");
-  for (const auto& [key, value] : j.items()) {
-    const uwb::EkfParamInfo* info = nullptr;
-    try {
-      info = &uwb::ekfParamInfo(key);
-    } catch (const std::invalid_argument& e) {
-      throw uwb::InputError(uwb::SourceLocation{file, 0, 0, key}, e.what());
-    }
-    uwb::EkfParamValue v;
-    if (value.is_boolean()) v = value.get<bool>();
-    else if (value.is_number()) v = value.get<double>();
-    else if (value.is_string()) v = value.get<std::string>();
-    else if (value.is_array() && value.size() == 3 && value[0].is_number() && value[1].is_number() && value[2].is_number())
-      v = Eigen::Vector3d(value[0].get<double>(), value[1].get<double>(), value[2].get<double>());
-    else v = value.dump();
-    try {
-      uwb::setEkfParam(p, *info, v, "");
-    } catch (const std::invalid_argument& e) {
-      throw uwb::InputError(uwb::SourceLocation{file, 0, 0, key}, e.what());
-    }
-  }
 }
 
 json statsJson(const uwb::PositionErrorStats& s) {
@@ -74,39 +55,69 @@ struct LocalizeArgs {
   std::vector<CLI::Option*> param_option;
 };
 
+/// Largest --output-period [s]: one sample a minute still draws a trajectory.
+constexpr double kMaxOutputPeriod_s = 60.0;
+
 void runLocalize(const LocalizeArgs& a) {
+  uwb::app::Warnings warnings;
+  // Outputs first: a run of minutes must not end in "cannot write".
+  if (!a.out.empty()) uwb::checkOutputFile(a.out, "trajectory file");
+  uwb::app::checkPeriod(a.output_period, "--output-period", kMaxOutputPeriod_s);
   uwb::EkfParams params;
+  bool process_model_given = false;
   if (!a.config.empty()) {
-    std::ifstream in(a.config);
-    if (!in) throw uwb::FileError("cannot open config file '" + a.config + "'");
-    json j;
+    const json j = uwb::readJsonFile(a.config, "config file");
+    uwb::app::applyEkfConfig(j, a.config, params);
+    process_model_given = j.is_object() && j.contains("process_model");
     try {
-      in >> j;
-    } catch (const json::parse_error& e) {
-      throw uwb::InputError(uwb::SourceLocation{a.config, 0, 0, ""}, std::string("invalid JSON: ") + e.what());
+      params.validate();
+    } catch (const std::invalid_argument& e) {
+      throw uwb::InputError(uwb::SourceLocation{a.config, 0, 0, ""}, e.what());
     }
-    applyConfig(j, params, a.config);
   }
   // flags override the config file
   const std::vector<uwb::EkfParamInfo>& registry = uwb::ekfParamRegistry();
+  bool start_flag = false;
   for (std::size_t k = 0; k < registry.size(); ++k) {
     if (a.param_option[k]->count() == 0) continue;
     const uwb::EkfParamInfo& info = registry[k];
+    if (info.name == "process_model") process_model_given = true;
+    if (info.name == "start_w_p_b") start_flag = true;
     if (info.kind == uwb::EkfParamKind::kBool) uwb::setEkfParam(params, info, a.param_flag[k], info.flag());
     else uwb::setEkfParamFromText(params, info, a.param_text[k], info.flag());
   }
   if (a.no_ground_detect) params.ground_phase = uwb::GroundPhase::kNone;
   params.validate();
-  // The GP bias model as a plain BiasPredictor (the filter knows nothing of GPs)
+  if (!params.b_t_tag.allFinite() || params.b_t_tag.norm() > 1.0)
+    throw uwb::InputError("--tag-offset / b_t_tag: the tag must sit within 1 m of the body origin, got " +
+                          std::to_string(params.b_t_tag.norm()) + " m");
+  // the GP bias model as a plain BiasPredictor (the filter knows nothing of GPs)
   uwb::BiasPredictor bias;
   if (!a.bias_model.empty()) bias = uwb::BiasModel::load(a.bias_model).predictor();
 
   const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(a.anchors);
+  warnings.addIssues(uwb::checkSurveyGeometry(survey));
+  if (params.has_start_position)
+    uwb::app::checkNearAnchors(params.start_w_p_b, survey, start_flag ? "--start" : a.config + " (start_w_p_b)");
   uwb::FlightReadOptions read_opt;
   read_opt.required = {uwb::Stream::kTdoa};
   read_opt.survey = &survey;
   uwb::ReadReport read_report;
   const uwb::Flight flight = uwb::readFlightCsv(a.flight, read_opt, &read_report);
+  const bool use_imu = params.process_model == uwb::ProcessModel::kImu && !a.tdoa_only;
+  if (use_imu && process_model_given && !flight.hasImu()) {
+    throw uwb::InputError(uwb::SourceLocation{a.flight, 1, 0, "t_acc"},
+                          "process model 'imu' was asked for but the flight has no IMU streams (acc and gyro); use "
+                          "--process-model cv or ca, or leave it out for the TDoA-only default");
+  }
+  {
+    std::vector<uwb::InputIssue> issues = uwb::checkStreamRates(flight);
+    for (uwb::InputIssue& i : issues) {  // an IMU that the run ignores only warrants a warning
+      const bool imu_field = i.where.field == "t_acc" || i.where.field == "t_gyro";
+      if (imu_field && !use_imu) i.severity = uwb::IssueSeverity::kWarning;
+    }
+    warnings.addIssues(issues);
+  }
 
   uwb::LocalizationOptions opt;
   opt.params = params;
@@ -117,7 +128,11 @@ void runLocalize(const LocalizeArgs& a) {
   const uwb::LocalizationRun run = uwb::localizeFlight(flight, survey, opt, bias);
   const double cpu_s = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (!a.out.empty()) uwb::writeTrajectoryCsv(run.trajectory, a.out);
+  std::vector<std::string> notes;  // expected behaviour worth stating (warnings are for doubtful input)
+  if (use_imu && !flight.hasImu() && run.summary.process_model != uwb::ProcessModel::kImu) {
+    notes.push_back(std::string("the flight has no IMU: the TDoA-only '") + uwb::toString(run.summary.process_model) +
+                    "' model ran (the default without IMU)");
+  }
 
   const uwb::LocalizerSummary& s = run.summary;
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -154,6 +169,8 @@ void runLocalize(const LocalizeArgs& a) {
   j["start_position_m"] = {s.start_w_p_b.x(), s.start_w_p_b.y(), s.start_w_p_b.z()};
   j["merge_notes"] = s.merge.notes();
   j["read_notes"] = read_report.notes;
+  j["warnings"] = warnings.list();
+  j["notes"] = notes;
   j["wall_time_s"] = wall_s;
   j["real_time_factor"] = wall_s > 0 ? run.duration_s / wall_s : nan;  // wall clock: slower on a loaded machine
   j["cpu_time_s"] = cpu_s;
@@ -169,8 +186,11 @@ void runLocalize(const LocalizeArgs& a) {
     j["rmse_m"] = nullptr;
     j["rmse_airborne_m"] = nullptr;
   }
+  // The JSON text is made before the trajectory file appears, so a failure here leaves no output behind.
+  const std::string json_text = uwb::app::dumpJson(j);
+  if (!a.out.empty()) uwb::writeTrajectoryCsv(run.trajectory, a.out);
   if (a.json_out) {
-    std::cout << j.dump() << '\n';
+    std::cout << json_text << '\n';
     return;
   }
   std::cout << "flight " << a.flight << ": " << run.duration_s << " s, model " << uwb::toString(s.process_model)
@@ -185,6 +205,7 @@ void runLocalize(const LocalizeArgs& a) {
   if (!std::isnan(s.takeoff_t_s)) std::cout << "left rest at " << s.takeoff_t_s << " s\n";
   for (double t_r : s.reacquisition_t_s) std::cout << "note: position re-acquired by multilateration at " << t_r << " s\n";
   for (const std::string& n : s.merge.notes()) std::cout << "note: " << n << "\n";
+  for (const std::string& n : notes) std::cout << "note: " << n << "\n";
   if (run.metrics) {
     const auto print = [](const char* name, const uwb::PositionErrorStats& st) {
       std::printf("%-9s n=%6zu  RMSE 3D %.3f m  (x %.3f, y %.3f, z %.3f)  p50 %.3f  p90 %.3f  p99 %.3f m\n", name,

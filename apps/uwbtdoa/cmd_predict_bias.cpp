@@ -11,7 +11,6 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
@@ -19,6 +18,9 @@
 #include "uwb/core/Error.h"
 #include "uwb/eval/BiasDataset.h"
 #include "uwb/eval/BiasModel.h"
+#include "uwb/io/FileAccess.h"
+#include "uwb/io/InputChecks.h"
+#include "InputGuards.h"
 #include "uwb/io/PoseTrack.h"
 #include "uwb/io/UtilCsv.h"
 
@@ -32,7 +34,9 @@ struct Options {
 };
 
 void run(const Options& o) {
+  uwb::checkOutputFile(o.out, "bias CSV");
   const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(o.anchors);
+  uwb::app::Warnings().addIssues(uwb::checkSurveyGeometry(survey));  // errors stop, warnings go to stderr
   uwb::FlightReadOptions ro;
   ro.required = {uwb::Stream::kTdoa};
   const uwb::Flight flight = uwb::readFlightCsv(o.flight, ro);
@@ -43,12 +47,12 @@ void run(const Options& o) {
   std::string inputs = o.inputs;
   if (inputs.empty()) {
     const auto meta = nlohmann::json::parse(model.metadata_json, nullptr, false);
-    inputs = meta.is_object() && meta.contains("inputs") ? meta.at("inputs").get<std::string>() : "truth";
+    inputs = meta.is_object() && meta.contains("inputs") && meta.at("inputs").is_string()
+                 ? meta.at("inputs").get<std::string>()
+                 : "truth";
   }
   const uwb::BiasInputSource source = uwb::biasInputSourceFromString(inputs);
-  std::ofstream out(o.out);
-  if (!out) throw uwb::FileError("cannot write '" + o.out + "'");
-  out << "t,idA,idB,tdoa_meas,error_m,bias_mean_m,bias_std_m,airborne\n";
+  std::string out = "t,idA,idB,tdoa_meas,error_m,bias_mean_m,bias_std_m,airborne\n";
   double se_b = 0, se_a = 0;
   std::size_t n_air = 0, n_rows = 0;
   if (source == uwb::BiasInputSource::kFilterEstimate) {
@@ -58,8 +62,8 @@ void run(const Options& o) {
     const uwb::BiasDataset data = uwb::buildBiasDataset({flight}, survey, dp);
     for (const auto& smp : data.samples) {
       const uwb::BiasPrediction p = model.predict(smp.feature);
-      out << fmt::format("{:.6f},{},{},,{:.7g},{:.7g},{:.7g},1\n", smp.t_s, smp.feature.id_a, smp.feature.id_b,
-                         smp.error_m, p.mean_m, std::sqrt(p.variance_m2));
+      out += fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},1\n", smp.t_s, smp.feature.id_a, smp.feature.id_b,
+                         smp.measured_m, smp.error_m, p.mean_m, std::sqrt(p.variance_m2));
       ++n_air;
       se_b += smp.error_m * smp.error_m;
       se_a += (smp.error_m - p.mean_m) * (smp.error_m - p.mean_m);
@@ -74,7 +78,7 @@ void run(const Options& o) {
     const uwb::TdoaFeature f = uwb::makeTdoaFeature(r.id_a, r.id_b, r.w_p_b, r.w_q_b, survey.position(r.id_a), survey.position(r.id_b));
     const uwb::BiasPrediction p = model.predict(f);
     const bool air = uwb::isAirborne(r.w_p_b.z(), o.min_z);
-    out << fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},{}\n", r.t_s, r.id_a, r.id_b, r.measured_m, r.residual_m,
+    out += fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},{}\n", r.t_s, r.id_a, r.id_b, r.measured_m, r.residual_m,
                        p.mean_m, std::sqrt(p.variance_m2), air ? 1 : 0);
     if (air && std::abs(r.residual_m) <= 1.0) {
       ++n_air;
@@ -82,14 +86,14 @@ void run(const Options& o) {
       se_a += (r.residual_m - p.mean_m) * (r.residual_m - p.mean_m);
     }
   }
-  if (!out) throw uwb::FileError("error while writing '" + o.out + "'");
   const double before = n_air ? std::sqrt(se_b / n_air) : std::nan(""), after = n_air ? std::sqrt(se_a / n_air) : std::nan("");
+  const std::string json_text = uwb::app::dumpJson(
+      nlohmann::json{{"flight", o.flight}, {"model", o.model}, {"inputs", inputs}, {"n_rows", n_rows},
+                     {"n_airborne", n_air}, {"bias_rmse_before_m", before}, {"bias_rmse_after_m", after},
+                     {"out", o.out}});
+  uwb::writeFileAtomically(o.out, out, "bias CSV");
   if (o.json_out) {
-    std::cout << nlohmann::json{{"flight", o.flight}, {"model", o.model}, {"inputs", inputs}, {"n_rows", n_rows},
-                                {"n_airborne", n_air}, {"bias_rmse_before_m", before}, {"bias_rmse_after_m", after},
-                                {"out", o.out}}
-                     .dump()
-              << '\n';
+    std::cout << json_text << '\n';
   } else {
     std::cout << fmt::format("{} rows written to {}; GP inputs from the {}; airborne (|eps| ≤ 1 m, {} samples) bias RMSE "
                              "before {:.4f} m, after {:.4f} m\n",

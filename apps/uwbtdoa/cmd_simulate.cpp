@@ -8,7 +8,6 @@
  */
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -20,7 +19,11 @@
 
 #include "Command.h"
 #include "uwb/core/Error.h"
+#include "uwb/io/FileAccess.h"
+#include "uwb/io/JsonFile.h"
 #include "uwb/io/UtilCsv.h"
+#include "InputGuards.h"
+#include "SimConfig.h"
 #include "uwb/sim/FlightSimulator.h"
 #include "uwb/sim/ResidualProfile.h"
 
@@ -28,100 +31,10 @@ namespace {
 
 using uwb::sim::SimParams;
 using uwb::sim::TrajectoryParams;
-using Field = std::variant<double*, int*, bool*>;
 
-void applyObject(const nlohmann::json& j, const std::string& section, const std::map<std::string, Field>& fields) {
-  if (!j.is_object()) throw std::invalid_argument("config: '" + section + "' must be an object");
-  for (const auto& [key, value] : j.items()) {
-    const auto it = fields.find(key);
-    if (it == fields.end()) {
-      std::string known;
-      for (const auto& [name, _] : fields) known += (known.empty() ? "" : ", ") + name;
-      throw std::invalid_argument("config: unknown key '" + section + "." + key + "' (known: " + known + ")");
-    }
-    const std::string where = "config: '" + section + "." + key + "'";
-    if (auto* d = std::get_if<double*>(&it->second)) {
-      if (!value.is_number()) throw std::invalid_argument(where + " must be a number");
-      **d = value.get<double>();
-    } else if (auto* i = std::get_if<int*>(&it->second)) {
-      if (!value.is_number_integer()) throw std::invalid_argument(where + " must be an integer");
-      **i = value.get<int>();
-    } else if (auto* b = std::get_if<bool*>(&it->second)) {
-      if (!value.is_boolean()) throw std::invalid_argument(where + " must be true or false");
-      **b = value.get<bool>();
-    }
-  }
-}
-
-/// Reads params.json: {"trajectory": {...}, "imu": {...}, "pose": {...}, "tdoa": {...}, "bias": {...},
-/// "b_t_tag": [x, y, z]}; keys are the C++ field names. Unknown keys are errors (typos must not pass silently).
-void applyConfig(const std::string& path, SimParams* sp, TrajectoryParams* tp) {
-  std::ifstream in(path);
-  if (!in) throw uwb::FileError("cannot open config file " + path);
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw uwb::InputError(uwb::SourceLocation{path, 0, 0, ""}, std::string("invalid JSON: ") + e.what());
-  }
-  if (!j.is_object()) throw uwb::InputError(uwb::SourceLocation{path, 0, 0, ""}, "config must be a JSON object");
-  for (const auto& [key, value] : j.items()) {
-    if (key == "trajectory") {
-      applyObject(value, key,
-                  {{"ground_before_s", &tp->ground_before_s}, {"ground_after_s", &tp->ground_after_s},
-                   {"takeoff_s", &tp->takeoff_s}, {"landing_s", &tp->landing_s},
-                   {"speed_ramp_s", &tp->speed_ramp_s}, {"ground_z_m", &tp->ground_z_m},
-                   {"radius_m", &tp->radius_m}, {"height_m", &tp->height_m}, {"omega_rps", &tp->omega_rps},
-                   {"sine_amplitude_m", &tp->sine_amplitude_m}, {"sine_omega_ratio", &tp->sine_omega_ratio},
-                   {"figure8_half_length_m", &tp->figure8_half_length_m},
-                   {"figure8_half_width_m", &tp->figure8_half_width_m}, {"figure8_omega_rps", &tp->figure8_omega_rps},
-                   {"zigzag_half_x_m", &tp->zigzag_half_x_m}, {"zigzag_half_y_m", &tp->zigzag_half_y_m},
-                   {"zigzag_z_min_m", &tp->zigzag_z_min_m}, {"zigzag_z_max_m", &tp->zigzag_z_max_m},
-                   {"zigzag_speed_mps", &tp->zigzag_speed_mps}, {"zigzag_sweep_ratio", &tp->zigzag_sweep_ratio},
-                   {"yaw0_rad", &tp->yaw0_rad}, {"yaw_rate_rps", &tp->yaw_rate_rps},
-                   {"center_x_m", &tp->w_center_xy.x()}, {"center_y_m", &tp->w_center_xy.y()}});
-    } else if (key == "imu") {
-      auto& p = sp->imu;
-      applyObject(value, key,
-                  {{"rate_hz", &p.rate_hz}, {"acc_noise_std_mps2", &p.acc_noise_std_mps2},
-                   {"acc_bias_std_mps2", &p.acc_bias_std_mps2}, {"acc_bias_rw_mps2_sqrt_s", &p.acc_bias_rw_mps2_sqrt_s},
-                   {"gyro_noise_std_rps", &p.gyro_noise_std_rps}, {"gyro_bias_std_rps", &p.gyro_bias_std_rps},
-                   {"gyro_bias_rw_rps_sqrt_s", &p.gyro_bias_rw_rps_sqrt_s}});
-    } else if (key == "pose") {
-      auto& p = sp->pose;
-      applyObject(value, key,
-                  {{"rate_hz", &p.rate_hz}, {"position_quantum_m", &p.position_quantum_m},
-                   {"quat_quantum", &p.quat_quantum}});
-    } else if (key == "tdoa") {
-      auto& p = sp->tdoa;
-      applyObject(value, key, {{"rate_hz", &p.rate_hz}, {"jitter_fraction", &p.jitter_fraction}});
-    } else if (key == "bias") {
-      auto& p = sp->bias;
-      applyObject(value, key,
-                  {{"enabled", &p.enabled}, {"antenna_rms_m", &p.antenna_rms_m}, {"antenna_degree", &p.antenna_degree},
-                   {"anchor_pattern_rms_m", &p.anchor_pattern_rms_m}, {"anchor_offset_std_m", &p.anchor_offset_std_m},
-                   {"nlos_bias_m", &p.nlos_bias_m}, {"nlos_elevation_rad", &p.nlos_elevation_rad},
-                   {"nlos_width_rad", &p.nlos_width_rad}, {"nlos_azimuth_gain", &p.nlos_azimuth_gain},
-                   {"nlos_azimuth_rad", &p.nlos_azimuth_rad}, {"multipath_std_m", &p.multipath_std_m},
-                   {"multipath_length_m", &p.multipath_length_m}, {"multipath_features", &p.multipath_features},
-                   {"noise_std_m", &p.noise_std_m}, {"outlier_probability", &p.outlier_probability},
-                   {"outlier_scale_m", &p.outlier_scale_m}, {"outlier_dof", &p.outlier_dof},
-                   {"outlier_max_m", &p.outlier_max_m}, {"burst_probability", &p.burst_probability},
-                   {"burst_length_s", &p.burst_length_s}, {"burst_scale_m", &p.burst_scale_m},
-                   {"ground_effect", &p.ground_effect},
-                   {"ground_low_anchor_z_m", &p.ground_low_anchor_z_m}, {"ground_low_min_m", &p.ground_low_min_m},
-                   {"ground_low_max_m", &p.ground_low_max_m}, {"ground_high_abs_m", &p.ground_high_abs_m},
-                   {"ground_noise_std_m", &p.ground_noise_std_m},
-                   {"ground_blend_height_m", &p.ground_blend_height_m}});
-    } else if (key == "b_t_tag") {
-      if (!value.is_array() || value.size() != 3) throw std::invalid_argument("config: 'b_t_tag' must be [x, y, z]");
-      for (int i = 0; i < 3; ++i) sp->b_t_tag[i] = value.at(static_cast<std::size_t>(i)).get<double>();
-    } else {
-      throw std::invalid_argument("config: unknown section '" + key +
-                                  "' (known: trajectory, imu, pose, tdoa, bias, b_t_tag)");
-    }
-  }
-}
+/// Longest simulated flight [s] and most samples of one stream: a flight of hours at 1 kHz is gigabytes.
+constexpr double kMaxDuration_s = 3600.0;
+constexpr double kMaxStreamSamples = 2e7;
 
 struct Options {
   std::string trajectory = "circle";
@@ -145,6 +58,11 @@ double spanOf(const S& stream) {
 }
 
 void run(const Options& o, CLI::App& sub) {
+  uwb::checkOutputFile(o.out, "flight file");
+  uwb::checkOutputFile(o.survey_out, "anchor survey");
+  if (!std::isfinite(o.duration_s) || !(o.duration_s > 0.0) || o.duration_s > kMaxDuration_s) {
+    throw uwb::InputError(fmt::format("--duration must be in (0, {:g}] s, got {}", kMaxDuration_s, o.duration_s));
+  }
   const auto t_start = std::chrono::steady_clock::now();
   SimParams params;
   uwb::sim::Scenario scenario;
@@ -154,12 +72,20 @@ void run(const Options& o, CLI::App& sub) {
   scenario.trajectory.duration_s = o.duration_s;
   uwb::sim::fitTrajectoryToAnchors(scenario.survey, &scenario.trajectory);
   scenario.trajectory.yaw_rate_rps = o.yaw_rate_rps;
-  if (!o.config.empty()) applyConfig(o.config, &params, &scenario.trajectory);
+  if (!o.config.empty()) uwb::app::applySimConfigFile(o.config, &params, &scenario.trajectory);
   params.bias.field_seed = o.field_seed;
   if (sub.count("--yaw-rate") > 0) scenario.trajectory.yaw_rate_rps = o.yaw_rate_rps;  // the flag wins
   scenario.trajectory.yaw_mode = scenario.trajectory.yaw_rate_rps == 0.0 ? uwb::sim::YawMode::kConstant
                                                                           : uwb::sim::YawMode::kConstantRate;
 
+  for (const auto& [name, rate_hz] : {std::pair<const char*, double>{"imu.rate_hz", params.imu.rate_hz},
+                                      {"pose.rate_hz", params.pose.rate_hz}, {"tdoa.rate_hz", params.tdoa.rate_hz}}) {
+    if (!(rate_hz * scenario.trajectory.duration_s <= kMaxStreamSamples)) {
+      throw uwb::InputError(fmt::format("{} = {:g} Hz over {:g} s gives more than {:g} samples; shorten the flight or "
+                                        "lower the rate",
+                                        name, rate_hz, scenario.trajectory.duration_s, kMaxStreamSamples));
+    }
+  }
   const uwb::sim::SimResult result = uwb::sim::simulateFlight(scenario, params, o.seed);
   const auto t_sim = std::chrono::steady_clock::now();
   uwb::writeFlightCsv(result.flight, o.out);
@@ -228,7 +154,7 @@ void run(const Options& o, CLI::App& sub) {
                             {"mean_abs_dev_m", ground.overall.mean_abs_dev_m}};
     j["time_simulate_s"] = sim_s;
     j["time_total_s"] = total_s;
-    std::cout << j.dump() << '\n';
+    std::cout << uwb::app::dumpJson(j) << '\n';
     return;
   }
   std::cout << fmt::format("simulated {} flight, {:.1f} s, seed {}, {} anchors ({}), yaw rate {:g} rad/s\n",

@@ -20,7 +20,10 @@
 #include "uwb/core/Error.h"
 #include "uwb/eval/BiasModel.h"
 #include "uwb/io/Airborne.h"
+#include "uwb/io/FileAccess.h"
+#include "uwb/io/InputChecks.h"
 #include "uwb/io/UtilCsv.h"
+#include "InputGuards.h"
 
 namespace {
 
@@ -75,7 +78,10 @@ void dumpArrays(const std::string& path, const uwb::BiasDataset& data, const uwb
 }
 
 void run(const TrainOptions& o) {
+  uwb::checkOutputFile(o.out, "bias model");  // before minutes of training
+  if (o.passes > 1 && o.inputs != "estimate") throw std::invalid_argument("--passes > 1 needs --inputs estimate");
   const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(o.anchors);
+  uwb::app::Warnings().addIssues(uwb::checkSurveyGeometry(survey));  // errors stop, warnings go to stderr
   std::vector<uwb::Flight> flights;
   uwb::FlightReadOptions ro;
   ro.required = {uwb::Stream::kTdoa};
@@ -152,11 +158,11 @@ void run(const TrainOptions& o) {
                     {"no_ground_truth", f.n_no_ground_truth}, {"pose_glitch", f.n_pose_glitch}, {"on_ground", f.n_on_ground},
                     {"non_neighbour", f.n_non_neighbour}, {"outlier", f.n_outlier}, {"used", f.n_used}});
   summary["exclusions"] = excl;
-  model.metadata_json = summary.dump();
+  model.metadata_json = uwb::app::dumpJson(summary);
   model.save(o.out);
 
   if (o.json_out) {
-    std::cout << summary.dump() << '\n';
+    std::cout << uwb::app::dumpJson(summary) << '\n';
     return;
   }
   std::cout << fmt::format("trained {} ({} GP{}, M = {}) on {} samples in {:.1f} s; held out {} samples; full-data "

@@ -111,6 +111,7 @@ BiasDataset buildBiasDataset(const std::vector<Flight>& flights, const AnchorSur
       BiasSample s;
       s.feature = makeTdoaFeature(r.id_a, r.id_b, w_p_b, w_q_b, survey.position(r.id_a), survey.position(r.id_b));
       s.error_m = eps;
+      s.measured_m = r.measured_m;
       s.t_s = r.t_s;
       s.flight = static_cast<int>(fi);
       ds.samples.push_back(s);

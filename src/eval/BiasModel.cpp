@@ -12,6 +12,9 @@
 #include <stdexcept>
 
 #include "uwb/core/Error.h"
+#include "uwb/io/AnchorSurvey.h"
+#include "uwb/io/FileAccess.h"
+#include "uwb/io/JsonFile.h"
 
 namespace uwb {
 
@@ -322,32 +325,91 @@ nlohmann::json BiasModel::toJson() const {
           {"training", meta}};
 }
 
+namespace {
+
+/// Plausible magnitude of a TDoA bias [m]: UWB NLOS and antenna effects reach a metre or two; a mean of 10⁶ m in a
+/// model file is a corrupt or foreign file, not a bias (issue: such a model moved the estimate by 1.9 km).
+constexpr double kMaxPlausibleBias_m = 10.0;
+/// Largest plausible extra TDoA variance (P31) [m²] and SVGP jitter.
+constexpr double kMaxExtraVariance_m2 = 100.0;
+constexpr double kMaxJitter = 1.0;
+
+/// Anchor id of a model entry: -1 (global model) or a valid anchor id; checked before conversion.
+int modelAnchorId(const nlohmann::json& m, const std::string& key, const char* name) {
+  return jsonInt(jsonMember(m, key, name), key + "." + name, -1, kMaxAnchorId);
+}
+
+/// Range checks of the SVGP block that the GP reader leaves to the caller (values it accepts but that make the
+/// model useless or its factorisation fail without naming the file).
+void checkSvgpValues(const nlohmann::json& svgp, const std::string& key) {
+  const double jitter = jsonDouble(jsonMember(svgp, key, "jitter"), key + ".jitter");
+  if (jitter < 0 || jitter > kMaxJitter)
+    throw std::invalid_argument(key + ".jitter must be in [0, " + std::to_string(kMaxJitter) + "], got " +
+                                std::to_string(jitter));
+  const nlohmann::json& mean = jsonMember(svgp, key, "mean");
+  const double c = jsonDouble(jsonMember(mean, key + ".mean", "constant"), key + ".mean.constant");
+  if (std::abs(c) > kMaxPlausibleBias_m)
+    throw std::invalid_argument(key + ".mean.constant = " + std::to_string(c) + " m is not a plausible TDoA bias (|m| ≤ " +
+                                std::to_string(kMaxPlausibleBias_m) + " m)");
+  const nlohmann::json& likelihood = jsonMember(svgp, key, "likelihood");
+  const double noise = jsonDouble(jsonMember(likelihood, key + ".likelihood", "noise"), key + ".likelihood.noise");
+  if (!(noise > 0) || noise > kMaxExtraVariance_m2)
+    throw std::invalid_argument(key + ".likelihood.noise must be in (0, " + std::to_string(kMaxExtraVariance_m2) +
+                                "] m², got " + std::to_string(noise));
+}
+
+}  // namespace
+
 BiasModel BiasModel::fromJson(const nlohmann::json& j) {
   try {
     if (!j.is_object()) throw std::invalid_argument("not a JSON object");
     if (j.value("format", std::string()) != "uwbtdoa-bias-model")
       throw std::invalid_argument("\"format\" is not \"uwbtdoa-bias-model\" (is this a bias model file?)");
-    const int version = j.at("version").get<int>();
+    const int version = jsonInt(jsonMember(j, "", "version"), "version", 0, 1000000);
     if (version != 1) throw std::invalid_argument("unsupported bias model version " + std::to_string(version) + " (expected 1)");
-    const FeatureMap map = featureMapFromString(j.at("features").get<std::string>());
-    if (j.contains("feature_columns") && j.at("feature_columns").get<int>() != featureDim(map))
+    const FeatureMap map = featureMapFromString(jsonString(jsonMember(j, "", "features"), "features"));
+    if (j.contains("feature_columns") && jsonInt(j.at("feature_columns"), "feature_columns", 0, 1000) != featureDim(map))
       throw std::invalid_argument("feature_columns does not match the feature map");
     std::vector<Entry> entries;
-    for (const auto& m : j.at("models")) entries.push_back({m.at("id_a").get<int>(), m.at("id_b").get<int>(), gp::Svgp::fromJson(m.at("svgp"))});
+    const nlohmann::json& models = jsonMember(j, "", "models");
+    if (!models.is_array()) throw std::invalid_argument("'models' must be an array");
+    for (std::size_t i = 0; i < models.size(); ++i) {
+      const std::string key = "models[" + std::to_string(i) + "]";
+      const nlohmann::json& m = models[i];
+      const int id_a = modelAnchorId(m, key, "id_a"), id_b = modelAnchorId(m, key, "id_b");
+      if ((id_a < 0) != (id_b < 0))
+        throw std::invalid_argument(key + ": id_a and id_b are both -1 (global model) or both anchor ids");
+      checkSvgpValues(jsonMember(m, key, "svgp"), key + ".svgp");
+      entries.push_back({id_a, id_b, gp::Svgp::fromJson(m.at("svgp"))});
+    }
     if (entries.empty()) throw std::invalid_argument("no models in the file");
     std::vector<PairMean> means;  // optional (P28); absent in files of the paper presets
     if (j.contains("pair_means")) {
-      for (const auto& m : j.at("pair_means")) {
-        means.push_back({m.at("id_a").get<int>(), m.at("id_b").get<int>(), m.at("mean_m").get<double>()});
-        if (!std::isfinite(means.back().mean_m)) throw std::invalid_argument("pair_means: mean_m is not finite");
+      const nlohmann::json& pm = j.at("pair_means");
+      if (!pm.is_array()) throw std::invalid_argument("'pair_means' must be an array");
+      for (std::size_t i = 0; i < pm.size(); ++i) {
+        const std::string key = "pair_means[" + std::to_string(i) + "]";
+        const int id_a = modelAnchorId(pm[i], key, "id_a"), id_b = modelAnchorId(pm[i], key, "id_b");
+        const double mean_m = jsonDouble(jsonMember(pm[i], key, "mean_m"), key + ".mean_m");
+        if (std::abs(mean_m) > kMaxPlausibleBias_m)
+          throw std::invalid_argument(key + ".mean_m = " + std::to_string(mean_m) +
+                                      " m is not a plausible TDoA bias (|mean| ≤ " + std::to_string(kMaxPlausibleBias_m) +
+                                      " m); is this the right model file?");
+        means.push_back({id_a, id_b, mean_m});
       }
     }
-    BiasModel model(j.at("preset").get<std::string>(), map, std::move(entries), std::move(means));
-    if (j.contains("training")) model.metadata_json = j.at("training").dump();
-    if (j.contains("extra_variance_m2")) model.setExtraVariance(j.at("extra_variance_m2").get<double>());
-    if (j.contains("mean_scale")) model.setMeanScale(j.at("mean_scale").get<double>());
-    if (j.value("full_variance", false))
-      model.setFullVariance(true, j.at("target_mean_square_m2").get<double>());
+    BiasModel model(jsonString(jsonMember(j, "", "preset"), "preset"), map, std::move(entries), std::move(means));
+    if (j.contains("training")) model.metadata_json = j.at("training").dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    if (j.contains("extra_variance_m2")) {
+      const double v = jsonDouble(j.at("extra_variance_m2"), "extra_variance_m2");
+      if (v > kMaxExtraVariance_m2)
+        throw std::invalid_argument("extra_variance_m2 = " + std::to_string(v) + " m² is not plausible (≤ " +
+                                    std::to_string(kMaxExtraVariance_m2) + ")");
+      model.setExtraVariance(v);
+    }
+    if (j.contains("mean_scale")) model.setMeanScale(jsonDouble(j.at("mean_scale"), "mean_scale"));
+    if (j.contains("full_variance") && jsonBool(j.at("full_variance"), "full_variance"))
+      model.setFullVariance(true, jsonDouble(jsonMember(j, "", "target_mean_square_m2"), "target_mean_square_m2"));
     return model;
   } catch (const nlohmann::json::exception& e) {
     throw std::invalid_argument(std::string("bias model: ") + e.what());
@@ -357,24 +419,14 @@ BiasModel BiasModel::fromJson(const nlohmann::json& j) {
 }
 
 void BiasModel::save(const std::string& path) const {
-  std::ofstream out(path);
-  if (!out) throw FileError("cannot write bias model '" + path + "'");
-  out << toJson().dump(1) << '\n';
-  if (!out) throw FileError("error while writing bias model '" + path + "'");
+  writeFileAtomically(path, toJson().dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", "bias model");
 }
 
 BiasModel BiasModel::load(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw FileError("cannot open bias model '" + path + "'");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(SourceLocation{path, 0, 0, ""}, std::string("not valid JSON (corrupt model file?): ") + e.what());
-  }
+  const nlohmann::json j = readJsonFile(path, "bias model");
   try {
     return fromJson(j);
-  } catch (const std::invalid_argument& e) {
+  } catch (const std::exception& e) {  // also the GP's own errors (e.g. a factorisation that fails)
     throw InputError(SourceLocation{path, 0, 0, ""}, e.what());
   }
 }

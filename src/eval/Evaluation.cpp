@@ -18,6 +18,7 @@
 
 #include "uwb/core/Error.h"
 #include "uwb/eval/BiasCalibration.h"
+#include "uwb/io/FileAccess.h"
 
 namespace uwb {
 namespace {
@@ -278,11 +279,9 @@ EvaluationResult runEvaluation(const std::vector<NamedFlight>& train, const std:
 
 namespace {
 
+/// Each report file appears complete or not at all (io/FileAccess.h).
 void writeText(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path);
-  if (!out) throw FileError(fmt::format("cannot write {}", path.string()));
-  out << text;
-  if (!out) throw FileError(fmt::format("error while writing {}", path.string()));
+  writeFileAtomically(path.string(), text, "report file");
 }
 
 std::string trajectoryRows(const std::string& flight, const std::string& variant, const Trajectory& traj,

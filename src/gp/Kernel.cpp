@@ -855,13 +855,28 @@ nlohmann::json Kernel::toJson() const {
           {"name", name()}};
 }
 
+namespace {
+/// An array of small non-negative integers (dimension or part indices), checked before conversion: get<int>() of
+/// a value like 1e300 would overflow (undefined behaviour).
+std::vector<int> indicesFromJson(const nlohmann::json& j, const char* what) {
+  if (!j.is_array()) throw std::invalid_argument(std::string(what) + ": expected an array of indices");
+  std::vector<int> out;
+  for (const auto& v : j) {
+    if (!v.is_number_integer() || v.get<std::int64_t>() < 0 || v.get<std::int64_t>() > 1000)
+      throw std::invalid_argument(std::string(what) + ": expected integer indices in [0, 1000], got " + v.dump());
+    out.push_back(static_cast<int>(v.get<std::int64_t>()));
+  }
+  return out;
+}
+}  // namespace
+
 Kernel Kernel::fromJson(const nlohmann::json& j) {
   try {
     std::vector<PartSpec> specs;
     for (const auto& jp : j.at("parts")) {
       PartSpec s;
       s.type = partTypeFromString(jp.at("type").get<std::string>());
-      s.active_dims = jp.at("active_dims").get<std::vector<int>>();
+      s.active_dims = indicesFromJson(jp.at("active_dims"), "active_dims");
       // Either our own layout or the fixture layout (parameters in a "paper" block; FIXTURES.md §2).
       const nlohmann::json& src = jp.contains("paper") ? jp.at("paper") : jp;
       if (s.type == PartType::kLedergerber) {
@@ -886,7 +901,7 @@ Kernel Kernel::fromJson(const nlohmann::json& j) {
       terms.emplace_back();
       for (int p = 0; p < static_cast<int>(specs.size()); ++p) terms[0].push_back(p);
     } else if (comb == "sum_of_products") {
-      terms = j.at("terms").get<std::vector<std::vector<int>>>();
+      for (const auto& t : j.at("terms")) terms.push_back(indicesFromJson(t, "terms"));
     } else {
       throw std::invalid_argument("unknown combination '" + comb + "'");
     }

@@ -446,8 +446,8 @@ Svgp Svgp::fromJson(const nlohmann::json& j) {
     if (!j.is_object()) throw std::invalid_argument("not a JSON object");
     if (j.value("format", std::string()) != "uwbtdoa-svgp")
       throw std::invalid_argument("\"format\" is not \"uwbtdoa-svgp\"");
-    const int version = j.at("version").get<int>();
-    if (version != 1) throw std::invalid_argument("unsupported SVGP model version " + std::to_string(version) + " (expected 1)");
+    // Compared as JSON numbers: get<int>() of a value like 1e300 would overflow (undefined behaviour).
+    if (j.at("version") != 1) throw std::invalid_argument("unsupported SVGP model version " + j.at("version").dump() + " (expected 1)");
     Svgp gp(Kernel::fromJson(j.at("kernel")), matFromJson(j.at("inducing_points"), "inducing_points"),
             j.at("jitter").get<double>());
     const VecX m = vecFromJson(j.at("variational").at("m"));

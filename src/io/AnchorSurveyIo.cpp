@@ -14,7 +14,10 @@
 namespace uwb {
 
 AnchorSurvey readAnchorSurvey(const std::string& path) {
-  const std::string text = io_detail::readWholeFile(path, "anchor survey");
+  return parseAnchorSurvey(io_detail::readWholeFile(path, "anchor survey"), path);
+}
+
+AnchorSurvey parseAnchorSurvey(std::string_view text, const std::string& path) {
   struct Entry {
     Anchor anchor;
     std::size_t p_line = 0;
@@ -45,8 +48,9 @@ AnchorSurvey readAnchorSurvey(const std::string& path) {
       }
       const std::string_view id_text = label.substr(2, us - 2);
       const auto [ptr, ec] = std::from_chars(id_text.data(), id_text.data() + id_text.size(), id);
-      if (ec != std::errc() || ptr != id_text.data() + id_text.size()) {
-        fail(line, 1, "", fmt::format("malformed anchor id in '{}'", label));
+      if (ec != std::errc() || ptr != id_text.data() + id_text.size() || id < 0 || id > kMaxAnchorId) {
+        fail(line, 1, "", fmt::format("malformed anchor id in '{}' (expected an integer in [0, {}])", label,
+                                      kMaxAnchorId));
       }
       const std::string_view kind = label.substr(us + 1);
       if (kind == "p") {

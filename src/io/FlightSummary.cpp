@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 
 namespace uwb {
 
@@ -71,9 +72,18 @@ FlightSummary summarizeFlight(const Flight& flight, const AnchorSurvey* survey, 
   if (survey != nullptr) {
     for (const Anchor& a : survey->anchors) ids.push_back(a.id);
   } else {
-    int max_id = -1;
-    for (const TdoaMeasurement& m : flight.tdoa) max_id = std::max({max_id, m.id_a, m.id_b});
-    for (int i = 0; i <= max_id; ++i) ids.push_back(i);
+    // UTIL numbers its anchors 0..N-1 around the arena: the ring is 0..(largest id seen). Ids beyond kMaxAnchorId
+    // (a flight built in memory) use the ids seen, so that no table is sized by an id.
+    std::set<int> seen;
+    for (const TdoaMeasurement& m : flight.tdoa) {
+      seen.insert(m.id_a);
+      seen.insert(m.id_b);
+    }
+    if (!seen.empty() && *seen.begin() >= 0 && *seen.rbegin() <= kMaxAnchorId) {
+      for (int i = 0; i <= *seen.rbegin(); ++i) ids.push_back(i);
+    } else {
+      ids.assign(seen.begin(), seen.end());
+    }
   }
   std::sort(ids.begin(), ids.end());
 

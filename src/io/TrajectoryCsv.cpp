@@ -40,7 +40,10 @@ void writeTrajectoryCsv(const Trajectory& trajectory, const std::string& path) {
 }
 
 Trajectory readTrajectoryCsv(const std::string& path) {
-  const std::string text = io_detail::readWholeFile(path, "trajectory file");
+  return parseTrajectoryCsv(io_detail::readWholeFile(path, "trajectory file"), path);
+}
+
+Trajectory parseTrajectoryCsv(std::string_view text, const std::string& path) {
   const auto fail = [&](std::size_t line, std::size_t column, const std::string& field, const std::string& msg) {
     throw InputError(SourceLocation{path, line, column, field}, msg);
   };

@@ -215,71 +215,55 @@ Flight readFlightCsv(const std::string& path, const FlightReadOptions& options, 
   return parseFlightCsv(text, path, options, report);
 }
 
-Flight parseFlightCsv(std::string_view text, const std::string& source, const FlightReadOptions& options,
-                      ReadReport* report) {
-  Flight flight;
-  flight.source = source;
-  ReadReport local_report;
-  ReadReport& rep = report != nullptr ? *report : local_report;
-  rep = ReadReport{};
-  rep.n_bytes = text.size();
+namespace {
 
-  io_detail::LineCursor lines(text);  // skips a UTF-8 BOM, strips CR
+/// Throws the reader's InputError: file, line, 1-based column (0: whole line) and field name.
+[[noreturn]] void failAt(const std::string& source, std::size_t line, std::size_t column, const std::string& field,
+                         const std::string& message) {
+  throw InputError(SourceLocation{source, line, column, field}, message);
+}
+
+bool isBlankLine(const char* b, const char* e) {
+  io_detail::trim(b, e);
+  return b == e;
+}
+
+/// The header: the first line that is not blank, split into column names.
+struct Header {
+  std::vector<std::string> names;
   std::size_t line = 0;
-  const auto nextLine = [&](const char*& b, const char*& e) {
-    const bool more = lines.next(b, e);
-    line = lines.line();
-    return more;
-  };
-  const auto failAt = [&](std::size_t at_line, std::size_t column, const std::string& field,
-                          const std::string& message) {
-    throw InputError(SourceLocation{source, at_line, column, field}, message);
-  };
+};
 
-  // ---- header
-  const char* hb = nullptr;
-  const char* he = nullptr;
-  bool got_header = false;
-  while (nextLine(hb, he)) {
-    const char* tb = hb;
-    const char* te = he;
-    io_detail::trim(tb, te);
-    if (tb != te) {
-      got_header = true;
+Header readHeader(io_detail::LineCursor& lines, const std::string& source) {
+  const char* b = nullptr;
+  const char* e = nullptr;
+  bool found = false;
+  while (lines.next(b, e)) {
+    if (!isBlankLine(b, e)) {
+      found = true;
       break;
     }
   }
-  if (!got_header) failAt(line == 0 ? 1 : line, 0, "", "empty file: missing header line");
-  const std::size_t header_line = line;
-  std::vector<std::string> names;
-  for (const char* b = hb;;) {
-    const char* comma = static_cast<const char*>(std::memchr(b, ',', static_cast<std::size_t>(he - b)));
-    const char* e = comma != nullptr ? comma : he;
-    const char* tb = b;
-    const char* te = e;
-    io_detail::trim(tb, te);
-    names.emplace_back(tb, te);
-    if (comma == nullptr) break;
-    b = comma + 1;
+  if (!found) failAt(source, lines.line() == 0 ? 1 : lines.line(), 0, "", "empty file: missing header line");
+  Header h;
+  h.line = lines.line();
+  io_detail::forEachCell(b, e, [&](std::size_t, const char* tb, const char* te) { h.names.emplace_back(tb, te); });
+  double dummy = 0.0;
+  const std::string& first = h.names.front();
+  if (first.empty() ||
+      io_detail::parseDouble(first.data(), first.data() + first.size(), dummy) == NumberStatus::kOk) {
+    failAt(source, h.line, 1, "", "missing header line: the first line holds data, expected column names");
   }
-  {
-    double dummy = 0.0;
-    const std::string& first = names.front();
-    if (io_detail::parseDouble(first.data(), first.data() + first.size(), dummy) == NumberStatus::kOk ||
-        first.empty()) {
-      failAt(header_line, 1, "", "missing header line: the first line holds data, expected column names");
-    }
-  }
-  const Layout layout = makeLayout(names, [&](std::size_t i, const std::string& name, const std::string& msg) {
-    failAt(header_line, i + 1, name, msg);
-  });
-  flight.columns = names;
-  flight.pose_has_orientation = layout.present[streamIndex(Stream::kPose)] && layout.pose_quat;
-  const std::size_t n_cols = names.size();
+  return h;
+}
 
-  // Capacity: no stream is longer than the number of lines left (one vectorised pass over the buffer).
-  const std::string_view rest = lines.rest();
-  const std::size_t approx_rows = static_cast<std::size_t>(std::count(rest.begin(), rest.end(), '\n')) + 1;
+/// Capacity: no stream is longer than the number of lines left (one vectorised pass over the buffer). Capped, so
+/// that a file of mostly blank lines cannot make the reader reserve gigabytes; longer streams simply grow.
+constexpr std::size_t kMaxReservedRows = std::size_t{1} << 21;
+
+void reserveStreams(const Layout& layout, std::string_view rest, Flight& flight) {
+  const std::size_t approx_rows = std::min(
+      static_cast<std::size_t>(std::count(rest.begin(), rest.end(), '\n')) + 1, kMaxReservedRows);
   for (Stream s : allStreams()) {
     if (!layout.present[streamIndex(s)]) continue;
     switch (s) {
@@ -291,8 +275,10 @@ Flight parseFlightCsv(std::string_view text, const std::string& source, const Fl
       default: break;
     }
   }
+}
 
-  // Present streams in the order of their time column in the file (error order follows the row).
+/// Present streams in the order of their time column in the file (error order follows the row).
+std::vector<Stream> streamsInFileOrder(const Layout& layout) {
   std::vector<Stream> present;
   for (Stream s : allStreams()) {
     if (layout.present[streamIndex(s)]) present.push_back(s);
@@ -300,159 +286,163 @@ Flight parseFlightCsv(std::string_view text, const std::string& source, const Fl
   std::sort(present.begin(), present.end(), [&](Stream a, Stream b) {
     return layout.col[streamIndex(a)][0] < layout.col[streamIndex(b)][0];
   });
+  return present;
+}
 
-  std::array<StreamCursor, kNumStreams> cursors{};
-  std::vector<const char*> cell_b(n_cols);
-  std::vector<const char*> cell_e(n_cols);
-  std::size_t blank_lines = 0;
-  std::size_t pending_blank = 0;  // blank lines not yet known to be trailing
-  std::size_t n_rows = 0;
+/// Parses the data rows into the flight, one stream cell group at a time; each stream keeps its own cursor.
+class RowParser {
+ public:
+  RowParser(const std::string& source, const Header& header, const Layout& layout, const FlightReadOptions& options,
+            Flight& flight)
+      : source_(source), names_(header.names), layout_(layout), options_(options), flight_(flight),
+        present_(streamsInFileOrder(layout)), cell_b_(names_.size()), cell_e_(names_.size()) {}
 
-  const char* lb = nullptr;
-  const char* le = nullptr;
-  while (nextLine(lb, le)) {
-    // A line with nothing but blanks: tolerated (counted) unless at the very end of the file.
-    {
-      const char* tb = lb;
-      const char* te = le;
-      io_detail::trim(tb, te);
-      if (tb == te) {
-        ++pending_blank;
-        continue;
+  /// One non-blank line: split it, then read each present stream's cells.
+  void parseRow(std::size_t line, const char* b, const char* e) {
+    line_ = line;
+    const std::size_t n_cols = names_.size();
+    const std::size_t n = io_detail::forEachCell(b, e, [&](std::size_t i, const char* tb, const char* te) {
+      if (i < n_cols) {
+        cell_b_[i] = tb;
+        cell_e_[i] = te;
       }
-    }
-    blank_lines += pending_blank;
-    pending_blank = 0;
-    ++n_rows;
-
-    // Split into cells.
-    // Cells are short (≤ 12 characters): a plain scan beats one memchr call per cell.
-    std::size_t n = 0;
-    for (const char* b = lb;;) {
-      const char* e = b;
-      while (e < le && *e != ',') ++e;
-      if (n < n_cols) {
-        const char* tb = b;
-        const char* te = e;
-        io_detail::trim(tb, te);
-        cell_b[n] = tb;
-        cell_e[n] = te;
-      }
-      ++n;
-      if (e == le) break;
-      b = e + 1;
-    }
+    });
     if (n != n_cols) {
-      failAt(line, std::min(n, n_cols) + (n > n_cols ? 1 : 0), "",
-             fmt::format("row has {} fields, the header has {}", n, n_cols));
+      fail(std::min(n, n_cols) + (n > n_cols ? 1 : 0), "", fmt::format("row has {} fields, the header has {}", n, n_cols));
     }
+    for (Stream s : present_) parseStream(s);
+  }
 
-    for (Stream s : present) {
-      const int si = streamIndex(s);
-      const auto& col = layout.col[si];
-      const int nf = layout.fieldsOf(s);
-      StreamCursor& cur = cursors[si];
-      const bool time_empty = cell_b[col[0]] == cell_e[col[0]];
-      if (time_empty) {
-        for (int f = 1; f < nf; ++f) {
-          const int c = col[f];
-          if (cell_b[c] != cell_e[c]) {
-            failAt(line, c + 1, names[c],
-                   fmt::format("partly filled row of stream '{}': '{}' is empty but '{}' is not", streamName(s),
-                               names[col[0]], names[c]));
-          }
-        }
-        if (!cur.ended) {
-          cur.ended = true;
-          cur.end_line = line;
-        }
-        continue;
-      }
-      if (cur.ended) {
-        failAt(line, col[0] + 1, names[col[0]],
-               fmt::format("stream '{}' continues after it ended (its time cell was empty on line {})", streamName(s),
-                           cur.end_line));
-      }
-      double v[kMaxFields];
-      for (int f = 0; f < nf; ++f) {
-        const int c = col[f];
-        if (cell_b[c] == cell_e[c]) {
-          failAt(line, c + 1, names[c],
-                 fmt::format("partly filled row of stream '{}': '{}' is empty", streamName(s), names[c]));
-        }
-        const NumberStatus st = io_detail::parseDouble(cell_b[c], cell_e[c], v[f]);
-        if (st != NumberStatus::kOk) {
-          failAt(line, c + 1, names[c],
-                 fmt::format("{}: '{}'", io_detail::describe(st), std::string_view(cell_b[c], cell_e[c] - cell_b[c])));
-        }
-      }
-      // Time order within the stream.
-      const double t = v[0];
-      if (t < cur.last_t) {
-        failAt(line, col[0] + 1, names[col[0]],
-               fmt::format("time goes backwards in stream '{}': {} after {}", streamName(s), t, cur.last_t));
-      }
-      if (t == cur.last_t) ++cur.duplicates;
-      cur.last_t = t;
-      ++cur.count;
+  const std::vector<Stream>& present() const { return present_; }
+  const StreamCursor& cursor(Stream s) const { return cursors_[streamIndex(s)]; }
 
-      const auto anchorId = [&](int f) -> int {
-        const double x = v[f];
-        const int c = col[f];
-        if (x != std::floor(x) || x < std::numeric_limits<int>::min() || x > std::numeric_limits<int>::max()) {
-          failAt(line, c + 1, names[c],
-                 fmt::format("anchor id must be an integer: '{}'", std::string_view(cell_b[c], cell_e[c] - cell_b[c])));
-        }
-        const int id = static_cast<int>(x);
-        if (options.survey != nullptr && !options.survey->contains(id)) {
-          failAt(line, c + 1, names[c],
-                 fmt::format("anchor id {} has no entry in the survey{}", id,
-                             options.survey->source.empty() ? std::string() : " " + options.survey->source));
-        }
-        return id;
-      };
+ private:
+  [[noreturn]] void fail(std::size_t column, const std::string& field, const std::string& message) const {
+    failAt(source_, line_, column, field, message);
+  }
+  bool empty(int c) const { return cell_b_[c] == cell_e_[c]; }
+  std::string_view cell(int c) const { return {cell_b_[c], static_cast<std::size_t>(cell_e_[c] - cell_b_[c])}; }
 
-      switch (s) {
-        case Stream::kTdoa: flight.tdoa.push_back({t, anchorId(1), anchorId(2), v[3]}); break;
-        case Stream::kTwr: flight.twr.push_back({t, anchorId(1), v[2]}); break;
-        case Stream::kAcc:
-          flight.acc.push_back({t, Vec3(v[1] * kGravity_mps2, v[2] * kGravity_mps2, v[3] * kGravity_mps2)});
-          break;
-        case Stream::kGyro:
-          flight.gyro.push_back({t, Vec3(v[1] * kDegToRad, v[2] * kDegToRad, v[3] * kDegToRad)});
-          break;
-        case Stream::kTof: flight.tof.push_back({t, v[1]}); break;
-        case Stream::kFlow: flight.flow.push_back({t, v[1], v[2]}); break;
-        case Stream::kBaro: flight.baro.push_back({t, v[1]}); break;
-        case Stream::kPose: {
-          PoseSample ps;
-          ps.t_s = t;
-          ps.w_p_b = Vec3(v[1], v[2], v[3]);
-          if (layout.pose_quat) {
-            double norm = 0.0;
-            if (!equalsQuatNorm(v[4], v[5], v[6], v[7], norm)) {
-              const int c = col[kPoseQuatFirstField];
-              failAt(line, c + 1, names[c],
-                     fmt::format("pose quaternion is far from unit norm: |q| = {:.6g} (tolerance {})", norm,
-                                 kMaxQuaternionNormError));
-            }
-            ps.w_q_b = Quat(v[7], v[4], v[5], v[6]);  // Eigen order: w, x, y, z
-          }
-          flight.pose.push_back(ps);
-          break;
-        }
+  void parseStream(Stream s) {
+    const int si = streamIndex(s);
+    const auto& col = layout_.col[si];
+    const int nf = layout_.fieldsOf(s);
+    StreamCursor& cur = cursors_[si];
+    if (empty(col[0])) {
+      endStream(s, cur);
+      return;
+    }
+    if (cur.ended) {
+      fail(col[0] + 1, names_[col[0]],
+           fmt::format("stream '{}' continues after it ended (its time cell was empty on line {})", streamName(s),
+                       cur.end_line));
+    }
+    double v[kMaxFields];
+    for (int f = 0; f < nf; ++f) {
+      const int c = col[f];
+      if (empty(c)) {
+        fail(c + 1, names_[c], fmt::format("partly filled row of stream '{}': '{}' is empty", streamName(s), names_[c]));
+      }
+      const NumberStatus st = io_detail::parseDouble(cell_b_[c], cell_e_[c], v[f]);
+      if (st != NumberStatus::kOk) fail(c + 1, names_[c], fmt::format("{}: '{}'", io_detail::describe(st), cell(c)));
+    }
+    checkTimeOrder(s, cur, v[0]);
+    appendSample(s, v);
+  }
+
+  /// An empty time cell ends the stream; its other cells must be empty too.
+  void endStream(Stream s, StreamCursor& cur) {
+    const auto& col = layout_.col[streamIndex(s)];
+    for (int f = 1; f < layout_.fieldsOf(s); ++f) {
+      const int c = col[f];
+      if (!empty(c)) {
+        fail(c + 1, names_[c],
+             fmt::format("partly filled row of stream '{}': '{}' is empty but '{}' is not", streamName(s),
+                         names_[col[0]], names_[c]));
       }
     }
+    if (!cur.ended) {
+      cur.ended = true;
+      cur.end_line = line_;
+    }
   }
-  if (n_rows == 0 && blank_lines == 0 && pending_blank == 0) {
-    // Header only: allowed (empty streams), but "required" below may reject it.
-  }
-  rep.n_rows = n_rows;
 
-  // ---- notes: tolerated oddities, counted
+  void checkTimeOrder(Stream s, StreamCursor& cur, double t) {
+    if (t < cur.last_t) {
+      const int c = layout_.col[streamIndex(s)][0];
+      fail(c + 1, names_[c], fmt::format("time goes backwards in stream '{}': {} after {}", streamName(s), t, cur.last_t));
+    }
+    if (t == cur.last_t) ++cur.duplicates;
+    cur.last_t = t;
+    ++cur.count;
+  }
+
+  /// Field f of stream s as an anchor id: an integer in [0, kMaxAnchorId], in the survey when one is given.
+  int anchorId(Stream s, int f, double x) const {
+    const int c = layout_.col[streamIndex(s)][f];
+    if (x != std::floor(x) || x < 0 || x > kMaxAnchorId) {
+      fail(c + 1, names_[c], fmt::format("anchor id must be an integer in [0, {}]: '{}'", kMaxAnchorId, cell(c)));
+    }
+    const int id = static_cast<int>(x);
+    if (options_.survey != nullptr && !options_.survey->contains(id)) {
+      fail(c + 1, names_[c],
+           fmt::format("anchor id {} has no entry in the survey{}", id,
+                       options_.survey->source.empty() ? std::string() : " " + options_.survey->source));
+    }
+    return id;
+  }
+
+  /// Stores one sample, converting units once (acc g → m/s², gyro deg/s → rad/s).
+  void appendSample(Stream s, const double* v) {
+    const double t = v[0];
+    switch (s) {
+      case Stream::kTdoa: flight_.tdoa.push_back({t, anchorId(s, 1, v[1]), anchorId(s, 2, v[2]), v[3]}); break;
+      case Stream::kTwr: flight_.twr.push_back({t, anchorId(s, 1, v[1]), v[2]}); break;
+      case Stream::kAcc:
+        flight_.acc.push_back({t, Vec3(v[1] * kGravity_mps2, v[2] * kGravity_mps2, v[3] * kGravity_mps2)});
+        break;
+      case Stream::kGyro: flight_.gyro.push_back({t, Vec3(v[1] * kDegToRad, v[2] * kDegToRad, v[3] * kDegToRad)}); break;
+      case Stream::kTof: flight_.tof.push_back({t, v[1]}); break;
+      case Stream::kFlow: flight_.flow.push_back({t, v[1], v[2]}); break;
+      case Stream::kBaro: flight_.baro.push_back({t, v[1]}); break;
+      case Stream::kPose: flight_.pose.push_back(poseSample(v)); break;
+    }
+  }
+
+  PoseSample poseSample(const double* v) const {
+    PoseSample ps;
+    ps.t_s = v[0];
+    ps.w_p_b = Vec3(v[1], v[2], v[3]);
+    if (layout_.pose_quat) {
+      double norm = 0.0;
+      if (!equalsQuatNorm(v[4], v[5], v[6], v[7], norm)) {
+        const int c = layout_.col[streamIndex(Stream::kPose)][kPoseQuatFirstField];
+        fail(c + 1, names_[c],
+             fmt::format("pose quaternion is far from unit norm: |q| = {:.6g} (tolerance {})", norm,
+                         kMaxQuaternionNormError));
+      }
+      ps.w_q_b = Quat(v[7], v[4], v[5], v[6]);  // Eigen order: w, x, y, z
+    }
+    return ps;
+  }
+
+  const std::string& source_;
+  const std::vector<std::string>& names_;
+  const Layout& layout_;
+  const FlightReadOptions& options_;
+  Flight& flight_;
+  std::vector<Stream> present_;
+  std::array<StreamCursor, kNumStreams> cursors_{};
+  std::vector<const char*> cell_b_;
+  std::vector<const char*> cell_e_;
+  std::size_t line_ = 0;
+};
+
+/// Tolerated oddities, counted in the report.
+void addNotes(const RowParser& rows, const Layout& layout, std::size_t blank_lines, ReadReport& rep) {
   if (blank_lines > 0) rep.notes.push_back(fmt::format("{} blank line(s) inside the data skipped", blank_lines));
-  for (Stream s : present) {
-    const StreamCursor& cur = cursors[streamIndex(s)];
+  for (Stream s : rows.present()) {
+    const StreamCursor& cur = rows.cursor(s);
     if (cur.duplicates > 0) {
       rep.notes.push_back(fmt::format("{} duplicate timestamp(s) in stream {}", cur.duplicates, streamName(s)));
     }
@@ -461,20 +451,63 @@ Flight parseFlightCsv(std::string_view text, const std::string& source, const Fl
   if (layout.present[streamIndex(Stream::kPose)] && !layout.pose_quat) {
     rep.notes.push_back("pose carries position only (no quaternion columns)");
   }
+}
 
-  // ---- required streams
+/// Streams the caller requires must be present and hold samples.
+void checkRequired(const std::string& source, const Header& header, const Layout& layout, const RowParser& rows,
+                   const FlightReadOptions& options) {
   for (Stream s : options.required) {
     const int si = streamIndex(s);
     if (!layout.present[si]) {
-      failAt(header_line, 0, "",
+      failAt(source, header.line, 0, "",
              fmt::format("required stream '{}' is missing: no '{}' column in the header", streamName(s),
                          fieldName(s, 0)));
     }
-    if (cursors[si].count == 0) {
+    if (rows.cursor(s).count == 0) {
       const int c = layout.col[si][0];
-      failAt(header_line + 1, c + 1, names[c], fmt::format("required stream '{}' has no samples", streamName(s)));
+      failAt(source, header.line + 1, c + 1, header.names[c],
+             fmt::format("required stream '{}' has no samples", streamName(s)));
     }
   }
+}
+
+}  // namespace
+
+Flight parseFlightCsv(std::string_view text, const std::string& source, const FlightReadOptions& options,
+                      ReadReport* report) {
+  Flight flight;
+  flight.source = source;
+  ReadReport local_report;
+  ReadReport& rep = report != nullptr ? *report : local_report;
+  rep = ReadReport{};
+  rep.n_bytes = text.size();
+
+  io_detail::LineCursor lines(text);  // skips a UTF-8 BOM, strips CR
+  const Header header = readHeader(lines, source);
+  const Layout layout = makeLayout(header.names, [&](std::size_t i, const std::string& name, const std::string& msg) {
+    failAt(source, header.line, i + 1, name, msg);
+  });
+  flight.columns = header.names;
+  flight.pose_has_orientation = layout.present[streamIndex(Stream::kPose)] && layout.pose_quat;
+  reserveStreams(layout, lines.rest(), flight);
+
+  RowParser rows(source, header, layout, options, flight);
+  std::size_t blank_lines = 0;
+  std::size_t pending_blank = 0;  // blank lines not yet known to be trailing (tolerated unless inside the data)
+  const char* b = nullptr;
+  const char* e = nullptr;
+  while (lines.next(b, e)) {
+    if (isBlankLine(b, e)) {
+      ++pending_blank;
+      continue;
+    }
+    blank_lines += pending_blank;
+    pending_blank = 0;
+    ++rep.n_rows;
+    rows.parseRow(lines.line(), b, e);
+  }
+  addNotes(rows, layout, blank_lines, rep);
+  checkRequired(source, header, layout, rows, options);
   return flight;
 }
 

@@ -36,7 +36,9 @@ class QuadImuProcessJacobian : public ::testing::TestWithParam<std::tuple<AccelM
 
 TEST_P(QuadImuProcessJacobian, FMatchesCentralDifferences) {
   // GIVEN a random state, IMU reading and step
-  const auto [model, seed] = GetParam();
+  // std::get, not a structured binding: lambdas below capture `model` (clang 14 rejects capturing a binding)
+  const auto model = std::get<0>(GetParam());
+  const auto seed = std::get<1>(GetParam());
   SCOPED_TRACE("seed " + std::to_string(seed));
   std::mt19937 rng(seed);
   const NavState x = randomState(rng);
@@ -55,7 +57,9 @@ TEST_P(QuadImuProcessJacobian, FMatchesCentralDifferences) {
 
 TEST_P(QuadImuProcessJacobian, GMatchesCentralDifferences) {
   // GIVEN a random state, reading and step
-  const auto [model, seed] = GetParam();
+  // std::get, not a structured binding: lambdas below capture `model` (clang 14 rejects capturing a binding)
+  const auto model = std::get<0>(GetParam());
+  const auto seed = std::get<1>(GetParam());
   std::mt19937 rng(seed + 100);
   const NavState x = randomState(rng);
   const ImuReading imu = randomImu(rng);

@@ -93,6 +93,9 @@ TEST(AnchorSurveyMalformed, QuaternionWithoutPosition) {
 TEST(AnchorSurveyMalformed, MalformedLabel) {
   expectSurveyError("an0_p,1,2,3\nanchor1,1,2,3\n", {":2:1", "malformed survey line"});
   expectSurveyError("anX_p,1,2,3\n", {":1:1", "malformed anchor id"});
+  expectSurveyError("an2147483647_p,1,2,3\n", {":1:1", "malformed anchor id", "[0, 255]"});
+  expectSurveyError("an256_p,1,2,3\n", {":1:1", "[0, 255]"});
+  expectSurveyError("an-1_p,1,2,3\n", {":1:1", "malformed anchor id"});
   expectSurveyError("an1_pos,1,2,3\n", {":1:1", "unknown kind 'pos'"});
 }
 

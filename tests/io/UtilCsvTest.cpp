@@ -222,6 +222,14 @@ TEST(UtilCsvMalformed, NonIntegerAnchorId) {
   expectInputError(kSmallHeader + "0.1,1.5,2,0.5,0.1,1,2,3\n", {":2:2 (idA)", "anchor id must be an integer"});
 }
 
+TEST(UtilCsvMalformed, AnAnchorIdBeyondTheLimitIsAnErrorNotATable) {
+  // GIVEN the two-line CSV that made `inspect` allocate gigabytes (a table sized by the largest id)
+  expectInputError("t_tdoa,idA,idB,tdoa_meas\n0.1,2147483647,0,0.5\n", {":2:2 (idA)", "[0, 255]", "2147483647"});
+  expectInputError("t_tdoa,idA,idB,tdoa_meas\n0.1,0,256,0.5\n", {":2:3 (idB)", "[0, 255]"});
+  expectInputError("t_tdoa,idA,idB,tdoa_meas\n0.1,-1,2,0.5\n", {":2:2 (idA)", "[0, 255]"});
+  expectInputError("t_tdoa,idA,idB,tdoa_meas\n0.1,1e300,2,0.5\n", {":2:2 (idA)", "[0, 255]"});
+}
+
 TEST(UtilCsvMalformed, TimeGoingBackwardsWithinAStream) {
   expectInputError(kSmallHeader + "0.1,1,2,0.5,0.3,1,2,3\n0.2,1,2,0.5,0.2,1,2,3\n",
                    {":3:5 (t_pose)", "time goes backwards in stream 'pose'"});

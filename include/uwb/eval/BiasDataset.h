@@ -54,6 +54,7 @@ struct BiasDatasetParams {
 struct BiasSample {
   TdoaFeature feature;
   double error_m = 0.0;  ///< ε [m]
+  double measured_m = 0.0;  ///< the measured TDoA [m] (the flight's tdoa_meas)
   double t_s = 0.0;
   int flight = 0;        ///< index of the source flight
 };

@@ -10,6 +10,10 @@
 
 namespace uwb {
 
+/// Largest anchor id the readers accept (Loco Positioning anchors carry an 8-bit id). Tables indexed by id stay
+/// small; a file with id 2147483647 is refused with its line instead of allocating gigabytes.
+inline constexpr int kMaxAnchorId = 255;
+
 struct Anchor {
   int id = 0;
   Vec3 w_p = Vec3::Zero();        ///< anchor antenna position in the world (Vicon) frame [m]

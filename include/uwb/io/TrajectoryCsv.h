@@ -6,6 +6,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "uwb/core/Types.h"
@@ -25,5 +26,7 @@ using Trajectory = std::vector<TrajectorySample>;
 
 void writeTrajectoryCsv(const Trajectory& trajectory, const std::string& path);
 Trajectory readTrajectoryCsv(const std::string& path);
+/// Same as readTrajectoryCsv on text already in memory; `source` names it in messages.
+Trajectory parseTrajectoryCsv(std::string_view text, const std::string& source);
 
 }  // namespace uwb

@@ -66,6 +66,8 @@ const std::vector<std::string>& utilTdoaColumns();
 
 /// Reads a UTIL anchor survey (`an{i}_p,x,y,z` lines, then `an{i}_quat,qx,qy,qz,qw`), any number of anchors.
 AnchorSurvey readAnchorSurvey(const std::string& path);
+/// Same as readAnchorSurvey on text already in memory; `source` names it in messages (and becomes survey.source).
+AnchorSurvey parseAnchorSurvey(std::string_view text, const std::string& source);
 
 /// Writes a survey that readAnchorSurvey reads back exactly.
 void writeAnchorSurvey(const AnchorSurvey& survey, const std::string& path);

@@ -1,0 +1,117 @@
+#!/usr/bin/env python3
+"""Seed corpora of the fuzz harnesses (fuzz/, scripts/fuzz.sh): small cut-down copies of real UTIL files.
+
+    scripts/make_fuzz_corpus.py OUT_DIR [DATA_DIR]      (DATA_DIR: $UWBTDOA_DATA or ../shared/data)
+
+Writes OUT_DIR/<harness>/seed_* : the first rows of a few real flights (full 27-column layout, position-only
+extract, a TWR-free subset), surveys, a trajectory CSV derived from a flight's ground truth, bias-model JSON and
+config JSON. Without the real data it writes the same kinds of files from built-in rows.
+"""
+import json
+import math
+import os
+import sys
+from pathlib import Path
+
+out = Path(sys.argv[1])
+data = Path(sys.argv[2] if len(sys.argv) > 2 else os.environ.get("UWBTDOA_DATA", Path(__file__).resolve().parents[1] / ".." / "shared" / "data"))
+real = data / "real"
+
+FALLBACK_FLIGHT = """t_tdoa,idA,idB,tdoa_meas,t_acc,acc_x,acc_y,acc_z,t_gyro,gyro_x,gyro_y,gyro_z,t_tof,tof,t_flow,deltaX,deltaY,t_baro,baro,t_pose,pose_x,pose_y,pose_z,pose_qx,pose_qy,pose_qz,pose_qw
+0.005383,7,1,-1.91424,0.000000,-0.002647779,0.004686676,1.000256,0.000017,-0.04690039,-0.1693154,0.007582872,0.018830,0.015,1.178125,-1,0,0.000036,181.1233,0.000496,1.498,0.038,0.03,-0.006918853,-0,-0.03044295,0.9995126
+0.007873,1,3,-1.309002,0.000935,-0.002654601,0.004758866,1.000237,0.000959,-0.01746717,-0.1386006,-0.003362787,0.060879,0.017,1.188106,1,4,0.000979,181.1233,0.003314,1.498,0.038,0.03,-0.008302623,-0.001383771,-0.02905918,0.9995422
+"""
+FALLBACK_SURVEY = """an0_p,-3.04,-4.04,0.21
+an1_p,-3.23,3.76,2.95
+an2_p,3.69,3.71,0.17
+an3_p,4.10,-4.27,3.20
+an0_quat,0.66,0.25,0.66,-0.26
+"""
+
+
+def head(path, rows):
+    """The header and the first `rows` data lines of a text file."""
+    lines = []
+    with open(path, newline="") as f:
+        for i, line in enumerate(f):
+            if i > rows:
+                break
+            lines.append(line)
+    return "".join(lines)
+
+
+def put(harness, name, text):
+    d = out / harness
+    d.mkdir(parents=True, exist_ok=True)
+    (d / name).write_text(text)
+
+
+flights = []
+pilot = real / "util-pilot" / "0425" / "0425-traj2.csv"
+extract = real / "util-final-extract" / "const4-trial1-tdoa2-traj1.csv"
+if pilot.is_file():
+    flights.append(("pilot", head(pilot, 12)))
+if extract.is_file():
+    flights.append(("extract", head(extract, 8)))
+if not flights:
+    flights.append(("builtin", FALLBACK_FLIGHT))
+for tag, text in flights:
+    put("flight_csv", f"seed_{tag}.csv", text)
+    put("flight_csv", f"seed_{tag}_short.csv", "".join(text.splitlines(True)[:3]))
+# A stream subset: TDoA and pose only, from the full layout (columns picked by name).
+lines = flights[0][1].splitlines()
+names = lines[0].split(",")
+keep = [i for i, n in enumerate(names) if n in ("t_tdoa", "idA", "idB", "tdoa_meas", "t_pose", "pose_x", "pose_y", "pose_z")]
+put("flight_csv", "seed_subset.csv", "\n".join(",".join(l.split(",")[i] for i in keep) for l in lines) + "\n")
+
+surveys = [real / "util-pilot" / "survey" / "anchor_0425_survey.txt",
+           real / "util-final-extract" / "survey" / "anchor_const4_survey.txt"]
+found = [s for s in surveys if s.is_file()]
+for s in found:
+    text = s.read_text()
+    put("survey", "seed_" + s.stem + ".txt", text)
+    put("survey", "seed_" + s.stem + "_positions.txt", "".join(l for l in text.splitlines(True) if "_p," in l)[:400])
+if not found:
+    put("survey", "seed_builtin.txt", FALLBACK_SURVEY)
+
+# Trajectory CSV (the `localize --out` layout) from the first rows' ground-truth pose.
+traj = ["t,x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz"]
+idx = {n: i for i, n in enumerate(names)}
+if "t_pose" in idx:
+    for l in lines[1:6]:
+        c = l.split(",")
+        q = [c[idx[k]] if k in idx else ("1" if k == "pose_qw" else "0") for k in ("pose_qx", "pose_qy", "pose_qz", "pose_qw")]
+        traj.append(",".join([c[idx["t_pose"]], c[idx["pose_x"]], c[idx["pose_y"]], c[idx["pose_z"]], *q,
+                              "0.05", "0.05", "0.08", "0", "0", "0"]))
+put("trajectory_csv", "seed_traj.csv", "\n".join(traj) + "\n")
+
+
+def svgp(m_points, dims, l):
+    """A small SVGP block in the layout of gp::Svgp::toJson (identity q(u) factor, ARD squared exponential)."""
+    Z = [[round(math.sin(1.3 * i + k), 4) for k in range(dims)] for i in range(m_points)]
+    L = [[1.0 if r == c else 0.0 for c in range(m_points)] for r in range(m_points)]
+    return {"format": "uwbtdoa-svgp", "version": 1,
+            "kernel": {"combination": "sum_of_products", "terms": [[0]], "fixed": [], "name": "se",
+                       "parts": [{"type": "se", "active_dims": list(range(dims)), "sigma2": 0.01, "l": [l] * dims}]},
+            "inducing_points": Z, "variational": {"m": [0.01 * i for i in range(m_points)], "L": L},
+            "mean": {"type": "constant", "constant": 0.0}, "likelihood": {"type": "gaussian", "noise": 0.01},
+            "jitter": 1e-6, "input_transform": {"shift": [0.0] * dims, "scale": [1.0] * dims}}
+
+
+model_global = {"format": "uwbtdoa-bias-model", "version": 1, "preset": "tdoa", "features": "body_positions",
+                "feature_columns": 6, "per_pair": False,
+                "models": [{"id_a": -1, "id_b": -1, "svgp": svgp(3, 6, 1.0)}], "pair_means": [],
+                "extra_variance_m2": 0.0, "training": {"inputs": "estimate"}}
+put("bias_model", "seed_global.json", json.dumps(model_global, indent=1))
+model_pairs = dict(model_global, preset="pair-tdoa", per_pair=True,
+                   models=[{"id_a": 0, "id_b": 1, "svgp": svgp(2, 6, 0.5)}, {"id_a": 1, "id_b": 2, "svgp": svgp(2, 6, 2.0)}],
+                   pair_means=[{"id_a": 0, "id_b": 1, "mean_m": 0.05}])
+put("bias_model", "seed_pairs.json", json.dumps(model_pairs))
+
+put("config_json", "seed_localize.json", json.dumps({"tdoa_sigma_m": 0.1, "robust_loss": "cauchy", "robust_iterations": 2,
+                                                     "b_t_tag": [0, 0, 0.03], "fuse_tof": True, "process_model": "imu"}))
+put("config_json", "seed_localize_start.json", json.dumps({"start_w_p_b": [1.5, 0.0, 0.1], "ground_phase": "detect"}))
+put("config_json", "seed_simulate.json", json.dumps({"bias": {"enabled": True, "multipath_features": 8, "noise_std_m": 0.05},
+                                                     "trajectory": {"radius_m": 1.0}, "imu": {"rate_hz": 500.0},
+                                                     "b_t_tag": [0, 0, 0.02]}))
+print(f"seed corpora written to {out}")
