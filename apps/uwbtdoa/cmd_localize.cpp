@@ -30,8 +30,6 @@ namespace {
 
 using nlohmann::json;
 
-}
-
 json statsJson(const uwb::PositionErrorStats& s) {
   return {{"n", s.n},
           {"rmse_m", s.rmse_m},

@@ -145,7 +145,7 @@ void Estimator::startAcquisition(double t_s, bool reacquisition) {
     if (summary_.reacquisition_t_s.size() < 100) summary_.reacquisition_t_s.push_back(t_s);
   }
   // at rest the body stays where it is: position only; otherwise position and velocity (F16b)
-  start_.begin(t_s, ekf_.state(), !(imu_mode_ && on_ground_));
+  start_.begin(t_s, ekf_.state(), !(imu_mode_ && on_ground_), reacquisition);
 }
 
 void Estimator::finishStart(double t_s, const StartFix& fix) {

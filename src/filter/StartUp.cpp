@@ -28,9 +28,10 @@ StartUp::StartUp(const AnchorTable& anchors, const Vec3& b_t_tag, const StartUpP
   samples_.reserve(4096);  // ≥ max_window_s of TDoA at the LPS rates: no allocation per event
 }
 
-void StartUp::begin(double t_s, const NavState& x_ref, bool moving) {
+void StartUp::begin(double t_s, const NavState& x_ref, bool moving, bool reacquisition) {
   active_ = true;
   moving_ = moving;
+  reacquisition_ = reacquisition;
   t_ref_ = t_try_ = t_s;
   x_ref_ = x_ref;
   samples_.clear();
@@ -51,7 +52,7 @@ std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x
       floor_z_m ? multilaterateOnFloor(samples_, anchors_, b_t_tag_, guesses_, *floor_z_m)
       : moving  ? multilaterateMoving(samples_, anchors_, b_t_tag_, guesses_, t_ref_)
                 : multilaterate(samples_, anchors_, b_t_tag_, guesses_);
-  const bool inside = r && (r->w_p0.array() >= box_min_.array() - params_.box_margin_m).all() &&
+  const bool inside = r && (!reacquisition_ || r->rms_residual_m <= params_.max_rms_residual_m) && (r->w_p0.array() >= box_min_.array() - params_.box_margin_m).all() &&
                       (r->w_p0.array() <= box_max_.array() + params_.box_margin_m).all() &&
                       (!moving || r->w_v0.norm() < 5.0);
   if (!inside) {

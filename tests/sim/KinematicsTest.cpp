@@ -92,21 +92,34 @@ TEST(Kinematics, ImuNoiseAndBiasHaveTheConfiguredMagnitudes) {
   const SimResult r = simulateFlight(sc, SimParams{}, 11);
   const ImuParams ip;
   // WHEN we subtract truth and bias from the samples
+  // (flying and on the ground with the motors off separately: S10)
+  const Trajectory traj(sc.trajectory);
   Vec3 sum_acc = Vec3::Zero(), sum_sq_acc = Vec3::Zero(), sum_sq_gyro = Vec3::Zero();
+  Vec3 sum_sq_acc_rest = Vec3::Zero(), sum_sq_gyro_rest = Vec3::Zero();
+  double n = 0.0, n_rest = 0.0;
   for (std::size_t i = 0; i < r.flight.acc.size(); ++i) {
     const ImuTruth& t = r.imu_truth[i];
     const Vec3 na = r.flight.acc[i].b_value - t.b_specific_force - t.b_acc_bias;
     const Vec3 ng = r.flight.gyro[i].b_value - t.b_omega - t.b_gyro_bias;
+    if (traj.evaluate(r.flight.acc[i].t_s).on_ground) {
+      sum_sq_acc_rest += na.cwiseProduct(na);
+      sum_sq_gyro_rest += ng.cwiseProduct(ng);
+      n_rest += 1.0;
+      continue;
+    }
     sum_acc += na;
     sum_sq_acc += na.cwiseProduct(na);
     sum_sq_gyro += ng.cwiseProduct(ng);
+    n += 1.0;
   }
-  const double n = static_cast<double>(r.flight.acc.size());
-  // THEN the white noise has the configured standard deviation and zero mean
+  ASSERT_GT(n_rest, 1000.0);
+  // THEN the white noise has the configured standard deviation and zero mean, in flight and at rest
   for (int a = 0; a < 3; ++a) {
     EXPECT_NEAR(std::sqrt(sum_sq_acc[a] / n), ip.acc_noise_std_mps2, 0.02 * ip.acc_noise_std_mps2);
     EXPECT_NEAR(std::sqrt(sum_sq_gyro[a] / n), ip.gyro_noise_std_rps, 0.02 * ip.gyro_noise_std_rps);
     EXPECT_NEAR(sum_acc[a] / n, 0.0, 5.0 * ip.acc_noise_std_mps2 / std::sqrt(n));
+    EXPECT_NEAR(std::sqrt(sum_sq_acc_rest[a] / n_rest), ip.rest_acc_noise_std_mps2, 0.05 * ip.rest_acc_noise_std_mps2);
+    EXPECT_NEAR(std::sqrt(sum_sq_gyro_rest[a] / n_rest), ip.rest_gyro_noise_std_rps, 0.05 * ip.rest_gyro_noise_std_rps);
   }
   // AND the bias is non-zero and moves slowly
   EXPECT_GT(r.imu_truth.front().b_acc_bias.norm(), 0.0);

@@ -31,13 +31,18 @@ struct StartUpParams {
   double max_pos_sigma_m = 2.0;
   double min_vel_sigma_mps = 0.15;  ///< the fix's velocity std is at least this [m/s]
   double box_margin_m = 1.0;        ///< a solution outside the anchors' box grown by this is a failed solve [m]
+  /// … and, in a re-acquisition, one whose robustly weighted RMS residual is above this [m]: the TDoA do not agree on
+  /// any position (garbage, a radio fault); the filter keeps predicting and the next window is tried
+  double max_rms_residual_m = 1.0;
 };
 
 class StartUp {
  public:
   StartUp(const AnchorTable& anchors, const Vec3& b_t_tag, const StartUpParams& params);
-  /// Starts collecting at t_s. x_ref is the predicted state then; `moving` selects the position-and-velocity solve.
-  void begin(double t_s, const NavState& x_ref, bool moving);
+  /// Starts collecting at t_s. x_ref is the predicted state then; `moving` selects the position-and-velocity solve;
+  /// `reacquisition` applies max_rms_residual_m (at the first start a poor fix is better than none: the floor-level
+  /// TDoA can disagree by metres, and the fix is revised in the air).
+  void begin(double t_s, const NavState& x_ref, bool moving, bool reacquisition = false);
   bool active() const { return active_; }
   void cancel() { active_ = false; samples_.clear(); }
   /// Adds a TDoA taken while the filter's predicted state is x_now; returns the fix when a solve succeeds (the
@@ -55,6 +60,7 @@ class StartUp {
   std::vector<MultilaterationSample> samples_;
   bool active_ = false;
   bool moving_ = false;
+  bool reacquisition_ = false;
   double t_ref_ = 0.0, t_try_ = 0.0;
   NavState x_ref_;
 };
