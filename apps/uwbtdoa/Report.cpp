@@ -52,9 +52,8 @@ EvaluationParams EvaluationCliOptions::toParams() const {
   return p;
 }
 
-std::vector<std::string> renderFigures(const std::string& dir) {
-  const std::string python_dir = UWB_PYTHON_DIR;
-  const std::string cmd = fmt::format("PYTHONPATH='{}' /usr/bin/python3 -m uwbtdoa.plots report '{}'", python_dir, dir);
+std::string runPlots(const std::string& args) {
+  const std::string cmd = fmt::format("PYTHONPATH='{}' /usr/bin/python3 -m uwbtdoa.plots {}", UWB_PYTHON_DIR, args);
   FILE* pipe = popen(cmd.c_str(), "r");
   if (pipe == nullptr) throw FileError("cannot start python3 to render the figures: " + cmd);
   std::string output;
@@ -62,8 +61,17 @@ std::vector<std::string> renderFigures(const std::string& dir) {
   while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) output += buffer.data();
   const int status = pclose(pipe);
   if (status != 0) {
-    throw FileError(fmt::format("rendering the figures failed (exit status {}): {}\n(use --no-plots to skip)",
-                                status, cmd));
+    throw FileError(fmt::format("rendering the figures failed (exit status {}): {}", status, cmd));
+  }
+  return output;
+}
+
+std::vector<std::string> renderFigures(const std::string& dir) {
+  std::string output;
+  try {
+    output = runPlots(fmt::format("report '{}'", dir));
+  } catch (const FileError& e) {
+    throw FileError(std::string(e.what()) + "\n(use --no-plots to skip)");
   }
   std::vector<std::string> pngs;
   std::istringstream lines(output);

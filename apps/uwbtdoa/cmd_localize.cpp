@@ -4,6 +4,7 @@
  *         prints the position RMSE against the flight's ground truth.
  */
 #include <chrono>
+#include <filesystem>
 #include <deque>
 #include <ctime>
 #include <iostream>
@@ -24,6 +25,7 @@
 #include "uwb/io/TrajectoryCsv.h"
 #include "uwb/io/UtilCsv.h"
 #include "EkfConfig.h"
+#include "Report.h"
 #include "InputGuards.h"
 
 namespace {
@@ -44,7 +46,7 @@ json statsJson(const uwb::PositionErrorStats& s) {
 }
 
 struct LocalizeArgs {
-  std::string flight, anchors, out, config, bias_model;
+  std::string flight, anchors, out, config, bias_model, plot;
   bool json_out = false, tdoa_only = false, no_ground_detect = false;
   double output_period = 0.01;
   /// One CLI option per EkfParams field (uwb::ekfParamRegistry(), same order): the text given, or the bool flag.
@@ -60,6 +62,7 @@ void runLocalize(const LocalizeArgs& a) {
   uwb::app::Warnings warnings;
   // Outputs first: a run of minutes must not end in "cannot write".
   if (!a.out.empty()) uwb::checkOutputFile(a.out, "trajectory file");
+  if (!a.plot.empty()) uwb::checkOutputFile(a.plot, "plot file");
   uwb::app::checkPeriod(a.output_period, "--output-period", kMaxOutputPeriod_s);
   uwb::EkfParams params;
   bool process_model_given = false;
@@ -187,6 +190,27 @@ void runLocalize(const LocalizeArgs& a) {
   // The JSON text is made before the trajectory file appears, so a failure here leaves no output behind.
   const std::string json_text = uwb::app::dumpJson(j);
   if (!a.out.empty()) uwb::writeTrajectoryCsv(run.trajectory, a.out);
+  if (!a.plot.empty()) {
+    // x, y, z against time with the ±2σ band and the ground truth (docs/math/filter.md F23); drawn to a temporary
+    // name beside the target and renamed, so the PNG appears complete or not at all
+    const std::filesystem::path png(a.plot);
+    const std::filesystem::path tmp_traj = png.parent_path() / (png.filename().string() + ".trajectory.tmp.csv");
+    const std::filesystem::path tmp_png = png.parent_path() / (png.filename().string() + ".tmp.png");
+    const auto cleanup = [&] {
+      std::error_code ec;
+      std::filesystem::remove(tmp_traj, ec);
+      std::filesystem::remove(tmp_png, ec);
+    };
+    try {
+      uwb::writeTrajectoryCsv(run.trajectory, tmp_traj.string());
+      uwb::app::runPlots("position '" + tmp_traj.string() + "' '" + a.flight + "' '" + tmp_png.string() + "'");
+      std::filesystem::rename(tmp_png, png);
+    } catch (...) {
+      cleanup();
+      throw;
+    }
+    cleanup();
+  }
   if (a.json_out) {
     std::cout << json_text << '\n';
     return;
@@ -225,6 +249,8 @@ const bool kRegistered = uwb::app::registerCommand(
        sub.add_option("flight", a->flight, "Flight CSV (UTIL layout)")->required();
        sub.add_option("--anchors", a->anchors, "Anchor survey (UTIL survey text)")->required();
        sub.add_option("--out", a->out, "Write the estimated trajectory CSV here");
+       sub.add_option("--plot", a->plot,
+                      "Draw x, y, z against time with the ±2σ band and the ground truth to this PNG (python3)");
        sub.add_flag("--json", a->json_out, "Print one JSON object with the results");
        sub.add_option("--config", a->config,
                       "JSON file with an object of EkfParams fields, e.g. {\"tdoa_sigma_m\": 0.3} (keys: uwbtdoa "
