@@ -335,12 +335,15 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
       n_low_z_ = std::min(n_low_z_ + 1, low_z_.size());
       t_low_z_sample_ = t_s;
     }
-    double z_low = ready_ ? ekf_.state().w_p_b.z() : 0.0;
-    for (std::size_t k = 0; k < n_low_z_; ++k) z_low = std::min(z_low, low_z_[k]);
     // shaking near the floor, or shaking for long wherever the estimate is (flight shakes only briefly)
+    const auto lowestRecentZ = [&] {
+      double z_low = ekf_.state().w_p_b.z();
+      for (std::size_t k = 0; k < n_low_z_; ++k) z_low = std::min(z_low, low_z_[k]);
+      return z_low;
+    };
     const bool contact = t_s - t_last_shake_ < kContactHold_s &&
-                         (!ready_ || z_low - params_.ground_z_m < kContactMaxHeight_m ||
-                          t_s - t_shake_since_ >= kContactSustained_s);
+                         (!ready_ || t_s - t_shake_since_ >= kContactSustained_s ||
+                          lowestRecentZ() - params_.ground_z_m < kContactMaxHeight_m);
     const bool ground_now = (rest_.atRest() || contact) && !climbing;
     if (ground_now && !on_ground_) {
       predictTo(t_s);
