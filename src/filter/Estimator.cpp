@@ -76,16 +76,10 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
   params_.validate();
   if (anchors_.size() < 4) throw std::invalid_argument("Estimator: at least 4 anchors are needed");
   summary_.process_model = params_.process_model;
-  const std::vector<int> ids = anchors_.ids();
-  box_min_ = Vec3::Constant(1e300);
-  box_max_ = Vec3::Constant(-1e300);
-  for (int id : ids) {
-    const Vec3& a = anchors_.find(id)->m;
-    centroid_ += a;
-    box_min_ = box_min_.cwiseMin(a);
-    box_max_ = box_max_.cwiseMax(a);
-  }
-  centroid_ /= static_cast<double>(ids.size());
+  const AnchorBox box = anchorBox(anchors_);
+  box_min_ = box.min;
+  box_max_ = box.max;
+  centroid_ = box.centroid;
 
   track_opt_.sigma_m = params_.tdoa_sigma_m;
   track_opt_.gate_sigma = params_.gate_sigma;

@@ -11,18 +11,10 @@ namespace uwb {
 
 StartUp::StartUp(const AnchorTable& anchors, const Vec3& b_t_tag, const StartUpParams& params)
     : anchors_(anchors), b_t_tag_(b_t_tag), params_(params) {
-  const std::vector<int> ids = anchors_.ids();
-  if (ids.empty()) throw std::invalid_argument("StartUp: no anchors");
-  Vec3 centroid = Vec3::Zero();
-  box_min_ = Vec3::Constant(1e300);
-  box_max_ = Vec3::Constant(-1e300);
-  for (int id : ids) {
-    const Vec3& a = anchors_.find(id)->m;
-    centroid += a;
-    box_min_ = box_min_.cwiseMin(a);
-    box_max_ = box_max_.cwiseMax(a);
-  }
-  centroid /= static_cast<double>(ids.size());
+  const AnchorBox box = anchorBox(anchors_);  // throws when there are no anchors
+  box_min_ = box.min;
+  box_max_ = box.max;
+  const Vec3& centroid = box.centroid;
   // starting guesses: near the floor, at flight height, at the anchors' centroid
   guesses_ = {Vec3(centroid.x(), centroid.y(), 0.5), Vec3(centroid.x(), centroid.y(), 1.5), centroid};
   samples_.reserve(4096);  // ≥ max_window_s of TDoA at the LPS rates: no allocation per event

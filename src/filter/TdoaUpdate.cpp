@@ -23,6 +23,20 @@ void AnchorTable::set(int id, const Vec3& w_p, double sigma_m) {
   known_[id] = 1;
 }
 
+AnchorBox anchorBox(const AnchorTable& anchors) {
+  const std::vector<int> ids = anchors.ids();
+  if (ids.empty()) throw std::invalid_argument("anchorBox: no anchors");
+  AnchorBox box{Vec3::Constant(1e300), Vec3::Constant(-1e300), Vec3::Zero()};
+  for (int id : ids) {
+    const Vec3& a = anchors.find(id)->m;
+    box.min = box.min.cwiseMin(a);
+    box.max = box.max.cwiseMax(a);
+    box.centroid += a;
+  }
+  box.centroid /= static_cast<double>(ids.size());
+  return box;
+}
+
 std::vector<int> AnchorTable::ids() const {
   std::vector<int> out;
   for (std::size_t i = 0; i < known_.size(); ++i)

@@ -96,6 +96,9 @@ class Estimator {
   /// params.validate() is called; throws std::invalid_argument when the params are bad or fewer than 4 anchors are
   /// given. With params.process_model == kImu the estimator waits for IMU samples; otherwise TDoA alone drive it.
   Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor bias = {});
+  // the start-up component refers to this estimator's anchor table: not copied or moved
+  Estimator(const Estimator&) = delete;
+  Estimator& operator=(const Estimator&) = delete;
 
   void addImu(double t_s, const ImuReading& imu);
   void addTdoa(const TdoaObservation& z);

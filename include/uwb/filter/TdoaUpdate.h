@@ -33,6 +33,13 @@ class AnchorTable {
   std::vector<unsigned char> known_;  ///< 1 where an anchor is set (bytes: find() is on the per-TDoA path)
 };
 
+/// The anchors' axis-aligned bounding box and centroid [m] (starting guesses, plausibility bounds).
+struct AnchorBox {
+  Vec3 min = Vec3::Zero(), max = Vec3::Zero(), centroid = Vec3::Zero();
+};
+/// Throws std::invalid_argument when the table is empty.
+AnchorBox anchorBox(const AnchorTable& anchors);
+
 /// One TDoA as the filter sees it: tdoa_m = |p_tag − a_B| − |p_tag − a_A| (UTIL convention).
 struct TdoaObservation {
   double t_s = 0.0;
