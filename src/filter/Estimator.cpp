@@ -35,6 +35,8 @@ constexpr double kDivergedSpeed_mps = 8.0;
 constexpr double kMaxIntegrationGap_s = 0.25;
 /// Pairs seen within this window enter the reported bias floor (F23) [s].
 constexpr double kRecentPairWindow_s = 0.5;
+/// The bias floor's geometry term is recomputed at most this often [s] (F23).
+constexpr double kBiasFloorPeriod_s = 0.05;
 constexpr int kMaxPairId = 64;
 /// Floor constraint std [m] (F22).
 constexpr double kFloorSigma_m = 0.02;
@@ -98,6 +100,7 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
   tof_opt_.floor_z_m = params_.floor_z_m;
   tof_opt_.max_range_m = params_.tof_max_range_m;
   if (params_.pair_bias_tau_s > 0.0) pair_offsets_.resize(kMaxPairId * kMaxPairId);
+  bias_floor_ = Mat3::Identity() * params_.output_bias_sigma_m * params_.output_bias_sigma_m;
   recent_pairs_.reserve(64);
 }
 
@@ -363,10 +366,11 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
   } else if (t_s - t_last_zupt_ >= kZuptPeriod_s) {
     t_last_zupt_ = t_s;
     applyFloorConstraint(false);
-  }
-  if (ready_ && !start_.active() && diverged()) {
-    propagate(true);
-    startAcquisition(t_s, true);
+    // (F16) divergence is checked at the same 10 ms period
+    if (ready_ && !start_.active() && diverged()) {
+      propagate(true);
+      startAcquisition(t_s, true);
+    }
   }
 }
 
@@ -485,6 +489,11 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     if (it != recent_pairs_.end()) it->t_s = t;
     else if (recent_pairs_.size() < recent_pairs_.capacity()) recent_pairs_.push_back({z.id_a, z.id_b, t});
   }
+  // (F23) the geometry term changes slowly with the position and the pairs in view: refreshed every 50 ms of TDoA
+  if (!(t - t_bias_floor_s_ < kBiasFloorPeriod_s && t >= t_bias_floor_s_)) {
+    bias_floor_ = biasFloor();
+    t_bias_floor_s_ = t;
+  }
   // (F16) lost: nothing accepted for max_lost_s → find the position again by multilateration from fresh TDoA
   if (!acquiring && t - t_last_accept_ > params_.max_lost_s && n_rejected_streak_ > kLostMinRejections) {
     startAcquisition(t, true);
@@ -494,8 +503,12 @@ void Estimator::addTdoa(const TdoaObservation& z) {
 }
 
 Mat3 Estimator::reportedPositionCovariance() const {
-  Mat3 P = ekf_.covariance().block<3, 3>(kPos, kPos);
+  const Mat3 P = ekf_.covariance().block<3, 3>(kPos, kPos);
   if (!(params_.output_bias_sigma_m > 0.0) || !ready_) return P;
+  return P + bias_floor_;
+}
+
+Mat3 Estimator::biasFloor() const {
   // (F23) a slowly varying TDoA bias of std σ_b per pair, common over the pairs in view, moves the position by
   // (HᵀH)⁻¹Hᵀ b: covariance σ_b² (HᵀH)⁻¹ with H the rows ∂z/∂p of the pairs seen recently
   const NavState& x = ekf_.state();
@@ -513,9 +526,10 @@ Mat3 Estimator::reportedPositionCovariance() const {
     HtH += h * h.transpose();
     ++n;
   }
-  if (n < 3) return P + Mat3::Identity() * params_.output_bias_sigma_m * params_.output_bias_sigma_m;
+  const double s2 = params_.output_bias_sigma_m * params_.output_bias_sigma_m;
+  if (n < 3) return Mat3::Identity() * s2;
   const Eigen::LDLT<Mat3> ldlt(HtH + 1e-6 * Mat3::Identity());
-  return P + params_.output_bias_sigma_m * params_.output_bias_sigma_m * ldlt.solve(Mat3::Identity());
+  return s2 * ldlt.solve(Mat3::Identity());
 }
 
 LocalizerEstimate Estimator::estimate() const {

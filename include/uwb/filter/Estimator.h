@@ -130,6 +130,8 @@ class Estimator {
   bool diverged() const;
   /// Reported position covariance: the filter's plus the bias floor (F23).
   Mat3 reportedPositionCovariance() const;
+  /// σ_b² (HᵀH)⁻¹ of the pairs in view (F23).
+  Mat3 biasFloor() const;
 
   EkfParams params_;
   AnchorTable anchors_;
@@ -182,6 +184,8 @@ class Estimator {
     double t_s = -1e300;
   };
   std::vector<RecentPair> recent_pairs_;
+  Mat3 bias_floor_ = Mat3::Zero();  ///< biasFloor() at t_bias_floor_s_; σ_b² I before the first TDoA (F23)
+  double t_bias_floor_s_ = -1e300;
 };
 
 }  // namespace uwb
