@@ -62,7 +62,10 @@ std::vector<SimScenarioRun> protocolSimulations(const std::string& data_dir, con
     for (std::uint64_t seed : seeds) {
       const sim::SimParams sp = simParams(seed);
       const std::string tag = layout.name + "-s" + std::to_string(seed);
-      {
+      const auto want = [&](const std::string& scenario) {
+        return only.empty() || (scenario + "-" + tag).find(only) != std::string::npos;
+      };
+      if (want("hover-start")) {
         // start in hover: a circle with a vertical sine, the log cut 2 s after the climb until before the landing
         sim::Scenario sc = sim::makeScenario(layout.survey, sim::TrajectoryShape::kCircleSine, 60.0);
         const sim::SimResult r = sim::simulateFlight(sc, sp, seed);
@@ -72,14 +75,14 @@ std::vector<SimScenarioRun> protocolSimulations(const std::string& data_dir, con
         out.push_back({"hover-start-" + tag, "hover-start", "cut in the air", sliceFlight(r.flight, t0, t1),
                        r.survey, true});
       }
-      {
-        // a still hover of 10 s between take-off and landing (must not read as landed)
+      if (want("still-hover")) {
+        // a still hover of 16 s between take-off and landing (must not read as landed)
         sim::Scenario sc = sim::makeScenario(layout.survey, sim::TrajectoryShape::kHover, 4.0 + 3.0 + 16.0 + 3.0 + 4.0);
         sc.trajectory.yaw_mode = sim::YawMode::kConstant;
         const sim::SimResult r = sim::simulateFlight(sc, sp, seed);
         out.push_back({"still-hover-" + tag, "still-hover", "full", r.flight, r.survey, false});
       }
-      {
+      if (want("two-takeoffs")) {
         // two take-offs: a circle, landing, then a hover flight from where it landed
         sim::Scenario a = sim::makeScenario(layout.survey, sim::TrajectoryShape::kCircle, 40.0);
         const sim::SimResult ra = sim::simulateFlight(a, sp, seed);
@@ -95,14 +98,14 @@ std::vector<SimScenarioRun> protocolSimulations(const std::string& data_dir, con
         append(f, rb.flight);
         out.push_back({"two-takeoffs-" + tag, "two-takeoffs", "full", f, ra.survey, false});
       }
-      {
+      if (want("fast")) {
         // fast: a circle at 2.25 m/s, yawing
         sim::Scenario sc = sim::makeScenario(layout.survey, sim::TrajectoryShape::kCircle, 40.0);
         sc.trajectory.omega_rps = 2.25 / sc.trajectory.radius_m;
         const sim::SimResult r = sim::simulateFlight(sc, sp, seed);
         out.push_back({"fast-" + tag, "fast", "full", r.flight, r.survey, false});
       }
-      {
+      if (want("yawing-start")) {
         // a yawing figure eight started in the air (unknown yaw at the log's start)
         sim::Scenario sc = sim::makeScenario(layout.survey, sim::TrajectoryShape::kFigureEight, 50.0);
         const sim::SimResult r = sim::simulateFlight(sc, sp, seed);
@@ -114,8 +117,6 @@ std::vector<SimScenarioRun> protocolSimulations(const std::string& data_dir, con
       }
     }
   }
-  if (!only.empty())
-    std::erase_if(out, [&](const SimScenarioRun& r) { return r.name.find(only) == std::string::npos; });
   return out;
 }
 
