@@ -1,0 +1,106 @@
+/** @file cmd_stream.cpp
+ *  @brief `uwbtdoa stream --anchors SURVEY [--format json|csv] [--output-period S] [--config FILE] ...`: reads sensor
+ *         events (the line protocol of docs/io.md §5) from stdin and writes estimates to stdout as they are made.
+ *         Ends cleanly (flush, exit 0) at the end of input and on SIGINT/SIGTERM; a malformed line is an input error
+ *         naming the line number and field.
+ */
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include <unistd.h>
+
+#include "Command.h"
+#include "FilterOptions.h"
+#include "InputGuards.h"
+#include "StopSignal.h"
+#include "uwb/core/Error.h"
+#include "uwb/eval/Localization.h"
+#include "uwb/io/UtilCsv.h"
+#include "uwb/stream/EstimateFormat.h"
+#include "uwb/stream/EstimateStream.h"
+#include "uwb/stream/FdLineReader.h"
+
+namespace {
+
+struct StreamArgs {
+  std::string anchors, format = "json";
+  double output_period = 0.01;
+  uwb::app::FilterOptionArgs filter;
+};
+
+constexpr double kMaxOutputPeriod_s = 60.0;
+
+/// Estimate lines to stdout, flushed whenever the input side is about to wait.
+class LineSink {
+ public:
+  void write(const std::string& line) {
+    buf_ += line;
+    buf_ += '\n';
+    if (buf_.size() > (1u << 16)) flush();
+  }
+  void flush() {
+    std::size_t done = 0;
+    while (done < buf_.size() && ok_) {
+      const ssize_t n = ::write(STDOUT_FILENO, buf_.data() + done, buf_.size() - done);
+      if (n > 0) done += static_cast<std::size_t>(n);
+      else if (n < 0 && errno != EINTR) ok_ = false;  // consumer gone (SIGPIPE ignored): stop writing
+    }
+    buf_.clear();
+  }
+  bool ok() const { return ok_; }
+
+ private:
+  std::string buf_;
+  bool ok_ = true;
+};
+
+void runStream(const StreamArgs& a) {
+  if (a.output_period != 0.0) uwb::app::checkPeriod(a.output_period, "--output-period", kMaxOutputPeriod_s);
+  if (a.format != "json" && a.format != "csv")
+    throw uwb::InputError("--format: expected json or csv, got '" + a.format + "'");
+  const uwb::EstimateFormat format = a.format == "csv" ? uwb::EstimateFormat::kCsv : uwb::EstimateFormat::kJson;
+  const uwb::app::FilterSetup setup = uwb::app::buildFilterParams(a.filter);
+  const uwb::BiasPredictor bias = uwb::app::loadBiasPredictor(a.filter);
+  const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(a.anchors);
+  uwb::app::Warnings warnings;
+  warnings.addIssues(uwb::checkSurveyGeometry(survey));
+  uwb::EstimateStream stream(setup.params, uwb::anchorTableFromSurvey(survey, setup.params.anchor_sigma_m),
+                             a.output_period, bias);
+
+  uwb::app::installStopHandlers();
+  LineSink sink;
+  if (format == uwb::EstimateFormat::kCsv) sink.write(uwb::estimateCsvHeader());
+  uwb::FdLineReader reader(STDIN_FILENO, uwb::app::stopFlag(), [&sink] { sink.flush(); });
+  std::size_t n_out = 0;
+  for (std::string line; sink.ok() && reader.next(line);) {
+    if (stream.add(uwb::parseEventLine(line, reader.lineNumber()))) {
+      sink.write(uwb::formatEstimate(stream.last(), format));
+      ++n_out;
+    }
+  }
+  if (stream.finish()) {
+    sink.write(uwb::formatEstimate(stream.last(), format));
+    ++n_out;
+  }
+  sink.flush();
+  if (!reader.error().empty()) throw uwb::FileError("stream: reading stdin: " + reader.error());
+  std::cerr << "stream: " << stream.eventsIn() << " events, " << n_out << " estimates"
+            << (reader.stopped() ? " (stopped by signal)" : "") << (sink.ok() ? "" : " (stdout closed)") << "\n";
+}
+
+const bool kRegistered = uwb::app::registerCommand(
+    {"stream", "Localize live: sensor events on stdin (docs/io.md line protocol), estimates on stdout",
+     [](CLI::App& sub) {
+       auto a = std::make_shared<StreamArgs>();
+       sub.add_option("--anchors", a->anchors, "Anchor survey (UTIL survey text)")->required();
+       sub.add_option("--format", a->format, "Estimate lines: json (one object per line) or csv")
+           ->check(CLI::IsMember({"json", "csv"}));
+       sub.add_option("--output-period", a->output_period,
+                      "Minimum spacing of estimates [s] (0: one per IMU/TDoA event)");
+       uwb::app::addFilterOptions(sub, a->filter);
+       sub.callback([a] { runStream(*a); });
+     }});
+
+}  // namespace
