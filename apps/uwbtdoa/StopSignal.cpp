@@ -23,6 +23,11 @@ void installStopHandlers() {
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
   std::signal(SIGPIPE, SIG_IGN);
+  sigset_t set;  // a parent may have blocked them (the mask survives exec)
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  sigprocmask(SIG_UNBLOCK, &set, nullptr);
 }
 
 const volatile std::sig_atomic_t* stopFlag() { return &g_stop; }

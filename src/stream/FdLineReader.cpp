@@ -6,9 +6,14 @@
 #include <cerrno>
 #include <cstring>
 
+#include <poll.h>
 #include <unistd.h>
 
 namespace uwb {
+
+namespace {
+constexpr int kStopPoll_ms = 100;
+}  // namespace
 
 FdLineReader::FdLineReader(int fd, const volatile std::sig_atomic_t* stop, std::function<void()> before_block)
     : fd_(fd), stop_(stop), before_block_(std::move(before_block)) {}
@@ -33,6 +38,10 @@ bool FdLineReader::next(std::string& line) {
     buf_.erase(0, pos_);  // keep only the partial line
     pos_ = 0;
     if (before_block_) before_block_();
+    // wait in short slices so a stop request that lands just before the read is seen within kStopPoll_ms
+    pollfd pfd{fd_, POLLIN, 0};
+    const int ready = ::poll(&pfd, 1, kStopPoll_ms);
+    if (ready == 0 || (ready < 0 && errno == EINTR)) continue;
     char chunk[65536];
     const ssize_t n = ::read(fd_, chunk, sizeof chunk);
     if (n > 0) {

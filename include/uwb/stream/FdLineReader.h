@@ -1,6 +1,7 @@
 /** @file FdLineReader.h
  *  @brief Lines from a file descriptor (stdin of `uwbtdoa stream`) that give up when asked to stop: a signal
- *         handler sets the stop flag and the interrupted read() returns, so SIGINT/SIGTERM end the loop cleanly.
+ *         handler sets the stop flag, which is checked at least every 100 ms while waiting for input, so
+ *         SIGINT/SIGTERM end the loop cleanly.
  */
 #pragma once
 
