@@ -1,6 +1,7 @@
 /** @file cmd_stream.cpp
- *  @brief `uwbtdoa stream --anchors SURVEY [--format json|csv] [--output-period S] [--config FILE] ...`: reads sensor
- *         events (the line protocol of docs/io.md §5) from stdin and writes estimates to stdout as they are made.
+ *  @brief `uwbtdoa stream --anchors SURVEY [--in ENDPOINT] [--out ENDPOINT] [--format json|csv] [--output-period S]
+ *         [--config FILE] ...`: reads sensor events (the line protocol of docs/io.md §5) from stdin or a ZeroMQ
+ *         socket and writes estimates to stdout or a ZeroMQ PUB socket as they are made.
  *         Ends cleanly (flush, exit 0) at the end of input and on SIGINT/SIGTERM; a malformed line is an input error
  *         naming the line number and field.
  */
@@ -21,11 +22,12 @@
 #include "uwb/stream/EstimateFormat.h"
 #include "uwb/stream/EstimateStream.h"
 #include "uwb/stream/FdLineReader.h"
+#include "uwb/stream/ZmqWire.h"
 
 namespace {
 
 struct StreamArgs {
-  std::string anchors, format = "json";
+  std::string anchors, format = "json", in, out;
   double output_period = 0.01;
   uwb::app::FilterOptionArgs filter;
 };
@@ -70,24 +72,44 @@ void runStream(const StreamArgs& a) {
                              a.output_period, bias);
 
   uwb::app::installStopHandlers();
+  zmq::context_t ctx;
+  std::unique_ptr<uwb::ZmqLineSubscriber> sub;
+  std::unique_ptr<uwb::ZmqLinePublisher> pub;
+  if (!a.in.empty()) sub = std::make_unique<uwb::ZmqLineSubscriber>(ctx, a.in, uwb::kEventTopic);
+  if (!a.out.empty()) pub = std::make_unique<uwb::ZmqLinePublisher>(ctx, a.out, uwb::kEstimateTopic, false);
   LineSink sink;
-  if (format == uwb::EstimateFormat::kCsv) sink.write(uwb::estimateCsvHeader());
+  const auto emit = [&](const std::string& line) {
+    if (pub) pub->send(line);  // never blocks: a slow consumer loses estimates (counted), never sensor events
+    else sink.write(line);
+  };
+  if (format == uwb::EstimateFormat::kCsv) emit(uwb::estimateCsvHeader());
   uwb::FdLineReader reader(STDIN_FILENO, uwb::app::stopFlag(), [&sink] { sink.flush(); });
+  const auto next = [&](std::string& line) {
+    if (sub) {
+      if (!sub->next(line, uwb::app::stopFlag())) return false;
+      return true;
+    }
+    return sink.ok() && reader.next(line);
+  };
+  const std::string source = sub ? "<zmq>" : "<stdin>";
   std::size_t n_out = 0;
-  for (std::string line; sink.ok() && reader.next(line);) {
-    if (stream.add(uwb::parseEventLine(line, reader.lineNumber()))) {
-      sink.write(uwb::formatEstimate(stream.last(), format));
+  for (std::string line; next(line);) {
+    const std::size_t line_no = sub ? sub->messageNumber() : reader.lineNumber();
+    if (stream.add(uwb::parseEventLine(line, line_no, source))) {
+      emit(uwb::formatEstimate(stream.last(), format));
       ++n_out;
     }
   }
   if (stream.finish()) {
-    sink.write(uwb::formatEstimate(stream.last(), format));
+    emit(uwb::formatEstimate(stream.last(), format));
     ++n_out;
   }
+  if (pub) pub->send(uwb::kEndOfEvents);  // tells the consumer the stream ended (may be dropped like any estimate)
   sink.flush();
   if (!reader.error().empty()) throw uwb::FileError("stream: reading stdin: " + reader.error());
-  std::cerr << "stream: " << stream.eventsIn() << " events, " << n_out << " estimates"
-            << (reader.stopped() ? " (stopped by signal)" : "") << (sink.ok() ? "" : " (stdout closed)") << "\n";
+  std::cerr << "stream: " << stream.eventsIn() << " events, " << n_out << " estimates";
+  if (pub) std::cerr << ", " << pub->sent() << " sent, " << pub->dropped() << " dropped (slow consumer)";
+  std::cerr << (*uwb::app::stopFlag() ? " (stopped by signal)" : "") << (sink.ok() ? "" : " (stdout closed)") << "\n";
 }
 
 const bool kRegistered = uwb::app::registerCommand(
@@ -99,6 +121,8 @@ const bool kRegistered = uwb::app::registerCommand(
            ->check(CLI::IsMember({"json", "csv"}));
        sub.add_option("--output-period", a->output_period,
                       "Minimum spacing of estimates [s] (0: one per IMU/TDoA event)");
+       sub.add_option("--in", a->in, "Read sensor events from this ZeroMQ PUB endpoint (SUB), e.g. tcp://127.0.0.1:5555");
+       sub.add_option("--out", a->out, "Publish estimates on this ZeroMQ endpoint (PUB, bound), e.g. tcp://127.0.0.1:5556");
        uwb::app::addFilterOptions(sub, a->filter);
        sub.callback([a] { runStream(*a); });
      }});
