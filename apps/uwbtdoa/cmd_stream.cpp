@@ -5,6 +5,7 @@
  *         Ends cleanly (flush, exit 0) at the end of input and on SIGINT/SIGTERM; a malformed line is an input error
  *         naming the line number and field.
  */
+#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -22,6 +23,7 @@
 #include "uwb/stream/EstimateFormat.h"
 #include "uwb/stream/EstimateStream.h"
 #include "uwb/stream/FdLineReader.h"
+#include "uwb/stream/LatencyStats.h"
 #include "uwb/stream/ZmqWire.h"
 
 namespace {
@@ -29,6 +31,7 @@ namespace {
 struct StreamArgs {
   std::string anchors, format = "json", in, out;
   double output_period = 0.01;
+  bool stats = false;
   uwb::app::FilterOptionArgs filter;
 };
 
@@ -93,11 +96,26 @@ void runStream(const StreamArgs& a) {
   };
   const std::string source = sub ? "<zmq>" : "<stdin>";
   std::size_t n_out = 0;
+  uwb::LatencyStats latency_all, latency_out;  // --stats: arrival → handled (all events) / → estimate sent
+  using Clock = std::chrono::steady_clock;
+  Clock::time_point t_first{}, t_last{};
+  double busy_s = 0.0;
   for (std::string line; next(line);) {
+    const Clock::time_point t_arrival = a.stats ? Clock::now() : Clock::time_point{};
     const std::size_t line_no = sub ? sub->messageNumber() : reader.lineNumber();
-    if (stream.add(uwb::parseEventLine(line, line_no, source))) {
+    const bool out = stream.add(uwb::parseEventLine(line, line_no, source));
+    if (out) {
       emit(uwb::formatEstimate(stream.last(), format));
       ++n_out;
+    }
+    if (a.stats) {
+      const Clock::time_point t_done = Clock::now();
+      const double dt_s = std::chrono::duration<double>(t_done - t_arrival).count();
+      latency_all.add(dt_s);
+      if (out) latency_out.add(dt_s);
+      busy_s += dt_s;
+      if (t_first == Clock::time_point{}) t_first = t_arrival;
+      t_last = t_done;
     }
   }
   if (stream.finish()) {
@@ -110,6 +128,14 @@ void runStream(const StreamArgs& a) {
   std::cerr << "stream: " << stream.eventsIn() << " events, " << n_out << " estimates";
   if (pub) std::cerr << ", " << pub->sent() << " sent, " << pub->dropped() << " dropped (slow consumer)";
   std::cerr << (*uwb::app::stopFlag() ? " (stopped by signal)" : "") << (sink.ok() ? "" : " (stdout closed)") << "\n";
+  if (a.stats) {
+    const double wall_s = std::chrono::duration<double>(t_last - t_first).count();
+    std::cerr << "stream: latency per event, arrival to handled: " << latency_all.summary() << "\n"
+              << "stream: latency per event with an estimate, arrival to sent: " << latency_out.summary() << "\n"
+              << "stream: throughput " << (busy_s > 0 ? static_cast<double>(latency_all.size()) / busy_s : 0.0)
+              << " events/s of handling time; " << (wall_s > 0 ? static_cast<double>(latency_all.size()) / wall_s : 0.0)
+              << " events/s received over " << wall_s << " s\n";
+  }
 }
 
 const bool kRegistered = uwb::app::registerCommand(
@@ -123,6 +149,8 @@ const bool kRegistered = uwb::app::registerCommand(
                       "Minimum spacing of estimates [s] (0: one per IMU/TDoA event)");
        sub.add_option("--in", a->in, "Read sensor events from this ZeroMQ PUB endpoint (SUB), e.g. tcp://127.0.0.1:5555");
        sub.add_option("--out", a->out, "Publish estimates on this ZeroMQ endpoint (PUB, bound), e.g. tcp://127.0.0.1:5556");
+       sub.add_flag("--stats", a->stats,
+                    "Print per-event latency (arrival to estimate sent: p50/p99/max) and throughput on stderr");
        uwb::app::addFilterOptions(sub, a->filter);
        sub.callback([a] { runStream(*a); });
      }});
