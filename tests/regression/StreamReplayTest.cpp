@@ -1,7 +1,7 @@
 /** @file StreamReplayTest.cpp
- *  @brief `uwbtdoa replay | uwbtdoa stream` on 5 s of a real flight gives the batch path's estimates
- *         (TdoaLocalizer::run on the same events) to 1e-9 m; a malformed line is a located error; SIGINT ends the
- *         stream cleanly with its output flushed.
+  *  @brief `uwbtdoa replay | uwbtdoa stream` on 5 s of a real flight gives the batch path's estimates
+ *         (TdoaLocalizer::run on the same events) to 1e-9 m; a malformed line is a located error; `--speed 1` paces
+ *         in real time; SIGINT ends the stream cleanly with its output flushed.
  */
 #include <gtest/gtest.h>
 
@@ -100,6 +100,23 @@ TEST_F(StreamCli, AMalformedLineIsAnErrorNamingItsLineAndField) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("<stdin>:3:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("tdoa_m"), std::string::npos) << r.err;
+}
+
+TEST_F(StreamCli, ReplayAtSpeedOneTakesTheFlightsDuration) {
+  // GIVEN 1 s of the flight
+  const std::string one_s = (dir_ / "one_s.csv").string();
+  writeFlightCsv(sliceFlight(readFlightCsv(short_), 12.0, 13.0), one_s);
+  // WHEN it is replayed in real time, and as fast as possible
+  const auto t0 = std::chrono::steady_clock::now();
+  const test::CliResult paced = test::runCli("replay " + one_s + " --speed 1");
+  const double paced_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const test::CliResult fast = test::runCli("replay " + one_s);
+  // THEN the paced run lasts about the second the events span, and both print the same lines
+  ASSERT_EQ(paced.exit_code, 0) << paced.err;
+  EXPECT_GT(paced_s, 0.95);
+  EXPECT_LT(paced_s, 10.0);
+  EXPECT_EQ(paced.out, fast.out);
+  EXPECT_GT(paced.out.size(), 10000u);
 }
 
 /// Reads what is available on `fd` into `out` for up to `timeout_ms`; false at end of file.
