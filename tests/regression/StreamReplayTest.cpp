@@ -1,5 +1,5 @@
 /** @file StreamReplayTest.cpp
-  *  @brief `uwbtdoa replay | uwbtdoa stream` on 5 s of a real flight gives the batch path's estimates
+ *  @brief `uwbtdoa replay | uwbtdoa stream` on 5 s of a real flight gives the batch path's estimates
  *         (TdoaLocalizer::run on the same events) to 1e-9 m; a malformed line is a located error; `--speed 1` paces
  *         in real time; SIGINT ends the stream cleanly with its output flushed.
  */
