@@ -233,6 +233,10 @@ py::object jsonToPython(const nlohmann::json& j) { return py::module_::import("j
 
 }  // namespace
 
+EkfParams ekfParamsFromPython(const std::string& preset, const py::dict& overrides) {
+  return ekfParams(preset, overrides);
+}
+
 void bindEval(py::module_& m) {
   // ------------------------------------------------------------------------------------- training data
   py::class_<BiasDataset>(m, "BiasDataset",

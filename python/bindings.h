@@ -18,6 +18,7 @@
 #include <string>
 
 #include "uwb/core/Types.h"
+#include "uwb/filter/EkfParams.h"
 #include "uwb/io/Flight.h"
 #include "uwb/io/TrajectoryCsv.h"
 #include "uwb/model/TdoaFeature.h"
@@ -144,6 +145,10 @@ void bindGp(py::module_& m);
 void bindSim(py::module_& m);
 void bindGpTrain(py::module_& m);
 void bindEval(py::module_& m);
+void bindStream(py::module_& m);
+
+/// EkfParams from a preset ("defaults" | "crazyflie" | "tdoa-only") and a dict of field overrides (validated).
+EkfParams ekfParamsFromPython(const std::string& preset, const py::dict& overrides);
 
 /// Feature dict (one row per measurement: id_a, id_b, yaw_a, yaw_b, b_p_a, b_p_b, w_p_b, w_p_anchor_a, w_p_anchor_b)
 /// of TdoaFeature rows; bind_eval.cpp.

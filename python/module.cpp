@@ -44,4 +44,5 @@ PYBIND11_MODULE(_uwbtdoa, m) {
   uwb::python::bindGpTrain(m);
   uwb::python::bindSim(m);
   uwb::python::bindEval(m);
+  uwb::python::bindStream(m);
 }

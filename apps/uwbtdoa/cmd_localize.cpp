@@ -24,7 +24,7 @@
 #include "uwb/io/JsonFile.h"
 #include "uwb/io/TrajectoryCsv.h"
 #include "uwb/io/UtilCsv.h"
-#include "EkfConfig.h"
+#include "FilterOptions.h"
 #include "Report.h"
 #include "InputGuards.h"
 
@@ -46,13 +46,10 @@ json statsJson(const uwb::PositionErrorStats& s) {
 }
 
 struct LocalizeArgs {
-  std::string flight, anchors, out, config, bias_model, plot;
+  std::string flight, anchors, out, plot;
   bool json_out = false, tdoa_only = false, no_ground_detect = false;
   double output_period = 0.01;
-  /// One CLI option per EkfParams field (uwb::ekfParamRegistry(), same order): the text given, or the bool flag.
-  std::deque<std::string> param_text;
-  std::deque<bool> param_flag;
-  std::vector<CLI::Option*> param_option;
+  uwb::app::FilterOptionArgs filter;  ///< --config, --bias-model, one flag per filter parameter
 };
 
 /// Largest --output-period [s]: one sample a minute still draws a trajectory.
@@ -64,42 +61,17 @@ void runLocalize(const LocalizeArgs& a) {
   if (!a.out.empty()) uwb::checkOutputFile(a.out, "trajectory file");
   if (!a.plot.empty()) uwb::checkOutputFile(a.plot, "plot file");
   uwb::app::checkPeriod(a.output_period, "--output-period", kMaxOutputPeriod_s);
-  uwb::EkfParams params;
-  bool process_model_given = false;
-  if (!a.config.empty()) {
-    const json j = uwb::readJsonFile(a.config, "config file");
-    uwb::app::applyEkfConfig(j, a.config, params);
-    process_model_given = j.is_object() && j.contains("process_model");
-    try {
-      params.validate();
-    } catch (const std::invalid_argument& e) {
-      throw uwb::InputError(uwb::SourceLocation{a.config, 0, 0, ""}, e.what());
-    }
-  }
-  // flags override the config file
-  const std::vector<uwb::EkfParamInfo>& registry = uwb::ekfParamRegistry();
-  bool start_flag = false;
-  for (std::size_t k = 0; k < registry.size(); ++k) {
-    if (a.param_option[k]->count() == 0) continue;
-    const uwb::EkfParamInfo& info = registry[k];
-    if (info.name == "process_model") process_model_given = true;
-    if (info.name == "start_w_p_b") start_flag = true;
-    if (info.kind == uwb::EkfParamKind::kBool) uwb::setEkfParam(params, info, a.param_flag[k], info.flag());
-    else uwb::setEkfParamFromText(params, info, a.param_text[k], info.flag());
-  }
+  uwb::app::FilterSetup setup = uwb::app::buildFilterParams(a.filter);
+  uwb::EkfParams& params = setup.params;
+  const bool process_model_given = setup.process_model_given, start_flag = setup.start_flag;
   if (a.no_ground_detect) params.ground_phase = uwb::GroundPhase::kNone;
   params.validate();
-  if (!params.b_t_tag.allFinite() || params.b_t_tag.norm() > 1.0)
-    throw uwb::InputError("--tag-offset / b_t_tag: the tag must sit within 1 m of the body origin, got " +
-                          std::to_string(params.b_t_tag.norm()) + " m");
-  // the GP bias model as a plain BiasPredictor (the filter knows nothing of GPs)
-  uwb::BiasPredictor bias;
-  if (!a.bias_model.empty()) bias = uwb::BiasModel::load(a.bias_model).predictor();
+  const uwb::BiasPredictor bias = uwb::app::loadBiasPredictor(a.filter);
 
   const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(a.anchors);
   warnings.addIssues(uwb::checkSurveyGeometry(survey));
   if (params.has_start_position)
-    uwb::app::checkNearAnchors(params.start_w_p_b, survey, start_flag ? "--start" : a.config + " (start_w_p_b)");
+    uwb::app::checkNearAnchors(params.start_w_p_b, survey, start_flag ? "--start" : a.filter.config + " (start_w_p_b)");
   uwb::FlightReadOptions read_opt;
   read_opt.required = {uwb::Stream::kTdoa};
   read_opt.survey = &survey;
@@ -141,7 +113,7 @@ void runLocalize(const LocalizeArgs& a) {
   j["flight"] = a.flight;
   j["duration_s"] = run.duration_s;
   j["process_model"] = uwb::toString(s.process_model);
-  j["bias_model"] = a.bias_model.empty() ? json(nullptr) : json(a.bias_model);
+  j["bias_model"] = a.filter.bias_model.empty() ? json(nullptr) : json(a.filter.bias_model);
   j["n_tdoa"] = s.n_tdoa_total;
   j["n_tdoa_used"] = s.n_tdoa_used;
   j["n_tdoa_rejected"] = s.n_tdoa_rejected;
@@ -252,33 +224,11 @@ const bool kRegistered = uwb::app::registerCommand(
        sub.add_option("--plot", a->plot,
                       "Draw x, y, z against time with the ±2σ band and the ground truth to this PNG (python3)");
        sub.add_flag("--json", a->json_out, "Print one JSON object with the results");
-       sub.add_option("--config", a->config,
-                      "JSON file with an object of EkfParams fields, e.g. {\"tdoa_sigma_m\": 0.3} (keys: uwbtdoa "
-                      "params); flags override it");
        sub.add_flag("--tdoa-only", a->tdoa_only, "Ignore the IMU: constant-velocity model");
        sub.add_flag("--no-ground-detect", a->no_ground_detect,
                     "Use TDoA from the start (no take-off detection; = --ground-phase none)");
-       // one option per filter parameter, from the registry (uwb/filter/EkfParamRegistry.h)
-       for (const uwb::EkfParamInfo& info : uwb::ekfParamRegistry()) {
-         const std::string names = info.flag() + (info.cli_alias.empty() ? "" : ",--" + info.cli_alias);
-         const std::string help = info.doc + " " + uwb::ekfParamHelpSuffix(info);
-         a->param_text.emplace_back();
-         a->param_flag.push_back(false);
-         a->param_option.push_back(info.kind == uwb::EkfParamKind::kBool
-                                       ? sub.add_flag(names, a->param_flag.back(), help)
-                                       : sub.add_option(names, a->param_text.back(), help));
-         a->param_option.back()->group("Filter parameters");
-         if (info.kind == uwb::EkfParamKind::kReal) a->param_option.back()->type_name("FLOAT");
-         if (info.kind == uwb::EkfParamKind::kInteger) a->param_option.back()->type_name("INT");
-         if (info.kind == uwb::EkfParamKind::kVec3) a->param_option.back()->type_name("X,Y,Z");
-         if (info.kind == uwb::EkfParamKind::kChoice) {
-           std::string choices;
-           for (const std::string& c : info.choices) choices += (choices.empty() ? "" : "|") + c;
-           a->param_option.back()->type_name(choices);
-         }
-       }
+       uwb::app::addFilterOptions(sub, a->filter);
        sub.add_option("--output-period", a->output_period, "Trajectory sample spacing [s]");
-       sub.add_option("--bias-model", a->bias_model, "Bias model JSON (GP) to correct the TDoA");
        sub.callback([a] { runLocalize(*a); });
      }});
 
