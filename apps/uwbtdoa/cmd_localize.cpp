@@ -109,6 +109,14 @@ void runLocalize(const LocalizeArgs& a) {
 
   const uwb::LocalizerSummary& s = run.summary;
   const double nan = std::numeric_limits<double>::quiet_NaN();
+  // the estimate lost the TDoA or diverged and was found again (docs/math/filter.md F16): the positions around
+  // these times are not to be trusted
+  for (double t_r : s.reacquisition_t_s)
+    warnings.add("position lost and re-acquired by multilateration at t = " + std::to_string(t_r) +
+                 " s (TDoA inconsistent with the estimate, divergence, or a sensor-time jump)");
+  if (s.n_time_jumps > 0)
+    warnings.add(std::to_string(s.n_time_jumps) + " sensor-time gap(s) or backward jump(s): the IMU was not integrated "
+                 "across them");
   json j;
   j["flight"] = a.flight;
   j["duration_s"] = run.duration_s;
@@ -197,7 +205,6 @@ void runLocalize(const LocalizeArgs& a) {
   }
   if (!std::isnan(s.ready_t_s)) std::cout << "position found at " << s.ready_t_s << " s\n";
   if (!std::isnan(s.takeoff_t_s)) std::cout << "left rest at " << s.takeoff_t_s << " s\n";
-  for (double t_r : s.reacquisition_t_s) std::cout << "note: position re-acquired by multilateration at " << t_r << " s\n";
   for (const std::string& n : s.merge.notes()) std::cout << "note: " << n << "\n";
   for (const std::string& n : notes) std::cout << "note: " << n << "\n";
   if (run.metrics) {
