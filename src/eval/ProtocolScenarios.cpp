@@ -65,16 +65,18 @@ std::vector<SimScenarioRun> protocolSimulations(const std::string& data_dir, con
       const auto want = [&](const std::string& scenario) {
         return only.empty() || (scenario + "-" + tag).find(only) != std::string::npos;
       };
-      if (want("hover-start")) {
-        // start in hover: a circle with a vertical sine, the log cut 2 s after the climb until before the landing
-        sim::Scenario sc = sim::makeScenario(layout.survey, sim::TrajectoryShape::kCircleSine, 60.0);
+      // a flight whose log starts after_climb_s after the climb and ends 1 s before the landing
+      const auto cutInAir = [&](const std::string& name, sim::TrajectoryShape shape, double duration_s,
+                                double after_climb_s) {
+        sim::Scenario sc = sim::makeScenario(layout.survey, shape, duration_s);
         const sim::SimResult r = sim::simulateFlight(sc, sp, seed);
         const sim::TrajectoryParams& tp = sc.trajectory;
-        const double t0 = tp.ground_before_s + tp.takeoff_s + 2.0;
+        const double t0 = tp.ground_before_s + tp.takeoff_s + after_climb_s;
         const double t1 = tp.duration_s - tp.ground_after_s - tp.landing_s - 1.0;
-        out.push_back({"hover-start-" + tag, "hover-start", "cut in the air", sliceFlight(r.flight, t0, t1),
-                       r.survey, true});
-      }
+        out.push_back({name + "-" + tag, name, "cut in the air", sliceFlight(r.flight, t0, t1), r.survey, true});
+      };
+      // start in hover: a circle with a vertical sine, the log cut 2 s after the climb
+      if (want("hover-start")) cutInAir("hover-start", sim::TrajectoryShape::kCircleSine, 60.0, 2.0);
       if (want("still-hover")) {
         // a still hover of 16 s between take-off and landing (must not read as landed)
         sim::Scenario sc = sim::makeScenario(layout.survey, sim::TrajectoryShape::kHover, 4.0 + 3.0 + 16.0 + 3.0 + 4.0);
@@ -105,16 +107,8 @@ std::vector<SimScenarioRun> protocolSimulations(const std::string& data_dir, con
         const sim::SimResult r = sim::simulateFlight(sc, sp, seed);
         out.push_back({"fast-" + tag, "fast", "full", r.flight, r.survey, false});
       }
-      if (want("yawing-start")) {
-        // a yawing figure eight started in the air (unknown yaw at the log's start)
-        sim::Scenario sc = sim::makeScenario(layout.survey, sim::TrajectoryShape::kFigureEight, 50.0);
-        const sim::SimResult r = sim::simulateFlight(sc, sp, seed);
-        const sim::TrajectoryParams& tp = sc.trajectory;
-        const double t0 = tp.ground_before_s + tp.takeoff_s + 6.0;
-        const double t1 = tp.duration_s - tp.ground_after_s - tp.landing_s - 1.0;
-        out.push_back({"yawing-start-" + tag, "yawing-start", "cut in the air", sliceFlight(r.flight, t0, t1),
-                       r.survey, true});
-      }
+      // a yawing figure eight started in the air (unknown yaw at the log's start)
+      if (want("yawing-start")) cutInAir("yawing-start", sim::TrajectoryShape::kFigureEight, 50.0, 6.0);
     }
   }
   return out;

@@ -21,10 +21,7 @@ namespace {
 using filtertest::arenaAnchors;
 
 /// A body flying a horizontal circle (r = 1 m, 0.8 rad/s) at 1.4 m around (0.5, 0): position, velocity, acceleration.
-struct CircleTruth {
-  Vec3 p, v, a;
-};
-CircleTruth circle(double t) {
+filtertest::Truth circle(double t) {
   const double w = 0.8, r = 1.0;
   return {Vec3(0.5 + r * std::cos(w * t), r * std::sin(w * t), 1.4),
           Vec3(-r * w * std::sin(w * t), r * w * std::cos(w * t), 0.0),
@@ -33,26 +30,7 @@ CircleTruth circle(double t) {
 
 /// IMU (1 kHz, level body, rotor vibration) and TDoA (400 Hz, neighbour pairs) of the circle flight over [t0, t1].
 SensorLog circleLog(double t0, double t1, unsigned seed, double tdoa_sigma_m = 0.05) {
-  const AnchorTable anchors = arenaAnchors();
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> n(0.0, 1.0);
-  SensorLog log;
-  for (double t = t0; t <= t1; t += 0.001) {
-    TimedImu s;
-    s.t_s = t;
-    // full-model specific force of a level body: a + g e_z (the filter's thrust model sees only its z part)
-    s.imu.b_acc_mps2 = circle(t).a + Vec3(0, 0, kGravity_mps2) + 0.5 * Vec3(n(rng), n(rng), n(rng));
-    s.imu.b_gyro_radps = 0.05 * Vec3(n(rng), n(rng), n(rng));
-    log.imu.push_back(s);
-  }
-  int k = 0;
-  for (double t = t0; t <= t1; t += 0.0025, ++k) {
-    const int a = k % 8, b = (k + 1) % 8;
-    const Vec3 p_tag = tagPosition(circle(t).p, Quat::Identity(), kUtilTagOffset_b);
-    log.tdoa.push_back({t, a, b, range(p_tag, anchors.find(b)->m) - range(p_tag, anchors.find(a)->m) +
-                                     tdoa_sigma_m * n(rng)});
-  }
-  return log;
+  return filtertest::flightLog(arenaAnchors(), circle, t0, t1, tdoa_sigma_m, true, seed, {}, 0.05);
 }
 
 EkfParams lateralFullParams() {
@@ -188,33 +166,27 @@ TEST(RestDetector, RestIsDecidedAndRevisedFromTheImu) {
   ImuReading still;
   d.reset(still);
   double t = 0.0;
+  // one phase of white IMU noise: accelerometer std acc_std, gyroscope std gyro_std per axis, until t_end
+  const auto feed = [&](double t_end, double acc_std, double gyro_std, double* t_rest_ended = nullptr) {
+    for (; t < t_end; t += 0.001) {
+      ImuReading m;
+      m.b_acc_mps2 += acc_std * Vec3(n(rng), n(rng), n(rng));
+      m.b_gyro_radps = gyro_std * Vec3(n(rng), n(rng), n(rng));
+      d.update(t, m, 0.001);
+      if (t_rest_ended && !d.atRest() && *t_rest_ended < 0.0) *t_rest_ended = t;
+    }
+  };
   // GIVEN a still IMU for 1 s THEN it is at rest and not shaking
-  for (; t < 1.0; t += 0.001) {
-    ImuReading m;
-    m.b_acc_mps2 += 0.01 * Vec3(n(rng), n(rng), n(rng));
-    m.b_gyro_radps = 0.001 * Vec3(n(rng), n(rng), n(rng));
-    d.update(t, m, 0.001);
-  }
+  feed(1.0, 0.01, 0.001);
   EXPECT_TRUE(d.atRest());
   EXPECT_FALSE(d.shaking());
   // WHEN the rotors spin up (vibration) THEN rest ends within 0.2 s
   double t_end = -1.0;
-  for (; t < 2.0; t += 0.001) {
-    ImuReading m;
-    m.b_acc_mps2 += 1.0 * Vec3(n(rng), n(rng), n(rng));
-    m.b_gyro_radps = 0.05 * Vec3(n(rng), n(rng), n(rng));
-    d.update(t, m, 0.001);
-    if (!d.atRest() && t_end < 0.0) t_end = t;
-  }
+  feed(2.0, 1.0, 0.05, &t_end);
   EXPECT_LT(t_end - 1.0, 0.2);
   EXPECT_FALSE(d.shaking());  // flight-level gyro noise is not floor contact
   // WHEN the frame shakes against the floor THEN shaking is reported
-  for (; t < 2.5; t += 0.001) {
-    ImuReading m;
-    m.b_acc_mps2 += 1.0 * Vec3(n(rng), n(rng), n(rng));
-    m.b_gyro_radps = 0.5 * Vec3(n(rng), n(rng), n(rng));
-    d.update(t, m, 0.001);
-  }
+  feed(2.5, 1.0, 0.5);
   EXPECT_TRUE(d.shaking());
 }
 

@@ -21,6 +21,42 @@ inline AnchorTable arenaAnchors() {
   return t;
 }
 
+/// World position, velocity and acceleration of a level body at one instant.
+struct Truth {
+  Vec3 p, v, a;
+};
+
+/// Synthetic log over [t0_s, t1_s]: a level body following `truth(t)`; IMU at 1 kHz with rotor vibration (specific
+/// force a + g e_z plus 0.5 m/s² white noise, gyro noise gyro_std_radps: a still IMU would mean "motors off"); TDoA
+/// on the neighbour pairs of `anchors` (ids 0…7) at 400 Hz with white noise sigma_m; `tdoa_offset(t, pair)` adds a
+/// deterministic error.
+inline SensorLog flightLog(const AnchorTable& anchors, const std::function<Truth(double)>& truth, double t0_s,
+                           double t1_s, double sigma_m, bool with_imu, unsigned seed,
+                           const std::function<double(double, int)>& tdoa_offset = {},
+                           double gyro_std_radps = 0.08) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  SensorLog log;
+  if (with_imu) {
+    for (double t = t0_s; t <= t1_s; t += 0.001) {
+      TimedImu s;
+      s.t_s = t;
+      s.imu.b_acc_mps2 = truth(t).a + Vec3(0, 0, kGravity_mps2) + 0.5 * Vec3(n(rng), n(rng), n(rng));
+      s.imu.b_gyro_radps = gyro_std_radps * Vec3(n(rng), n(rng), n(rng));
+      log.imu.push_back(s);
+    }
+  }
+  int k = 0;
+  for (double t = t0_s; t <= t1_s; t += 0.0025, ++k) {
+    const int a = k % 8, b = (k + 1) % 8;
+    const Vec3 p_tag = tagPosition(truth(t).p, Quat::Identity(), kUtilTagOffset_b);
+    double z = range(p_tag, anchors.find(b)->m) - range(p_tag, anchors.find(a)->m) + sigma_m * n(rng);
+    if (tdoa_offset) z += tdoa_offset(t, a);
+    log.tdoa.push_back({t, a, b, z});
+  }
+  return log;
+}
+
 /// Height z [m], vertical velocity vz [m/s] and acceleration az [m/s²] of a take-off.
 struct Vertical {
   double z, vz, az;

@@ -8,6 +8,7 @@
 #include <functional>
 #include <random>
 
+#include "FilterTestUtil.h"
 #include "uwb/filter/OutlierGate.h"
 #include "uwb/filter/TdoaLocalizer.h"
 #include "uwb/model/TdoaModel.h"
@@ -25,37 +26,13 @@ AnchorTable boxAnchors() {
   return t;
 }
 
-struct Truth {
-  Vec3 p, v, a;  ///< world position, velocity, acceleration
-};
+using filtertest::Truth;
 
-/// Synthetic log: level body following `truth(t)`, IMU at 1 kHz with vibration noise (specific force = a − g), TDoA on the neighbour
-/// pairs at 400 Hz with white noise sigma; `tdoa_offset(t, pair)` adds a deterministic error.
+/// Synthetic log over [0, duration_s] (filtertest::flightLog).
 SensorLog makeLog(const AnchorTable& anchors, const std::function<Truth(double)>& truth, double duration_s,
                   double sigma_m, bool with_imu, unsigned seed,
                   const std::function<double(double, int)>& tdoa_offset = {}) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> n(0.0, 1.0);
-  SensorLog log;
-  if (with_imu) {
-    for (double t = 0.0; t <= duration_s; t += 0.001) {
-      TimedImu s;
-      s.t_s = t;
-      // propeller vibration of a flying quadrotor (≈0.05 g, ≈5 °/s rms): a still IMU would mean "motors off"
-      s.imu.b_acc_mps2 = truth(t).a + Vec3(0, 0, kGravity_mps2) + 0.5 * Vec3(n(rng), n(rng), n(rng));
-      s.imu.b_gyro_radps = 0.08 * Vec3(n(rng), n(rng), n(rng));
-      log.imu.push_back(s);
-    }
-  }
-  int k = 0;
-  for (double t = 0.0; t <= duration_s; t += 0.0025, ++k) {
-    const int a = k % 8, b = (k + 1) % 8;
-    const Vec3 p_tag = tagPosition(truth(t).p, Quat::Identity(), kUtilTagOffset_b);
-    double z = range(p_tag, anchors.find(b)->m) - range(p_tag, anchors.find(a)->m) + sigma_m * n(rng);
-    if (tdoa_offset) z += tdoa_offset(t, a);
-    log.tdoa.push_back({t, a, b, z});
-  }
-  return log;
+  return filtertest::flightLog(anchors, truth, 0.0, duration_s, sigma_m, with_imu, seed, tdoa_offset);
 }
 
 double finalError(const LocalizerResult& r, const std::function<Truth(double)>& truth) {
