@@ -195,8 +195,9 @@ void Estimator::handleTimeJump(double t_s, double gap_s) {
   n_imu_acc_ = 0;
   t_pred_ = t_s;
   if (ready_) {
-    const double g = std::min(std::abs(gap_s), 5.0);
-    ekf_.inflatePosition(std::min(1.0 * g, 2.0), std::min(1.0 * g, 1.0));
+    // up to 1 m/s for the length of the gap, at most 2 m and 1 m/s
+    const double g = std::abs(gap_s);
+    ekf_.inflatePosition(std::min(g, 2.0), std::min(g, 1.0));
     if (std::abs(gap_s) > 1.0 && !start_.active()) startAcquisition(t_s, true);
   }
 }
