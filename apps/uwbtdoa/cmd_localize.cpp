@@ -122,6 +122,8 @@ void runLocalize(const LocalizeArgs& a) {
   j["duration_s"] = run.duration_s;
   j["process_model"] = uwb::toString(s.process_model);
   j["bias_model"] = a.filter.bias_model.empty() ? json(nullptr) : json(a.filter.bias_model);
+  j["bias_guard_mean_weight"] = std::isnan(s.bias_guard_mean_weight) ? json(nullptr) : json(s.bias_guard_mean_weight);
+  j["bias_guard_final_weight"] = std::isnan(s.bias_guard_final_weight) ? json(nullptr) : json(s.bias_guard_final_weight);
   j["n_tdoa"] = s.n_tdoa_total;
   j["n_tdoa_used"] = s.n_tdoa_used;
   j["n_tdoa_rejected"] = s.n_tdoa_rejected;

@@ -124,6 +124,11 @@ std::vector<EkfParamInfo> makeRegistry() {
       integer("robust_iterations", &P::robust_iterations, EkfParamRange{1, 20}, "IRLS iterations per TDoA update"),
       real("pair_bias_tau_s", &P::pair_bias_tau_s, "s", kNonNegative,
            "Per-pair TDoA offset learned from innovations with this time constant; 0 off (F19)"),
+      boolean("bias_guard", &P::bias_guard,
+              "With a bias model: mix the corrected and the uncorrected filter by their recent TDoA predictive "
+              "likelihood (F24)"),
+      real("bias_guard_tau_s", &P::bias_guard_tau_s, "s", kPositive,
+           "Memory of the bias guard's likelihood comparison (F24)"),
       real("max_lost_s", &P::max_lost_s, "s", kPositive,
            "All TDoA rejected this long: re-acquire (inflate P, open the gate)"),
       // --- scheduling ---

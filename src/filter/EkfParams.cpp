@@ -40,6 +40,7 @@ void EkfParams::validate() const {
     throw std::invalid_argument("EkfParams.robust_iterations must be in [1, 20]");
   requirePositive(max_lost_s, "max_lost_s");
   requireNonNegative(pair_bias_tau_s, "pair_bias_tau_s");
+  requirePositive(bias_guard_tau_s, "bias_guard_tau_s");
   requirePositive(max_predict_dt_s, "max_predict_dt_s");
   requireNonNegative(cov_period_s, "cov_period_s");
   requireNonNegative(update_predict_dt_s, "update_predict_dt_s");

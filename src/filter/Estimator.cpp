@@ -407,6 +407,7 @@ void Estimator::addTof(const TofObservation& tof) {
 
 void Estimator::addTdoa(const TdoaObservation& z) {
   ++summary_.n_tdoa_total;
+  last_tdoa_ = TdoaUpdateResult{};
   const double t = z.t_s;
   if (!initialized_) {
     if (imu_mode_) {
@@ -462,6 +463,7 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   const bool near_floor = on_ground_ || ekf_.state().w_p_b.z() - params_.ground_z_m < kLowFlight_m;
   const TdoaUpdateOptions& opt = acquiring ? acq_opt_ : (near_floor ? rest_opt_ : track_opt_);
   const TdoaUpdateResult r = updateTdoa(ekf_, anchors_, zc, opt, bias_ ? &bias_ : nullptr);
+  last_tdoa_ = r;
   if (po && !acquiring && r.outcome == UpdateOutcome::kApplied) {
     const double dt_pair = std::isnan(po->t_last_s) ? 0.0 : std::min(t - po->t_last_s, 0.2);
     po->offset_m =

@@ -3,36 +3,21 @@
  */
 #include "uwb/filter/TdoaLocalizer.h"
 
+#include "uwb/filter/BiasGuard.h"
+
 #include <stdexcept>
 
 namespace uwb {
+namespace {
 
-TdoaLocalizer::TdoaLocalizer(const EkfParams& params, AnchorTable anchors, BiasPredictor bias)
-    : params_(params), anchors_(std::move(anchors)), bias_(std::move(bias)) {
-  params_.validate();
-  if (anchors_.size() < 4) throw std::invalid_argument("TdoaLocalizer: at least 4 anchors are needed");
-}
-
-LocalizerResult TdoaLocalizer::run(const SensorLog& input, double output_period_s) const {
-  LocalizerResult result;
-  // (F17) streams cleaned and merged; the input is copied only when it needs cleaning, and the merged sequence is
-  // walked by a cursor over the clean streams instead of being stored
-  SensorLog cleaned;
-  const std::optional<MergeReport> clean_report = cleanSensorLogReportIfClean(input, params_.max_gap_s);
-  const bool input_clean = clean_report.has_value();
-  if (!input_clean) cleaned = input;
-  const SensorLog& log = input_clean ? input : cleaned;
-  const MergeReport merge = input_clean ? *clean_report : cleanSensorLog(cleaned, params_.max_gap_s);
-  SensorEventCursor events(log);
-
-  EkfParams p = params_;
-  if (log.imu.empty() && p.process_model == ProcessModel::kImu) p.process_model = ProcessModel::kConstantVelocity;
-  if (p.process_model != ProcessModel::kImu) p.ground_phase = GroundPhase::kNone;
-  Estimator estimator(p, anchors_, bias_);
+/// Feeds every event of the log to the online estimator (Estimator or GuardedEstimator) and takes its estimate at the
+/// output spacing.
+template <class OnlineEstimator>
+void runEvents(OnlineEstimator& estimator, const SensorLog& log, SensorEventCursor& events, double output_period_s,
+               LocalizerResult& result) {
   if (events.empty()) {
     result.summary = estimator.summary();
-    result.summary.merge = merge;
-    return result;
+    return;
   }
   // outputs spaced by output_period_s (plus one at the end): reserve once, no regrowth
   const double span_s = events.lastStamp() - events.firstStamp();
@@ -60,9 +45,44 @@ LocalizerResult TdoaLocalizer::run(const SensorLog& input, double output_period_
     result.estimates.back().t_s = events.lastStamp();
   }
   result.summary = estimator.summary();
+}
+
+}  // namespace
+
+TdoaLocalizer::TdoaLocalizer(const EkfParams& params, AnchorTable anchors, BiasPredictor bias)
+    : params_(params), anchors_(std::move(anchors)), bias_(std::move(bias)) {
+  params_.validate();
+  if (anchors_.size() < 4) throw std::invalid_argument("TdoaLocalizer: at least 4 anchors are needed");
+}
+
+LocalizerResult TdoaLocalizer::run(const SensorLog& input, double output_period_s) const {
+  LocalizerResult result;
+  // (F17) streams cleaned and merged; the input is copied only when it needs cleaning, and the merged sequence is
+  // walked by a cursor over the clean streams instead of being stored
+  SensorLog cleaned;
+  const std::optional<MergeReport> clean_report = cleanSensorLogReportIfClean(input, params_.max_gap_s);
+  const bool input_clean = clean_report.has_value();
+  if (!input_clean) cleaned = input;
+  const SensorLog& log = input_clean ? input : cleaned;
+  const MergeReport merge = input_clean ? *clean_report : cleanSensorLog(cleaned, params_.max_gap_s);
+  SensorEventCursor events(log);
+
+  EkfParams p = params_;
+  if (log.imu.empty() && p.process_model == ProcessModel::kImu) p.process_model = ProcessModel::kConstantVelocity;
+  if (p.process_model != ProcessModel::kImu) p.ground_phase = GroundPhase::kNone;
+  if (bias_ && p.bias_guard) {
+    // (F24) the corrected filter beside the uncorrected one, mixed by their recent predictive likelihood
+    GuardedEstimator estimator(p, anchors_, bias_);
+    runEvents(estimator, log, events, output_period_s, result);
+  } else {
+    Estimator estimator(p, anchors_, bias_);
+    runEvents(estimator, log, events, output_period_s, result);
+  }
   result.summary.merge = merge;
-  result.summary.start_t_s = events.firstStamp();
-  result.summary.end_t_s = events.lastStamp();
+  if (!events.empty()) {
+    result.summary.start_t_s = events.firstStamp();
+    result.summary.end_t_s = events.lastStamp();
+  }
   return result;
 }
 

@@ -158,6 +158,7 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
   st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
   res.innovation_m = st.innovation_m;
   res.nis = st.nis;
+  res.innovation_var_m2 = st.innovation_var_m2;
   if (options.gate_sigma > 0.0 && !OutlierGate(options.gate_sigma).accept(st.nis)) {
     res.outcome = UpdateOutcome::kRejectedOutlier;
     return res;

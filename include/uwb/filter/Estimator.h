@@ -89,6 +89,9 @@ struct LocalizerSummary {
   Vec3 start_w_p_b = Vec3::Zero();     ///< first position found by multilateration (or given)
   double start_rms_residual_m = 0.0;
   MergeReport merge;                   ///< batch path only: what cleaning the log found (F17)
+  /// With the bias guard (F24): time-mean and final weight of the corrected filter in the output (NaN without it)
+  double bias_guard_mean_weight = std::numeric_limits<double>::quiet_NaN();
+  double bias_guard_final_weight = std::numeric_limits<double>::quiet_NaN();
 };
 
 class Estimator {
@@ -116,6 +119,9 @@ class Estimator {
   LocalizerEstimate estimate() const;
   const LocalizerSummary& summary() const { return summary_; }
   const EkfParams& params() const { return params_; }
+  /// The update of the TDoA last given to addTdoa; outcome kSkipped when it reached no update (not initialized,
+  /// start-up collection, out of order). Its innovation and S are the filter's one-step prediction of it (F24).
+  const TdoaUpdateResult& lastTdoaUpdate() const { return last_tdoa_; }
 
  private:
   void initialize(double t_s, const Vec3& acc_mean_b, bool moving);
@@ -184,6 +190,7 @@ class Estimator {
     double t_s = -1e300;
   };
   std::vector<RecentPair> recent_pairs_;
+  TdoaUpdateResult last_tdoa_;
   Mat3 bias_floor_ = Mat3::Zero();  ///< biasFloor() at t_bias_floor_s_; σ_b² I before the first TDoA (F23)
   double t_bias_floor_s_ = -1e300;
 };

@@ -61,6 +61,7 @@ struct TdoaUpdateResult {
   UpdateOutcome outcome = UpdateOutcome::kSkipped;
   double innovation_m = 0.0;  ///< z_corrected − ẑ (prior)
   double nis = 0.0;           ///< r²/S with the unweighted measurement variance
+  double innovation_var_m2 = 0.0;  ///< S = a P aᵀ + measurement variance (unweighted) [m²]
   double weight = 1.0;        ///< IRLS weight applied (1 = full)
   double bias_mean_m = 0.0;   ///< bias-model correction subtracted from z
 };

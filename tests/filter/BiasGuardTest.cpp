@@ -1,0 +1,123 @@
+/** @file BiasGuardTest.cpp
+ *  @brief The bias guard (docs/math/filter.md F24): the robust predictive NLL, and the weight of the corrected filter
+ *         following the evidence: towards the correction when it fits the flight, away from it when it does not.
+ */
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "FilterTestUtil.h"
+#include "uwb/filter/BiasGuard.h"
+#include "uwb/filter/TdoaLocalizer.h"
+
+namespace uwb {
+namespace {
+
+using filtertest::Truth;
+
+TEST(PredictiveNll, GaussianInsideTheHuberScaleLinearOutside) {
+  // GIVEN innovations at 2σ and at 5σ with S = 0.01 m²
+  const double half_log_s = 0.5 * std::log(0.01);
+  // THEN inside k = 3 the NLL is the Gaussian ½ u² + ½ log S, beyond it k u − ½ k² + ½ log S
+  EXPECT_NEAR(predictiveNll(4.0, 0.01), 2.0 + half_log_s, 1e-12);
+  EXPECT_NEAR(predictiveNll(25.0, 0.01), 3.0 * 5.0 - 4.5 + half_log_s, 1e-12);
+  // AND the two branches meet at u = k
+  EXPECT_NEAR(predictiveNll(9.0, 0.01), 4.5 + half_log_s, 1e-12);
+  // AND a wider predictive density costs more for the same normalised innovation
+  EXPECT_GT(predictiveNll(1.0, 0.04), predictiveNll(1.0, 0.01));
+  // AND a non-positive variance has no density
+  EXPECT_TRUE(std::isinf(predictiveNll(1.0, 0.0)));
+}
+
+/// A body hovering still at one point with per-pair TDoA offsets that do not look like a position shift
+/// (+0.35 m on the pairs from anchor 1 and 5, −0.3 m on the pair from anchor 3).
+double pairOffset(int id_a) {
+  return id_a == 1 || id_a == 5 ? 0.35 : id_a == 3 ? -0.3 : 0.0;
+}
+
+struct HoverRun {
+  double guarded_error_m, plain_error_m, corrected_error_m, weight;
+};
+
+HoverRun hoverWith(const BiasPredictor& bias) {
+  const AnchorTable anchors = filtertest::arenaAnchors();
+  const Vec3 p(0.5, -0.3, 1.5);
+  const auto truth = [&](double) { return Truth{p, Vec3::Zero(), Vec3::Zero()}; };
+  const SensorLog log = filtertest::flightLog(anchors, truth, 0.0, 20.0, 0.1, true, 3,
+                                              [](double, int id_a) { return pairOffset(id_a); });
+  EkfParams params;
+  params.ground_phase = GroundPhase::kNone;
+  GuardedEstimator est(params, anchors, bias);
+  std::size_t i = 0, k = 0;
+  while (i < log.imu.size() || k < log.tdoa.size()) {
+    if (k >= log.tdoa.size() || (i < log.imu.size() && log.imu[i].t_s <= log.tdoa[k].t_s)) {
+      est.addImu(log.imu[i].t_s, log.imu[i].imu);
+      ++i;
+    } else {
+      est.addTdoa(log.tdoa[k++]);
+    }
+  }
+  EXPECT_TRUE(est.ready());
+  return {(est.estimate().x.w_p_b - p).norm(), (est.uncorrected().estimate().x.w_p_b - p).norm(),
+          (est.corrected().estimate().x.w_p_b - p).norm(), est.weight()};
+}
+
+BiasPredictor offsetPredictor(double sign) {
+  return [sign](const TdoaFeature& f) { return BiasPrediction{sign * pairOffset(f.id_a), 0.0, 1.0}; };
+}
+
+TEST(BiasGuard, FollowsACorrectionThatFitsTheFlight) {
+  // GIVEN per-pair TDoA offsets and a bias model that knows them
+  // WHEN the guarded estimator runs 20 s
+  const HoverRun r = hoverWith(offsetPredictor(1.0));
+  // THEN the correction is trusted, the corrected filter is better than the plain one, and the output is it
+  EXPECT_GT(r.weight, 0.95);
+  EXPECT_LT(r.corrected_error_m, r.plain_error_m);
+  EXPECT_LT(r.guarded_error_m, r.corrected_error_m + 0.05 * r.plain_error_m + 0.01);
+}
+
+TEST(BiasGuard, LeavesACorrectionThatDoesNotFit) {
+  // GIVEN the same offsets and a bias model with the wrong sign (it doubles the error)
+  // WHEN the guarded estimator runs 20 s
+  const HoverRun r = hoverWith(offsetPredictor(-1.0));
+  // THEN the correction is dropped from the output, which is the plain filter's, better than the corrected one
+  EXPECT_LT(r.weight, 0.05);
+  EXPECT_GT(r.corrected_error_m, r.plain_error_m);
+  EXPECT_LT(r.guarded_error_m, r.plain_error_m + 0.05 * r.corrected_error_m + 0.01);
+}
+
+TEST(BiasGuard, LocalizerUsesTheGuardOnlyWithABiasModelAndWhenOn) {
+  // GIVEN a hovering flight with per-pair offsets and the wrong-sign bias model
+  const AnchorTable anchors = filtertest::arenaAnchors();
+  const Vec3 p(0.5, -0.3, 1.5);
+  const auto truth = [&](double) { return Truth{p, Vec3::Zero(), Vec3::Zero()}; };
+  const SensorLog log = filtertest::flightLog(anchors, truth, 0.0, 20.0, 0.1, true, 4,
+                                              [](double, int id_a) { return pairOffset(id_a); });
+  EkfParams on;
+  on.ground_phase = GroundPhase::kNone;
+  EkfParams off = on;
+  off.bias_guard = false;
+  // WHEN localizing without a model, with the model unguarded and guarded
+  const LocalizerResult plain = TdoaLocalizer(on, anchors).run(log);
+  const LocalizerResult unguarded = TdoaLocalizer(off, anchors, offsetPredictor(-1.0)).run(log);
+  const LocalizerResult guarded = TdoaLocalizer(on, anchors, offsetPredictor(-1.0)).run(log);
+  // THEN only the guarded run reports a weight, and its last output is the plain filter's to within millimetres
+  EXPECT_TRUE(std::isnan(plain.summary.bias_guard_final_weight));
+  EXPECT_TRUE(std::isnan(unguarded.summary.bias_guard_final_weight));
+  EXPECT_LT(guarded.summary.bias_guard_final_weight, 0.05);
+  EXPECT_LT(guarded.summary.bias_guard_mean_weight, 0.5);
+  EXPECT_LT((guarded.estimates.back().x.w_p_b - plain.estimates.back().x.w_p_b).norm(), 0.01);
+  EXPECT_GT((unguarded.estimates.back().x.w_p_b - p).norm(), (plain.estimates.back().x.w_p_b - p).norm());
+}
+
+TEST(BiasGuard, MixtureOfEqualFiltersIsEitherFilter) {
+  // GIVEN a bias model that predicts no bias: both filters see the same measurements
+  const HoverRun r = hoverWith([](const TdoaFeature&) { return BiasPrediction{0.0, 0.0, 1.0}; });
+  // THEN the log-odds never move, and the mixture is the (identical) filters' estimate
+  EXPECT_NEAR(r.weight, 0.5, 1e-12);
+  EXPECT_NEAR(r.guarded_error_m, r.plain_error_m, 1e-12);
+  EXPECT_NEAR(r.corrected_error_m, r.plain_error_m, 1e-12);
+}
+
+}  // namespace
+}  // namespace uwb
