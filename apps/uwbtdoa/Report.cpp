@@ -36,9 +36,9 @@ void EvaluationCliOptions::addTo(CLI::App& sub) {
   sub.add_flag("--full-variance", full_variance,
                "Corrected measurements get the TDoA variance scaled by (var_f + noise)/E[eps^2] instead of R + var_f "
                "(docs/math/gp.md P45)");
-  sub.add_flag("--no-bias-guard", no_bias_guard,
-               "Corrected runs use the corrected filter alone, not mixed with the uncorrected one by their TDoA "
-               "predictive likelihood (docs/math/filter.md F24)");
+  sub.add_flag("--bias-guard", bias_guard,
+               "Corrected runs mix the corrected and the uncorrected filter by their TDoA predictive likelihood "
+               "(docs/math/filter.md F24)");
   sub.add_flag("--json", json, "Print one JSON object (results and paths) on stdout");
 }
 
@@ -52,7 +52,7 @@ EvaluationParams EvaluationCliOptions::toParams() const {
   if (epochs > 0) p.train.svgp.epochs = epochs;
   if (batch > 0) p.train.svgp.batch_size = batch;
   p.train.full_variance = full_variance;
-  p.localization.params.bias_guard = !no_bias_guard;
+  p.localization.params.bias_guard = bias_guard;
   return p;
 }
 

@@ -93,10 +93,11 @@ TEST(BiasGuard, LocalizerUsesTheGuardOnlyWithABiasModelAndWhenOn) {
   const auto truth = [&](double) { return Truth{p, Vec3::Zero(), Vec3::Zero()}; };
   const SensorLog log = filtertest::flightLog(anchors, truth, 0.0, 20.0, 0.1, true, 4,
                                               [](double, int id_a) { return pairOffset(id_a); });
-  EkfParams on;
-  on.ground_phase = GroundPhase::kNone;
-  EkfParams off = on;
-  off.bias_guard = false;
+  EkfParams off;
+  off.ground_phase = GroundPhase::kNone;
+  EXPECT_FALSE(off.bias_guard);  // off by default (F24)
+  EkfParams on = off;
+  on.bias_guard = true;
   // WHEN localizing without a model, with the model unguarded and guarded
   const LocalizerResult plain = TdoaLocalizer(on, anchors).run(log);
   const LocalizerResult unguarded = TdoaLocalizer(off, anchors, offsetPredictor(-1.0)).run(log);

@@ -84,8 +84,9 @@ struct EkfParams {
   double pair_bias_tau_s = 0.0;          ///< >0: per-pair TDoA offset learned from innovations, time constant [s] (F19)
   double max_lost_s = 1.0;               ///< all TDoA rejected this long → re-acquire (inflate P, open gate)
   /// With a bias model: run the uncorrected filter beside the corrected one and output their mixture, weighted by
-  /// how well each predicted the recent TDoA (F24). A model that does not transfer to the flight is then phased out.
-  bool bias_guard = true;
+  /// how well each predicted the recent TDoA (F24). Off by default: it halves the worst loss of a model that does not
+  /// transfer, but also gives up part of the gain of one that does (docs/math/filter.md F24).
+  bool bias_guard = false;
   double bias_guard_tau_s = 10.0;        ///< memory of the F24 predictive-likelihood comparison [s]
 
   // --- scheduling ---
