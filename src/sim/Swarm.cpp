@@ -91,10 +91,11 @@ SwarmScenario makeSwarmScenario(const std::string& name, int n_agents, double du
     p.yaw0_rad = 2.0 * kPi * spread(k, 0.5698403);
     p.yaw_rate_rps = 0.3;
     if (name == "outside-hull" && k % 3 == 2) {
-      // beyond the x walls of the hull by 1.0–1.6 m (the estimator's divergence box allows 3 m)
+      // beyond the x walls of the hull by 0.45–0.95 m (the estimator's start-up accepts a fix up to 1 m outside the
+      // anchors' box, F16)
       const double side = (k / 3) % 2 == 0 ? 1.0 : -1.0;
-      p.w_center_xy.x() = side > 0 ? hi.x() + 1.3 : lo.x() - 1.3;
-      p.radius_m = std::min(p.radius_m, 0.3);
+      p.w_center_xy.x() = side > 0 ? hi.x() + 0.7 : lo.x() - 0.7;
+      p.radius_m = std::min(p.radius_m, 0.25);
       p.omega_rps = std::min(speed_mps / p.radius_m, 1.5);
     }
     if (name == "occluded" && k % 2 == 1) {

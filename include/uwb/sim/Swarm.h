@@ -6,7 +6,8 @@
  *  Scenarios (swarmScenarioNames()):
  *  - `nominal`: the 8 `paper` anchors, every agent inside their hull;
  *  - `few-anchors`: only anchors 0–3 of the `paper` room (one low/high tetrahedron, 3 independent TDoA);
- *  - `outside-hull`: every third agent circles outside the anchors' hull (beyond the x walls);
+ *  - `outside-hull`: every third agent circles 0.45–0.95 m outside the anchors' hull (beyond the x
+ *    walls);
  *  - `occluded`: every second agent sees only anchors 0–2 (two TDoA pairs) from 2 s after take-off until 2 s
  *    before landing, so one direction of its position is unobservable from anchors alone.
  *  Deterministic by seed: agent k's flight uses seed·1000 + k, the TWR noise and schedule their own stream.
