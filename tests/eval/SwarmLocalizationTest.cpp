@@ -49,7 +49,9 @@ TEST(SwarmLocalization, ExtrinsicBeliefsAreConsistentAndHelpOccludedAgents) {
     std::printf("agent %d: n=%zu  RMSE coop %.3f indep %.3f m;  NEES coop %.2f indep %.2f\n", k, r.n, r.rmse_coop_m,
                 r.rmse_indep_m, r.nees_coop, r.nees_indep);
     // THEN an occluded agent is localized far better with its neighbours than alone
-    if (k % 2 == 1) EXPECT_LT(r.rmse_coop_m, 0.3 * r.rmse_indep_m) << "agent " << k;
+    if (k % 2 == 1) {
+      EXPECT_LT(r.rmse_coop_m, 0.3 * r.rmse_indep_m) << "agent " << k;
+    }
   }
   // AND the cooperative estimate is consistent: mean position NEES ≈ 3 (χ²₃), within the factor-2.5 band of
   // NeesConsistencyTest (correlated samples, one per 0.1 s)
