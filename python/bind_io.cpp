@@ -18,6 +18,7 @@
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/Flight.h"
 #include "uwb/io/PoseTrack.h"
+#include "uwb/io/UsdImport.h"
 #include "uwb/io/UtilCsv.h"
 
 namespace uwb::python {
@@ -571,6 +572,42 @@ void bindIo(py::module_& m) {
         writeFlightCsv(f, path);
       },
       py::arg("flight"), py::arg("path"), "Writes a flight in the UTIL layout (read_flight_csv reads it back exactly).");
+  m.def(
+      "import_usd_log",
+      [](const std::string& path, bool salvage, bool with_report) -> py::object {
+        UsdReadOptions options;
+        options.salvage = salvage;
+        UsdImportReport report;
+        Flight f;
+        {
+          py::gil_scoped_release release;
+          f = importUsdLog(path, options, &report);
+        }
+        if (!with_report) return py::cast(std::move(f));
+        py::list sources;
+        for (const auto& s : report.sources) {
+          py::dict d;
+          d["stream"] = streamName(s.stream), d["event"] = s.event, d["fields"] = s.fields, d["count"] = s.count;
+          sources.append(d);
+        }
+        py::dict r;
+        r["sources"] = sources, r["notes"] = report.notes, r["t0_us"] = report.t0_us;
+        return py::make_tuple(std::move(f), r);
+      },
+      py::arg("path"), py::arg("salvage") = false, py::arg("with_report") = false,
+      "Imports a Crazyflie uSD-card event log (cfusdlog, versions 1 and 2) as a flight, with UTIL's event-type\n"
+      "mapping and units (docs/io.md section 6). salvage=True reads a log whose writing was cut (no valid CRC).\n"
+      "with_report=True returns (flight, {sources: [{stream, event, fields, count}], notes, t0_us}).\n"
+      "ValueError 'file: byte B, event K (type.field): ...' on bad data, OSError when the file cannot be read.");
+  m.def(
+      "write_usd_log",
+      [](const Flight& f, const std::string& path) {
+        py::gil_scoped_release release;
+        writeUsdLog(usdLogFromFlight(f), path);
+      },
+      py::arg("flight"), py::arg("path"),
+      "Writes a flight as the events UTIL recorded (cfusdlog version 2, float32 values in the file units);\n"
+      "import_usd_log reads it back within float32 precision.");
   m.def(
       "read_trajectory_csv", [](const std::string& path) { return trajectoryToDict(readTrajectoryCsv(path)); },
       py::arg("path"),
