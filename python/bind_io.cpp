@@ -51,6 +51,19 @@ py::array_t<double> times(const std::vector<Sample>& v) {
   return out;
 }
 
+/// Runs `read(report)` without the GIL; the flight, or (flight, to_dict(report)) when with_report.
+template <class Report, class Read, class ToDict>
+py::object flightWithReport(bool with_report, Read&& read, ToDict&& to_dict) {
+  Report report;
+  Flight f;
+  {
+    py::gil_scoped_release release;
+    f = read(report);
+  }
+  if (!with_report) return py::cast(std::move(f));
+  return py::make_tuple(std::move(f), to_dict(report));
+}
+
 // ---- C++ → numpy (one pass per stream) ----
 py::dict tdoaDict(const std::vector<TdoaMeasurement>& v) {
   const auto n = static_cast<Eigen::Index>(v.size());
@@ -549,16 +562,13 @@ void bindIo(py::module_& m) {
         FlightReadOptions options;
         for (const auto& name : required) options.required.push_back(streamFromName(name));
         options.survey = survey;
-        ReadReport report;
-        Flight f;
-        {
-          py::gil_scoped_release release;
-          f = readFlightCsv(path, options, &report);
-        }
-        if (!with_report) return py::cast(std::move(f));
-        py::dict r;
-        r["n_rows"] = report.n_rows, r["n_bytes"] = report.n_bytes, r["notes"] = report.notes;
-        return py::make_tuple(std::move(f), r);
+        return flightWithReport<ReadReport>(
+            with_report, [&](ReadReport& report) { return readFlightCsv(path, options, &report); },
+            [](const ReadReport& report) {
+              py::dict r;
+              r["n_rows"] = report.n_rows, r["n_bytes"] = report.n_bytes, r["notes"] = report.notes;
+              return r;
+            });
       },
       py::arg("path"), py::arg("required") = std::vector<std::string>{}, py::arg("survey") = nullptr,
       py::arg("with_report") = false,
@@ -577,22 +587,19 @@ void bindIo(py::module_& m) {
       [](const std::string& path, bool salvage, bool with_report) -> py::object {
         UsdReadOptions options;
         options.salvage = salvage;
-        UsdImportReport report;
-        Flight f;
-        {
-          py::gil_scoped_release release;
-          f = importUsdLog(path, options, &report);
-        }
-        if (!with_report) return py::cast(std::move(f));
-        py::list sources;
-        for (const auto& s : report.sources) {
-          py::dict d;
-          d["stream"] = streamName(s.stream), d["event"] = s.event, d["fields"] = s.fields, d["count"] = s.count;
-          sources.append(d);
-        }
-        py::dict r;
-        r["sources"] = sources, r["notes"] = report.notes, r["t0_us"] = report.t0_us;
-        return py::make_tuple(std::move(f), r);
+        return flightWithReport<UsdImportReport>(
+            with_report, [&](UsdImportReport& report) { return importUsdLog(path, options, &report); },
+            [](const UsdImportReport& report) {
+              py::list sources;
+              for (const auto& s : report.sources) {
+                py::dict d;
+                d["stream"] = streamName(s.stream), d["event"] = s.event, d["fields"] = s.fields, d["count"] = s.count;
+                sources.append(d);
+              }
+              py::dict r;
+              r["sources"] = sources, r["notes"] = report.notes, r["t0_us"] = report.t0_us;
+              return r;
+            });
       },
       py::arg("path"), py::arg("salvage") = false, py::arg("with_report") = false,
       "Imports a Crazyflie uSD-card event log (cfusdlog, versions 1 and 2) as a flight, with UTIL's event-type\n"
