@@ -367,21 +367,31 @@ std::size_t UsdLog::addType(std::uint16_t id, const std::string& name,
   if (name.empty() || name.find('\0') != std::string::npos) {
     throw std::invalid_argument("event-type name must be non-empty and hold no NUL byte");
   }
-  for (const UsdEventType& t : types) {
-    if (t.id == id) throw std::invalid_argument(fmt::format("event id {} is declared twice ({} and {})", id, t.name, name));
-    if (t.name == name) throw std::invalid_argument(fmt::format("event type '{}' is declared twice", name));
+  if (added_ids_.count(id) != 0) {
+    const auto same = std::find_if(types.begin(), types.end(), [&](const UsdEventType& t) { return t.id == id; });
+    throw std::invalid_argument(fmt::format("event id {} is declared twice ({} and {})", id,
+                                            same != types.end() ? same->name : "?", name));
   }
+  if (added_names_.count(name) != 0) throw std::invalid_argument(fmt::format("event type '{}' is declared twice", name));
   UsdEventType t;
   t.id = id;
   t.name = name;
+  std::vector<std::string_view> sorted;
+  sorted.reserve(fields.size());
   for (const auto& [field, type] : fields) {
     if (field.empty() || field.find_first_of(std::string_view("(\0", 2)) != std::string::npos) {
       throw std::invalid_argument(fmt::format("field name '{}' of {} must be non-empty, without '(' or NUL", field, name));
     }
-    if (t.fieldIndex(field) >= 0) throw std::invalid_argument(fmt::format("field '{}' of {} is declared twice", field, name));
     t.fields.push_back({field, type, t.payload_bytes});
     t.payload_bytes += usdTypeSize(type);
+    sorted.push_back(field);
   }
+  std::sort(sorted.begin(), sorted.end());
+  if (const auto dup = std::adjacent_find(sorted.begin(), sorted.end()); dup != sorted.end()) {
+    throw std::invalid_argument(fmt::format("field '{}' of {} is declared twice", *dup, name));
+  }
+  added_ids_.insert(id);
+  added_names_.insert(name);
   types.push_back(std::move(t));
   events.emplace_back();
   return types.size() - 1;

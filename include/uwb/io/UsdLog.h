@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <unordered_set>
 #include <vector>
 
 namespace uwb {
@@ -73,8 +74,8 @@ struct UsdLog {
   std::string where(std::size_t type, std::size_t event, int field = -1) const;
 
   // ---- building a log in code (tests, export) ----
-  /// Appends an event type; std::invalid_argument on a duplicate id or name, an empty name, a field name that is
-  /// empty or repeated or holds '(' or NUL.
+  /// Appends an event type; std::invalid_argument on an id or name already added, an empty name, a field name that
+  /// is empty or repeated or holds '(' or NUL. The checks take O(1) per type and O(F log F) per type of F fields.
   std::size_t addType(std::uint16_t id, const std::string& name, const std::vector<std::pair<std::string, UsdType>>& fields);
   /// Appends one event of type index `type` (values converted to the field types, rounding floats to float32
   /// and half; std::invalid_argument when a value does not fit its integer type or the count is wrong). Events
@@ -85,6 +86,8 @@ struct UsdLog {
  private:
   std::size_t next_offset_ = 0;  ///< file offset of the next added event (0: not yet known)
   std::size_t next_number_ = 0;  ///< number of the next added event
+  std::unordered_set<std::uint16_t> added_ids_;  ///< ids and names given to addType (its duplicate check)
+  std::unordered_set<std::string> added_names_;
 };
 
 struct UsdReadOptions {
