@@ -96,7 +96,7 @@ void run(const Options& o) {
     return;
   }
   std::cout << fmt::format("log       {} (cfusdlog version {}, {} events, {} bytes, CRC {})\n", o.log, log.version,
-                           read_report.n_events, read_report.n_bytes, read_report.crc_ok ? "ok" : "NOT CHECKED");
+                           read_report.n_events, read_report.n_bytes, read_report.crc_ok ? "ok" : "mismatch, read in salvage mode");
   std::cout << fmt::format("flight    {}\n", o.out);
   std::cout << fmt::format("duration  {:.3f} s  ({:.6f} … {:.6f} s)\n\n", summary.duration_s, summary.t_start_s,
                            summary.t_end_s);

@@ -147,7 +147,7 @@ class Parser {
       if (!options_.salvage) {
         failAt(n_ - kCrcBytes, "crc",
                fmt::format("CRC mismatch: stored 0x{:08X}, computed 0x{:08X} (the file is damaged, or its writing "
-                           "was cut; salvage mode reads the events up to the last complete one)",
+                           "was cut; salvage mode, `uwbtdoa import --salvage`, reads the events up to the last complete one)",
                            stored, computed));
       }
       report_.notes.push_back(fmt::format("CRC mismatch (stored 0x{:08X}, computed 0x{:08X}): read in salvage mode, "
