@@ -197,17 +197,16 @@ class Converter {
       PoseSample p;
       p.t_s = time(s, i);
       p.w_p_b = Vec3(finite(type, i, f[0]), finite(type, i, f[1]), finite(type, i, f[2]));
-      if (f.size() == 7) {
-        const double qx = finite(type, i, f[3]), qy = finite(type, i, f[4]), qz = finite(type, i, f[5]),
-                     qw = finite(type, i, f[6]);
+      if (f.size() > 3) {  // the file check of the CSV reader, so that the flight CSV reads back
+        const Quat q = f.size() == 7 ? Quat(finite(type, i, f[6]), finite(type, i, f[3]), finite(type, i, f[4]),
+                                            finite(type, i, f[5]))
+                                     : decompressQuaternion(static_cast<std::uint32_t>(log_.value(type, i, f[3])));
         double norm = 0.0;
-        if (!isFileQuaternionNormOk(qx, qy, qz, qw, norm)) {
+        if (!isFileQuaternionNormOk(q.x(), q.y(), q.z(), q.w(), norm)) {
           throw InputError(fmt::format("{}: pose quaternion is far from unit norm: |q| = {:.6g} (tolerance {})",
                                        log_.where(type, i, static_cast<int>(f[3])), norm, kMaxQuaternionNormError));
         }
-        p.w_q_b = Quat(qw, qx, qy, qz);
-      } else if (f.size() == 4) {
-        p.w_q_b = decompressQuaternion(static_cast<std::uint32_t>(log_.value(type, i, f[3])));
+        p.w_q_b = q;
       }
       flight_.pose.push_back(p);
     }

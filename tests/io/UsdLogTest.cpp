@@ -263,6 +263,19 @@ TEST(UsdLogErrors, AnchorIdsAndQuaternionsAreCheckedAsTheCsvReaderDoes) {
               std::string::npos)
         << e.what();
   }
+  // A compressed quaternion whose three small components are too large to leave room for the largest.
+  UsdLog c;
+  c.source = "c.log";
+  const std::size_t cp = c.addType(3, "estPose", {{"x", F}, {"y", F}, {"z", F}, {"quat", UsdType::kUint32}});
+  c.addEvent(cp, 0, {0, 0, 0, double((3u << 30) | (511u << 20) | (511u << 10) | 511u)});
+  try {
+    (void)flightFromUsdLog(c);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("(estPose.quat): pose quaternion is far from unit norm: |q| = 1.22474"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(UsdLogErrors, SalvageReadsACutLogUpToTheLastCompleteEvent) {
