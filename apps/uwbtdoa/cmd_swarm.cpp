@@ -1,7 +1,7 @@
 /** @file cmd_swarm.cpp
  *  @brief `uwbtdoa swarm --agents N --scenario NAME [--duration S] [--seed K] [--speed 1|max] [--imu-rate HZ]
  *         [--fusion extrinsic|ci|naive] [--json] [--out DIR]`: cooperative localization of N simulated agents, each
- *         in its own process, over ZeroMQ on loopback (docs/io.md §6).
+ *         in its own process, over ZeroMQ on loopback (docs/io.md §7).
  *
  *  This process simulates the swarm and publishes each agent's sensor stream (one topic per agent), runs the
  *  belief bus (ZeroMQ's built-in XSUB/XPUB proxy) and the collector, and fork/execs N `uwbtdoa swarm-agent`

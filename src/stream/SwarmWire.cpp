@@ -1,5 +1,5 @@
 /** @file SwarmWire.cpp
- *  @brief Text bodies of the swarm wire, version 1 (docs/io.md §6).
+ *  @brief Text bodies of the swarm wire, version 1 (docs/io.md §7).
  */
 #include "uwb/stream/SwarmWire.h"
 

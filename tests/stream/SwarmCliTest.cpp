@@ -1,5 +1,5 @@
 /** @file SwarmCliTest.cpp
- *  @brief `uwbtdoa swarm` end to end (agents in their own processes over ZeroMQ, docs/io.md §6): a short run prints
+ *  @brief `uwbtdoa swarm` end to end (agents in their own processes over ZeroMQ, docs/io.md §7): a short run prints
  *         RMSE, NEES, rates and latencies; SIGINT stops every agent (none left behind), writes nothing, exits 130.
  *         The swarm wire's text bodies round-trip.
  */

@@ -1,5 +1,5 @@
 /** @file SwarmWire.h
- *  @brief The ZeroMQ messages of `uwbtdoa swarm` (docs/io.md §6, swarm wire version 1). Every message is two
+ *  @brief The ZeroMQ messages of `uwbtdoa swarm` (docs/io.md §7, swarm wire version 1). Every message is two
  *         frames, topic and body text:
  *
  *    "uwb.swarm.v1.events.KKKK"  agent KKKK's sensor events: "# SEND_NS" then event lines (LineProtocol.h) and
