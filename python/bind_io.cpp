@@ -18,6 +18,7 @@
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/Flight.h"
 #include "uwb/io/PoseTrack.h"
+#include "uwb/io/UsdImport.h"
 #include "uwb/io/UtilCsv.h"
 
 namespace uwb::python {
@@ -48,6 +49,19 @@ py::array_t<double> times(const std::vector<Sample>& v) {
   auto o = out.template mutable_unchecked<1>();
   for (std::size_t i = 0; i < v.size(); ++i) o(i) = v[i].t_s;
   return out;
+}
+
+/// Runs `read(report)` without the GIL; the flight, or (flight, to_dict(report)) when with_report.
+template <class Report, class Read, class ToDict>
+py::object flightWithReport(bool with_report, Read&& read, ToDict&& to_dict) {
+  Report report;
+  Flight f;
+  {
+    py::gil_scoped_release release;
+    f = read(report);
+  }
+  if (!with_report) return py::cast(std::move(f));
+  return py::make_tuple(std::move(f), to_dict(report));
 }
 
 // ---- C++ → numpy (one pass per stream) ----
@@ -548,16 +562,13 @@ void bindIo(py::module_& m) {
         FlightReadOptions options;
         for (const auto& name : required) options.required.push_back(streamFromName(name));
         options.survey = survey;
-        ReadReport report;
-        Flight f;
-        {
-          py::gil_scoped_release release;
-          f = readFlightCsv(path, options, &report);
-        }
-        if (!with_report) return py::cast(std::move(f));
-        py::dict r;
-        r["n_rows"] = report.n_rows, r["n_bytes"] = report.n_bytes, r["notes"] = report.notes;
-        return py::make_tuple(std::move(f), r);
+        return flightWithReport<ReadReport>(
+            with_report, [&](ReadReport& report) { return readFlightCsv(path, options, &report); },
+            [](const ReadReport& report) {
+              py::dict r;
+              r["n_rows"] = report.n_rows, r["n_bytes"] = report.n_bytes, r["notes"] = report.notes;
+              return r;
+            });
       },
       py::arg("path"), py::arg("required") = std::vector<std::string>{}, py::arg("survey") = nullptr,
       py::arg("with_report") = false,
@@ -571,6 +582,39 @@ void bindIo(py::module_& m) {
         writeFlightCsv(f, path);
       },
       py::arg("flight"), py::arg("path"), "Writes a flight in the UTIL layout (read_flight_csv reads it back exactly).");
+  m.def(
+      "import_usd_log",
+      [](const std::string& path, bool salvage, bool with_report) -> py::object {
+        UsdReadOptions options;
+        options.salvage = salvage;
+        return flightWithReport<UsdImportReport>(
+            with_report, [&](UsdImportReport& report) { return importUsdLog(path, options, &report); },
+            [](const UsdImportReport& report) {
+              py::list sources;
+              for (const auto& s : report.sources) {
+                py::dict d;
+                d["stream"] = streamName(s.stream), d["event"] = s.event, d["fields"] = s.fields, d["count"] = s.count;
+                sources.append(d);
+              }
+              py::dict r;
+              r["sources"] = sources, r["notes"] = report.notes, r["t0_us"] = report.t0_us;
+              return r;
+            });
+      },
+      py::arg("path"), py::arg("salvage") = false, py::arg("with_report") = false,
+      "Imports a Crazyflie uSD-card event log (cfusdlog, versions 1 and 2) as a flight, with UTIL's event-type\n"
+      "mapping and units (docs/io.md section 6). salvage=True reads a log whose writing was cut (no valid CRC).\n"
+      "with_report=True returns (flight, {sources: [{stream, event, fields, count}], notes, t0_us}).\n"
+      "ValueError 'file: byte B, event K (type.field): ...' on bad data, OSError when the file cannot be read.");
+  m.def(
+      "write_usd_log",
+      [](const Flight& f, const std::string& path) {
+        py::gil_scoped_release release;
+        writeUsdLog(usdLogFromFlight(f), path);
+      },
+      py::arg("flight"), py::arg("path"),
+      "Writes a flight as the events UTIL recorded (cfusdlog version 2, float32 values in the file units);\n"
+      "import_usd_log reads it back within float32 precision.");
   m.def(
       "read_trajectory_csv", [](const std::string& path) { return trajectoryToDict(readTrajectoryCsv(path)); },
       py::arg("path"),

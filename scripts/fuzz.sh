@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer harnesses (fuzz/, clang 14, ASan + UBSan) into build-fuzz/ and runs each in turn.
 #
-#   scripts/fuzz.sh [SECONDS_PER_HARNESS] [HARNESS...]     (default: 60 s each; harnesses: flight_csv survey
+#   scripts/fuzz.sh [SECONDS_PER_HARNESS] [HARNESS...]     (default: 60 s each; harnesses: flight_csv usd_log survey
 #                                                          trajectory_csv bias_model config_json)
 #
 # Seed corpora: scripts/make_fuzz_corpus.py cuts a few rows out of the real files (build-fuzz/seeds/<harness>);
@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 SECONDS_EACH="${1:-60}"
 shift || true
 HARNESSES=("$@")
-((${#HARNESSES[@]})) || HARNESSES=(flight_csv survey trajectory_csv bias_model config_json)
+((${#HARNESSES[@]})) || HARNESSES=(flight_csv usd_log survey trajectory_csv bias_model config_json)
 BUILD=build-fuzz
 
 command -v clang++-14 >/dev/null || UWB_WITH_CLANG=1 UWB_PACKAGES_ONLY=1 scripts/setup.sh

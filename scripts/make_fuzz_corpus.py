@@ -4,13 +4,15 @@
     scripts/make_fuzz_corpus.py OUT_DIR [DATA_DIR]      (DATA_DIR: $UWBTDOA_DATA or ../shared/data)
 
 Writes OUT_DIR/<harness>/seed_* : the first rows of a few real flights (full 27-column layout, position-only
-extract, a TWR-free subset), surveys, a trajectory CSV derived from a flight's ground truth, bias-model JSON and
+extract, a TWR-free subset), uSD-card event logs of the same rows, surveys, a trajectory CSV derived from a flight's ground truth, bias-model JSON and
 config JSON. Without the real data it writes the same kinds of files from built-in rows.
 """
 import json
 import math
 import os
+import struct
 import sys
+import zlib
 from pathlib import Path
 
 out = Path(sys.argv[1])
@@ -63,6 +65,55 @@ lines = flights[0][1].splitlines()
 names = lines[0].split(",")
 keep = [i for i, n in enumerate(names) if n in ("t_tdoa", "idA", "idB", "tdoa_meas", "t_pose", "pose_x", "pose_y", "pose_z")]
 put("flight_csv", "seed_subset.csv", "\n".join(",".join(l.split(",")[i] for i in keep) for l in lines) + "\n")
+
+# uSD-card event logs (cfusdlog, docs/io.md §6) holding the same rows as UTIL recorded them.
+def usd_log(rows, version):
+    """A cfusdlog file (header, events in row order, CRC-32) with UTIL's event types and field names."""
+    types = [(1, "estTDOA", ["idA(B)", "idB(B)", "distanceDiff(f)"], ["t_tdoa", "idA", "idB", "tdoa_meas"]),
+             (2, "estAcceleration", ["acc.x(f)", "acc.y(f)", "acc.z(f)"], ["t_acc", "acc_x", "acc_y", "acc_z"]),
+             (3, "estGyroscope", ["gyro.x(f)", "gyro.y(f)", "gyro.z(f)"], ["t_gyro", "gyro_x", "gyro_y", "gyro_z"]),
+             (4, "estTOF", ["range.zrange(H)"], ["t_tof", "tof"]),
+             (5, "estFlow", ["motion.deltaX(h)", "motion.deltaY(h)"], ["t_flow", "deltaX", "deltaY"]),
+             (6, "estBarometer", ["baro.asl(f)"], ["t_baro", "baro"]),
+             (7, "estPose", ["locSrv.x(f)", "locSrv.y(f)", "locSrv.z(f)", "locSrv.qx(f)", "locSrv.qy(f)",
+                             "locSrv.qz(f)", "locSrv.qw(f)"],
+              ["t_pose", "pose_x", "pose_y", "pose_z", "pose_qx", "pose_qy", "pose_qz", "pose_qw"])]
+    col = {n: i for i, n in enumerate(rows[0].split(","))}
+    out = bytearray(struct.pack("<BHH", 0xBC, version, len(types)))
+    for tid, name, fields, _ in types:
+        out += struct.pack("<H", tid) + name.encode() + b"\0" + struct.pack("<H", len(fields))
+        for f in fields:
+            out += f.encode() + b"\0"
+    events = []
+    for line in rows[1:]:
+        c = line.split(",")
+        for tid, _, fields, cols in types:
+            if any(k not in col or c[col[k]].strip() == "" for k in cols):
+                continue
+            vals = [float(c[col[k]]) for k in cols[1:]]
+            fmt = "<" + "".join(f[-2] for f in fields)
+            if tid == 4:
+                vals = [round(vals[0] * 1000)]
+            vals = [int(v) if ch in "BbHhIi" else v for v, ch in zip(vals, fmt[1:])]
+            t_us = round(float(c[col[cols[0]]]) * 1e6)
+            events.append((t_us, tid, struct.pack(fmt, *vals)))
+    events.sort(key=lambda e: (e[0], e[1]))
+    for t_us, tid, payload in events:
+        stamp = struct.pack("<I", t_us // 1000) if version == 1 else struct.pack("<Q", t_us)
+        out += struct.pack("<H", tid) + stamp + payload
+    return bytes(out + struct.pack("<I", zlib.crc32(bytes(out)) & 0xFFFFFFFF))
+
+
+def put_bytes(harness, name, data):
+    d = out / harness
+    d.mkdir(parents=True, exist_ok=True)
+    (d / name).write_bytes(data)
+
+
+flight_rows = flights[0][1].splitlines()
+put_bytes("usd_log", "seed_v2.log", usd_log(flight_rows[:6], 2))
+put_bytes("usd_log", "seed_v1.log", usd_log(flight_rows[:4], 1))
+put_bytes("usd_log", "seed_cut.log", usd_log(flight_rows[:3], 2)[:-7])
 
 surveys = [real / "util-pilot" / "survey" / "anchor_0425_survey.txt",
            real / "util-final-extract" / "survey" / "anchor_const4_survey.txt"]

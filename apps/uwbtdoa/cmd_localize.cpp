@@ -18,6 +18,7 @@
 #include "uwb/core/Error.h"
 #include "uwb/eval/BiasModel.h"
 #include "uwb/eval/Localization.h"
+#include "uwb/eval/RunDiagnostics.h"
 #include "uwb/filter/EkfParamRegistry.h"
 #include "uwb/io/FileAccess.h"
 #include "uwb/io/InputChecks.h"
@@ -31,6 +32,47 @@
 namespace {
 
 using nlohmann::json;
+
+json vecJson(const uwb::Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+/// The checks of eval/RunDiagnostics.h as JSON (null for a check that did not run).
+json diagnosticsJson(const uwb::RunDiagnostics& d) {
+  json j;
+  const uwb::SurveyFitCheck& s = d.survey;
+  j["survey_fit"] = !s.done ? json(nullptr)
+                            : json{{"n", s.n},
+                                   {"residual_rms_m", s.truncated_rms_m},
+                                   {"gross_fraction", s.gross_fraction},
+                                   {"start_rms_residual_m", s.start_rms_residual_m},
+                                   {"misfit", s.misfit},
+                                   {"mean_error_vs_truth_m", s.has_truth ? vecJson(s.mean_error_m) : json(nullptr)},
+                                   {"frame_offset", s.frame_offset}};
+  if (d.anchors.done) {
+    json per = json::array();
+    for (const uwb::AnchorOffset& o : d.anchors.anchors)
+      per.push_back({{"id", o.id},
+                     {"n", o.n},
+                     {"offset_m", vecJson(o.offset_m)},
+                     {"offset_norm_m", o.offset_m.norm()},
+                     {"rms_before_m", o.rms_before_m},
+                     {"rms_after_m", o.rms_after_m},
+                     {"gain_m", o.gain_m()}});
+    j["anchor_survey"] = {{"anchors", per},
+                          {"named_anchor", d.anchors.named_id >= 0 ? json(d.anchors.named_id) : json(nullptr)},
+                          {"named_offset_m", d.anchors.named_id >= 0 ? vecJson(d.anchors.named_offset_m) : json(nullptr)},
+                          {"top_gain_m", d.anchors.top_gain_m},
+                          {"gain_ratio", d.anchors.named_ratio}};
+  } else {
+    j["anchor_survey"] = nullptr;
+  }
+  j["clock_offset"] = !d.clock.done ? json(nullptr)
+                                    : json{{"lags_s", d.clock.lags_s},
+                                           {"residual_rms_m", d.clock.rms_m},
+                                           {"best_lag_s", d.clock.best_lag_s},
+                                           {"power_ratio", d.clock.power_ratio},
+                                           {"offset_detected", d.clock.offset}};
+  return j;
+}
 
 json statsJson(const uwb::PositionErrorStats& s) {
   return {{"n", s.n},
@@ -48,6 +90,7 @@ json statsJson(const uwb::PositionErrorStats& s) {
 struct LocalizeArgs {
   std::string flight, anchors, out, plot;
   bool json_out = false, tdoa_only = false, no_ground_detect = false;
+  bool no_diagnostics = false, fix_survey = false;
   double output_period = 0.01;
   uwb::app::FilterOptionArgs filter;  ///< --config, --bias-model, one flag per filter parameter
 };
@@ -98,15 +141,29 @@ void runLocalize(const LocalizeArgs& a) {
   opt.tdoa_only = a.tdoa_only;
   const auto t0 = std::chrono::steady_clock::now();
   const std::clock_t c0 = std::clock();  // process CPU time: the filter runs on one thread
-  const uwb::LocalizationRun run = uwb::localizeFlight(flight, survey, opt, bias);
+  uwb::LocalizationRun run = uwb::localizeFlight(flight, survey, opt, bias);
   const double cpu_s = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // the "wrong but plausible" checks: survey fit, one anchor mis-surveyed, TDoA/IMU clock offset (re-runs)
+  std::optional<uwb::RunDiagnostics> diag;
+  std::optional<uwb::LocalizationRun> fixed_run;
+  if (!a.no_diagnostics) {
+    diag = uwb::diagnoseRun(flight, survey, opt, run, bias);
+    for (const std::string& w : diag->warnings()) warnings.add(w);
+    if (a.fix_survey && diag->anchors.named_id >= 0)
+      fixed_run = uwb::localizeFlight(flight, uwb::correctedSurvey(survey, diag->anchors), opt, bias);
+  }
   std::vector<std::string> notes;  // expected behaviour worth stating (warnings are for doubtful input)
   if (use_imu && !flight.hasImu() && run.summary.process_model != uwb::ProcessModel::kImu) {
     notes.push_back(std::string("the flight has no IMU: the TDoA-only '") + uwb::toString(run.summary.process_model) +
                     "' model ran (the default without IMU)");
   }
 
+  double rmse_before_fix = std::numeric_limits<double>::quiet_NaN();
+  if (fixed_run) {
+    if (run.metrics && run.metrics->airborne.n) rmse_before_fix = run.metrics->airborne.rmse_m;
+    run = std::move(*fixed_run);
+  }
   const uwb::LocalizerSummary& s = run.summary;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   // the estimate lost the TDoA or diverged and was found again (docs/math/filter.md F16): the positions around
@@ -150,6 +207,16 @@ void runLocalize(const LocalizeArgs& a) {
   j["takeoff_t_s"] = std::isnan(s.takeoff_t_s) ? json(nullptr) : json(s.takeoff_t_s);
   j["landing_t_s"] = std::isnan(s.landing_t_s) ? json(nullptr) : json(s.landing_t_s);
   j["start_position_m"] = {s.start_w_p_b.x(), s.start_w_p_b.y(), s.start_w_p_b.z()};
+  j["diagnostics"] = diag ? diagnosticsJson(*diag) : json(nullptr);
+  if (diag && a.fix_survey && diag->anchors.named_id >= 0) {
+    // the estimate with the named anchor moved by its fitted offset: the trajectory written and the RMSE below
+    j["fixed_survey"] = {{"anchor", diag->anchors.named_id},
+                         {"offset_m", vecJson(diag->anchors.named_offset_m)},
+                         {"rmse_airborne_before_m",
+                          std::isfinite(rmse_before_fix) ? json(rmse_before_fix) : json(nullptr)}};
+    notes.push_back("--fix-survey: anchor " + std::to_string(diag->anchors.named_id) +
+                    " moved by its fitted offset; the results are those of the corrected survey");
+  }
   j["merge_notes"] = s.merge.notes();
   j["read_notes"] = read_report.notes;
   j["warnings"] = warnings.list();
@@ -238,6 +305,12 @@ const bool kRegistered = uwb::app::registerCommand(
                     "Use TDoA from the start (no take-off detection; = --ground-phase none)");
        uwb::app::addFilterOptions(sub, a->filter);
        sub.add_option("--output-period", a->output_period, "Trajectory sample spacing [s]");
+       sub.add_flag("--no-diagnostics", a->no_diagnostics,
+                    "Skip the checks after the run (survey fit, per-anchor survey, TDoA/IMU clock offset; they re-run "
+                    "the filter about 15 times)");
+       sub.add_flag("--fix-survey", a->fix_survey,
+                    "When the checks name a mis-surveyed anchor, re-run with it moved by its fitted offset and report "
+                    "that run");
        sub.callback([a] { runLocalize(*a); });
      }});
 

@@ -19,6 +19,7 @@
 #include "uwb/core/Error.h"
 #include "uwb/eval/EstimateChecks.h"
 #include "uwb/eval/FaultInjection.h"
+#include "uwb/eval/RunDiagnostics.h"
 #include "uwb/filter/EkfParamRegistry.h"
 #include "uwb/eval/Localization.h"
 #include "uwb/eval/ProtocolScenarios.h"
@@ -35,7 +36,7 @@ struct ProtocolArgs {
   std::string data_dir;
   std::vector<double> cuts{5.0, 10.0, 20.0};
   std::vector<std::string> sets;
-  bool json_out = false, no_real = false, no_sim = false, no_cuts = false, faults = false;
+  bool json_out = false, no_real = false, no_sim = false, no_cuts = false, faults = false, checks = false;
   std::string only;
 };
 
@@ -264,7 +265,7 @@ void runFaults(const ProtocolArgs& a, const uwb::LocalizationOptions& opt) {
   json rows = json::array();
   if (!a.json_out)
     std::cout << "## Fault injection\n\n| flight | fault | RMSE air clean [m] | RMSE air faulted [m] | ratio | max err 3–6 s "
-                 "after [m] | back below 0.5 m after [s] | reacq | note |\n|---|---|---|---|---|---|---|---|---|\n";
+                 "after [m] | back below 0.5 m after [s] | reacq | checks | note |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const RealFlight& f : realFlights(data)) {
     if (std::find(names.begin(), names.end(), f.name) == names.end()) continue;
     if (!a.only.empty() && f.name.find(a.only) == std::string::npos) continue;
@@ -279,6 +280,15 @@ void runFaults(const ProtocolArgs& a, const uwb::LocalizationOptions& opt) {
         if (std::isnan(t_air0)) t_air0 = e.t_s;
         t_air1 = e.t_s;
       }
+    // the checks after the run (eval/RunDiagnostics.h) on the clean flight: no finding expected
+    const std::string clean_verdict = uwb::diagnoseRun(flight, survey, opt, clean).verdict();
+    if (!a.json_out)
+      std::cout << "| " << f.name << " | none | " << fmt3(clean.metrics->airborne.rmse_m) << " | | | | | "
+                << clean.summary.n_reacquisitions << " | " << clean_verdict << " | |\n";
+    rows.push_back({{"flight", f.name},
+                    {"fault", "none"},
+                    {"rmse_airborne_clean_m", clean.metrics->airborne.rmse_m},
+                    {"checks", clean_verdict}});
     for (const uwb::FaultSpec& spec : uwb::standardFaults(t_air0 + 3.0, t_air1 - 3.0, survey.anchors.front().id)) {
       uwb::Flight fl = flight;
       uwb::AnchorSurvey sv = survey;
@@ -289,15 +299,18 @@ void runFaults(const ProtocolArgs& a, const uwb::LocalizationOptions& opt) {
       double err_after = std::nan(""), t_rec = std::nan("");
       if (run.metrics) recovery(*run.metrics, t_end, &err_after, &t_rec);
       const double faulted = run.metrics ? run.metrics->airborne.rmse_m : std::nan("");
+      const std::string verdict = uwb::diagnoseRun(fl, sv, opt, run).verdict();
       std::string note;
       for (const std::string& n : run.summary.merge.notes()) note += (note.empty() ? "" : "; ") + n;
       if (run.summary.n_time_jumps) note += (note.empty() ? "" : "; ") + std::to_string(run.summary.n_time_jumps) + " time jump(s)";
-      if (spec.kind == uwb::FaultKind::kAnchorSurveyOff) t_rec = std::nan("");
+      if (spec.kind == uwb::FaultKind::kAnchorSurveyOff || spec.kind == uwb::FaultKind::kClockOffsetTdoa ||
+          spec.kind == uwb::FaultKind::kSurveyShifted || spec.kind == uwb::FaultKind::kSurveyOtherArena)
+        t_rec = std::nan("");  // whole-flight faults: nothing to recover from
       if (!a.json_out)
         std::cout << "| " << f.name << " | " << uwb::toString(spec.kind) << " | " << fmt3(clean.metrics->airborne.rmse_m)
                   << " | " << fmt3(faulted) << " | " << fmt2(faulted / clean.metrics->airborne.rmse_m) << " | "
-                  << fmt3(err_after) << " | " << fmt2(t_rec) << " | " << run.summary.n_reacquisitions << " | " << note
-                  << " |\n";
+                  << fmt3(err_after) << " | " << fmt2(t_rec) << " | " << run.summary.n_reacquisitions << " | " << verdict
+                  << " | " << note << " |\n";
       rows.push_back({{"flight", f.name},
                       {"fault", uwb::toString(spec.kind)},
                       {"rmse_airborne_clean_m", clean.metrics->airborne.rmse_m},
@@ -305,10 +318,74 @@ void runFaults(const ProtocolArgs& a, const uwb::LocalizationOptions& opt) {
                       {"max_error_3_to_6s_after_m", std::isfinite(err_after) ? json(err_after) : json(nullptr)},
                       {"recover_below_0_5m_s", std::isfinite(t_rec) ? json(t_rec) : json(nullptr)},
                       {"n_reacquisitions", run.summary.n_reacquisitions},
+                      {"checks", verdict},
                       {"notes", note}});
     }
   }
   if (a.json_out) std::cout << json{{"faults", rows}}.dump() << '\n';
+}
+
+/// The statistics of the checks after a run (eval/RunDiagnostics.h) on every real flight, clean and with the
+/// faults they are meant to find: how the thresholds were chosen (docs/robustness.md, "Wrong but plausible").
+void runChecks(const ProtocolArgs& a, const uwb::LocalizationOptions& opt) {
+  const std::string data = a.data_dir.empty() ? uwb::app::defaultDataDir() : a.data_dir;
+  json rows = json::array();
+  if (!a.json_out)
+    std::cout << "## Checks after the run: statistic clean / faulted\n\n| flight | survey rms clean | other arena | "
+                 "shifted 10 m: mean error | anchor: top gain, ratio clean | anchor 1 m off: named, offset, gain, ratio | "
+                 "clock: lag, power ratio clean | TDoA 0.5 s late: lag, power ratio | verdict clean |\n"
+                 "|---|---|---|---|---|---|---|---|---|\n";
+  for (const RealFlight& f : realFlights(data)) {
+    if (!a.only.empty() && f.name.find(a.only) == std::string::npos) continue;
+    if (!fs::is_regular_file(f.path)) continue;
+    const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(f.survey);
+    const uwb::Flight flight = uwb::readFlightCsv(f.path);
+    const auto diagnose = [&](uwb::FaultKind kind, bool faulted) {
+      uwb::Flight fl = flight;
+      uwb::AnchorSurvey sv = survey;
+      if (faulted) uwb::injectFault({kind, 0.0, 1e9, survey.anchors.front().id, 1}, fl, sv);
+      const uwb::LocalizationRun run = uwb::localizeFlight(fl, sv, opt);
+      return uwb::diagnoseRun(fl, sv, opt, run);
+    };
+    const uwb::RunDiagnostics clean = diagnose(uwb::FaultKind::kOutlierBurst, false);
+    const uwb::RunDiagnostics arena = diagnose(uwb::FaultKind::kSurveyOtherArena, true);
+    const uwb::RunDiagnostics shifted = diagnose(uwb::FaultKind::kSurveyShifted, true);
+    const uwb::RunDiagnostics off = diagnose(uwb::FaultKind::kAnchorSurveyOff, true);
+    const uwb::RunDiagnostics late = diagnose(uwb::FaultKind::kClockOffsetTdoa, true);
+    const auto vec = [](const uwb::Vec3& v) { return json{v.x(), v.y(), v.z()}; };
+    rows.push_back({{"flight", f.name},
+                    {"survey_rms_clean_m", clean.survey.truncated_rms_m},
+                    {"survey_rms_other_arena_m", arena.survey.truncated_rms_m},
+                    {"mean_error_shifted_m", vec(shifted.survey.mean_error_m)},
+                    {"anchor_top_gain_clean_m", clean.anchors.top_gain_m},
+                    {"anchor_top_gain_faulted_m", off.anchors.top_gain_m},
+                    {"anchor_ratio_clean", clean.anchors.named_ratio},
+                    {"anchor_named_faulted", off.anchors.named_id},
+                    {"anchor_offset_faulted_m", vec(off.anchors.named_offset_m)},
+                    {"anchor_ratio_faulted", off.anchors.named_ratio},
+                    {"clock_done", clean.clock.done},
+                    {"clock_lag_clean_s", clean.clock.best_lag_s},
+                    {"clock_power_ratio_clean", clean.clock.power_ratio},
+                    {"clock_lag_faulted_s", late.clock.best_lag_s},
+                    {"clock_power_ratio_faulted", late.clock.power_ratio},
+                    {"verdict_clean", clean.verdict()},
+                    {"verdicts_faulted",
+                     {arena.verdict(), shifted.verdict(), off.verdict(), late.verdict()}}});
+    if (a.json_out) continue;
+    const std::string named = off.anchors.named_id >= 0 ? std::to_string(off.anchors.named_id) : "none";
+    std::cout << "| " << f.name << " | " << fmt3(clean.survey.truncated_rms_m) << " | "
+              << fmt3(arena.survey.truncated_rms_m) << " | " << fmt2(shifted.survey.mean_error_m.norm()) << " | "
+              << fmt3(clean.anchors.top_gain_m) << ", " << fmt2(clean.anchors.named_ratio) << " | " << named << ", "
+              << fmt2(off.anchors.named_offset_m.norm()) << ", " << fmt3(off.anchors.top_gain_m) << ", "
+              << fmt2(off.anchors.named_ratio) << " | ";
+    if (clean.clock.done)
+      std::cout << fmt2(clean.clock.best_lag_s) << ", " << fmt2(clean.clock.power_ratio) << " | "
+                << fmt2(late.clock.best_lag_s) << ", " << fmt2(late.clock.power_ratio) << " | ";
+    else
+      std::cout << "– (no IMU) | – | ";
+    std::cout << clean.verdict() << " |\n";
+  }
+  if (a.json_out) std::cout << json{{"checks", rows}}.dump() << '\n';
 }
 
 void runProtocol(const ProtocolArgs& a) {
@@ -319,6 +396,10 @@ void runProtocol(const ProtocolArgs& a) {
   opt.params = params;
   if (a.faults) {
     runFaults(a, opt);
+    return;
+  }
+  if (a.checks) {
+    runChecks(a, opt);
     return;
   }
   json j;
@@ -445,6 +526,9 @@ const bool kRegistered = uwb::app::registerCommand(
        sub.add_flag("--faults", a->faults,
                     "run the fault-injection suite on four dev flights instead (outliers, garbage, dead anchor, "
                     "anchor off, IMU dropout, clipping, clock jumps)");
+       sub.add_flag("--checks", a->checks,
+                    "the statistics of the checks after a run on every real flight, clean and with the faults they "
+                    "find (anchor 1 m off, TDoA clock 0.5 s late, survey shifted or of another arena)");
        sub.add_flag("--json", a->json_out, "print one JSON object instead of tables");
        sub.callback([a] { runProtocol(*a); });
      }});

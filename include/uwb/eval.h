@@ -9,4 +9,5 @@
 #include "uwb/eval/Evaluation.h"
 #include "uwb/eval/EvaluationTable.h"
 #include "uwb/eval/Localization.h"
+#include "uwb/eval/SwarmLocalization.h"
 #include "uwb/eval/TrajectoryMetrics.h"

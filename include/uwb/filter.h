@@ -4,6 +4,7 @@
  */
 #pragma once
 
+#include "uwb/filter/CooperativeRange.h"
 #include "uwb/filter/Ekf.h"
 #include "uwb/filter/EkfParams.h"
 #include "uwb/filter/Multilateration.h"

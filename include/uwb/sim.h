@@ -10,4 +10,5 @@
 #include "uwb/sim/ResidualProfile.h"
 #include "uwb/sim/Scenario.h"
 #include "uwb/sim/SimParams.h"
+#include "uwb/sim/Swarm.h"
 #include "uwb/sim/Trajectory.h"

@@ -18,6 +18,9 @@ std::string toString(FaultKind kind) {
     case FaultKind::kAccClipping: return "acc clipped at 1.2 g, 2 s";
     case FaultKind::kClockJumpTdoa: return "TDoA clock +0.5 s";
     case FaultKind::kClockJumpAll: return "all clocks +5 s";
+    case FaultKind::kClockOffsetTdoa: return "TDoA clock 0.5 s late, whole flight";
+    case FaultKind::kSurveyShifted: return "survey shifted 10 m";
+    case FaultKind::kSurveyOtherArena: return "survey of another arena (ids on other anchors)";
   }
   return "unknown";
 }
@@ -33,6 +36,9 @@ std::vector<FaultSpec> standardFaults(double t_air0_s, double t_air1_s, int anch
       {FaultKind::kAccClipping, tm - 1.0, tm + 1.0, anchor_id, 6},
       {FaultKind::kClockJumpTdoa, tm, tm, anchor_id, 7},
       {FaultKind::kClockJumpAll, tm, tm, anchor_id, 8},
+      {FaultKind::kClockOffsetTdoa, t_air0_s, t_air1_s, anchor_id, 9},
+      {FaultKind::kSurveyShifted, t_air0_s, t_air1_s, anchor_id, 10},
+      {FaultKind::kSurveyOtherArena, t_air0_s, t_air1_s, anchor_id, 11},
   };
 }
 
@@ -82,6 +88,21 @@ void injectFault(const FaultSpec& f, Flight& flight, AnchorSurvey& survey) {
       };
       shift(flight.tdoa), shift(flight.acc), shift(flight.gyro), shift(flight.tof), shift(flight.flow);
       shift(flight.baro), shift(flight.pose);
+      break;
+    }
+    case FaultKind::kClockOffsetTdoa:
+      for (TdoaMeasurement& m : flight.tdoa) m.t_s += 0.5;
+      break;
+    case FaultKind::kSurveyShifted:
+      for (Anchor& a : survey.anchors) a.w_p += Vec3(10.0, 0.0, 0.0);
+      break;
+    case FaultKind::kSurveyOtherArena: {
+      // each id gets the next anchor's position: the same kind of constellation, not this one (a rigid motion
+      // of the whole survey would leave every TDoA unchanged)
+      if (survey.anchors.size() < 2) break;
+      const Vec3 first = survey.anchors.front().w_p;
+      for (std::size_t i = 0; i + 1 < survey.anchors.size(); ++i) survey.anchors[i].w_p = survey.anchors[i + 1].w_p;
+      survey.anchors.back().w_p = first;
       break;
     }
   }

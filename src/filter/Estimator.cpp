@@ -405,6 +405,29 @@ void Estimator::addTof(const TofObservation& tof) {
   }
 }
 
+CooperativeRangeResult Estimator::addNeighbourRange(double t_s, const Moments3& neighbour, double range_m,
+                                                   const CooperativeRangeOptions& options) {
+  ++summary_.n_coop_total;
+  if (!initialized_ || !ready_ || start_.active() || phase_ == FlightPhase::kAcquisition) {
+    ++summary_.n_coop_not_ready;
+    return {};
+  }
+  t_last_event_ = std::max(t_last_event_, t_s);
+  summary_.end_t_s = t_last_event_;
+  if (!imu_mode_ || t_s - t_pred_ >= params_.update_predict_dt_s) predictTo(t_s);
+  propagate(true);  // (G21) the CI weight reads the current P
+  const CooperativeRangeResult r = updateCooperativeRange(ekf_, neighbour, range_m, options);
+  switch (r.outcome) {
+    case UpdateOutcome::kApplied:
+      ++summary_.n_coop_used;
+      summary_.coop_omega_sum += r.omega;
+      break;
+    case UpdateOutcome::kRejectedOutlier: ++summary_.n_coop_rejected; break;
+    default: ++summary_.n_coop_not_ready; break;
+  }
+  return r;
+}
+
 void Estimator::addTdoa(const TdoaObservation& z) {
   ++summary_.n_tdoa_total;
   last_tdoa_ = TdoaUpdateResult{};

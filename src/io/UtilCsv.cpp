@@ -162,12 +162,12 @@ struct StreamCursor {
   std::size_t count = 0;
 };
 
-bool equalsQuatNorm(double qx, double qy, double qz, double qw, double& norm) {
+}  // namespace
+
+bool isFileQuaternionNormOk(double qx, double qy, double qz, double qw, double& norm) {
   norm = std::sqrt(qx * qx + qy * qy + qz * qz + qw * qw);
   return std::abs(norm - 1.0) <= kMaxQuaternionNormError;
 }
-
-}  // namespace
 
 const char* streamName(Stream stream) {
   switch (stream) {
@@ -415,7 +415,7 @@ class RowParser {
     ps.w_p_b = Vec3(v[1], v[2], v[3]);
     if (layout_.pose_quat) {
       double norm = 0.0;
-      if (!equalsQuatNorm(v[4], v[5], v[6], v[7], norm)) {
+      if (!isFileQuaternionNormOk(v[4], v[5], v[6], v[7], norm)) {
         const int c = layout_.col[streamIndex(Stream::kPose)][kPoseQuatFirstField];
         fail(c + 1, names_[c],
              fmt::format("pose quaternion is far from unit norm: |q| = {:.6g} (tolerance {})", norm,

@@ -1,7 +1,8 @@
 /** @file FaultInjection.h
  *  @brief Faults a flight or a radio link can have, applied to a recorded flight (the fault-injection suite of
  *         `uwbtdoa protocol --faults`): outlier bursts, garbage TDoA, a dead anchor, an anchor surveyed off, IMU
- *         dropouts, accelerometer clipping, a clock jump in one stream or in all.
+ *         dropouts, accelerometer clipping, a clock jump in one stream or in all, a TDoA clock offset, a survey
+ *         shifted or of another arena.
  */
 #pragma once
 
@@ -23,6 +24,9 @@ enum class FaultKind {
   kAccClipping,     ///< accelerometer saturated at ±1.2 g per axis in the window
   kClockJumpTdoa,   ///< the TDoA stamps from the window start on 0.5 s late
   kClockJumpAll,    ///< every stream's stamps from the window start on 5 s late (the truth moves with them)
+  kClockOffsetTdoa, ///< the TDoA stamps 0.5 s late over the whole flight (window not used)
+  kSurveyShifted,   ///< the whole survey shifted by 10 m along x (window not used)
+  kSurveyOtherArena,///< the survey of another arena: each anchor id at the next anchor's position
 };
 
 struct FaultSpec {

@@ -87,6 +87,8 @@ class Ekf {
   void positionUpdate(int axis, double value_m, double sigma_m);
   /// Adds sigma² to the position (and optionally velocity) variances: used on re-acquisition.
   void inflatePosition(double sigma_m, double vel_sigma_mps);
+  /// P ← factor · P (factor > 0): the prior of a covariance-intersection update, P/ω (message-passing.md G21).
+  void scaleCovariance(double factor) { P_ *= factor; }
   /// Adds sigma² to the x and y position variances and vel_sigma² to the velocity variances.
   void inflateHorizontalPosition(double sigma_m, double vel_sigma_mps);
   /// Overwrites the position; keeps other state; sets the position block of P to sigma² I, clears its correlations.

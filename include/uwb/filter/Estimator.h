@@ -12,6 +12,7 @@
  *  @code
  *    Estimator est(EkfParams::defaults(), anchors);     // optional 3rd argument: a BiasPredictor
  *    est.addImu(t, imu);  est.addTdoa(z);  est.addTof(tof);   // in time order
+ *    est.addNeighbourRange(t, neighbour_belief, range_m, coop);  // another agent as an uncertain anchor (G20)
  *    if (est.ready()) { LocalizerEstimate e = est.estimate(); ... }
  *  @endcode
  */
@@ -23,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "uwb/filter/CooperativeRange.h"
 #include "uwb/filter/Ekf.h"
 #include "uwb/filter/EkfParams.h"
 #include "uwb/filter/RestDetector.h"
@@ -72,6 +74,12 @@ struct LocalizerSummary {
   std::size_t n_tof_invalid = 0;       ///< non-finite, ≤ 0 or above tof_max_range_m (ignored)
   std::size_t n_tof_tilted = 0;        ///< cos(tilt) ≤ kTofMinCosTilt (ignored)
   std::size_t n_tof_not_ready = 0;     ///< before the position was known
+  // ranges to neighbouring agents (message-passing.md G20–G22; only through addNeighbourRange)
+  std::size_t n_coop_total = 0;
+  std::size_t n_coop_used = 0;
+  std::size_t n_coop_rejected = 0;     ///< χ² gate
+  std::size_t n_coop_not_ready = 0;    ///< before the position was known, or degenerate
+  double coop_omega_sum = 0.0;         ///< Σ ω of the applied ones (mean = coop_omega_sum / n_coop_used)
   std::size_t n_predictions = 0;
   std::size_t n_covariance_propagations = 0;
   std::size_t n_zero_velocity_updates = 0;
@@ -106,6 +114,10 @@ class Estimator {
   void addImu(double t_s, const ImuReading& imu);
   void addTdoa(const TdoaObservation& z);
   void addTof(const TofObservation& tof);
+  /// A two-way range at t_s to a neighbouring agent whose tag-position belief (aged to t_s, G22) is `neighbour`
+  /// (G20, G21). Ignored (counted) before the position is known.
+  CooperativeRangeResult addNeighbourRange(double t_s, const Moments3& neighbour, double range_m,
+                                           const CooperativeRangeOptions& options);
 
   /// The position is known (after the first multilateration or from a given start).
   bool ready() const { return ready_; }

@@ -54,6 +54,8 @@ std::string formatFlightCsv(const Flight& flight);
 
 /// Largest tolerated |‖q‖ − 1| of a pose quaternion in a file (UTIL quantises components to ≈0.0014).
 inline constexpr double kMaxQuaternionNormError = 0.02;
+/// The reader's check of a pose quaternion: |‖q‖ − 1| ≤ kMaxQuaternionNormError; `norm` receives ‖q‖.
+bool isFileQuaternionNormOk(double qx, double qy, double qz, double qw, double& norm);
 
 /// UTIL column names of one stream, in UTIL order (pose: position columns then quaternion columns).
 std::vector<std::string> streamColumns(Stream stream);

@@ -1,0 +1,641 @@
+/** @file cmd_swarm.cpp
+ *  @brief `uwbtdoa swarm --agents N --scenario NAME [--duration S] [--seed K] [--speed 1|max] [--imu-rate HZ]
+ *         [--fusion extrinsic|ci|naive] [--json] [--out DIR]`: cooperative localization of N simulated agents, each
+ *         in its own process, over ZeroMQ on loopback (docs/io.md §7).
+ *
+ *  This process simulates the swarm and publishes each agent's sensor stream (one topic per agent), runs the
+ *  belief bus (ZeroMQ's built-in XSUB/XPUB proxy) and the collector, and fork/execs N `uwbtdoa swarm-agent`
+ *  processes (a hidden subcommand). Each agent runs a cooperative and an independent Estimator, publishes its belief
+ *  and its estimates on the bus and fuses its neighbours' beliefs with its TWR (message-passing.md G20–G22).
+ *  SIGINT/SIGTERM: every agent is sent SIGTERM and reaped, nothing is written, exit 130.
+ */
+#include <fmt/format.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+#include <zmq.hpp>
+
+#include "Command.h"
+#include "StopSignal.h"
+#include "uwb/core/Error.h"
+#include "uwb/eval/Localization.h"
+#include "uwb/io/FileAccess.h"
+#include "uwb/stream/LatencyStats.h"
+#include "uwb/stream/LineProtocol.h"
+#include "uwb/stream/SwarmWire.h"
+#include "uwb/stream/ZmqWire.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using json = nlohmann::json;
+
+std::int64_t nowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
+}
+
+constexpr int kExitInterrupted = 130;
+/// Sensor events of one agent are sent in batches of this much sensor time [s].
+constexpr double kBatch_s = 0.01;
+/// Agents publish an estimate pair for the collector this often (sensor time) [s].
+constexpr double kEstimatePeriod_s = 0.1;
+
+struct SwarmArgs {
+  int agents = 3;
+  std::string scenario = "nominal", speed = "1", fusion = "extrinsic", out;
+  double duration = 20.0, imu_rate = 1000.0;
+  std::uint64_t seed = 1;
+  bool json_out = false, in_process = false;
+};
+
+struct AgentArgs {
+  int id = 0, agents = 0;
+  std::string scenario, fusion, events, bus_in, bus_out;
+  double duration = 0.0;
+};
+
+uwb::CooperativeAgentOptions agentOptions(const std::string& fusion) {
+  uwb::CooperativeAgentOptions o;
+  if (fusion == "extrinsic") {
+    o.broadcast = uwb::BeliefSource::kIndependent;
+    o.range.fusion = uwb::NeighbourFusion::kNaive;  // exact: the belief holds nothing of the receiver's (G21)
+  } else if (fusion == "ci") {
+    o.broadcast = uwb::BeliefSource::kCooperative;
+    o.range.fusion = uwb::NeighbourFusion::kCovarianceIntersection;
+  } else if (fusion == "naive") {
+    o.broadcast = uwb::BeliefSource::kCooperative;
+    o.range.fusion = uwb::NeighbourFusion::kNaive;
+  } else {
+    throw uwb::InputError("--fusion: expected extrinsic, ci or naive, got '" + fusion + "'");
+  }
+  return o;
+}
+
+bool recvPair(zmq::socket_t& s, std::string& topic, std::string& body, int timeout_ms) {
+  zmq::pollitem_t item{s.handle(), 0, ZMQ_POLLIN, 0};
+  try {
+    if (zmq::poll(&item, 1, std::chrono::milliseconds(timeout_ms)) == 0) return false;
+  } catch (const zmq::error_t& e) {
+    if (e.num() == EINTR) return false;
+    throw;
+  }
+  zmq::message_t t, b;
+  if (!s.recv(t, zmq::recv_flags::dontwait)) return false;
+  if (!t.more()) throw uwb::InputError(uwb::SourceLocation{"<zmq>", 0, 0, "topic"}, "a message must have two frames");
+  (void)s.recv(b);
+  topic = t.to_string();
+  body = b.to_string();
+  return true;
+}
+
+void sendPair(zmq::socket_t& s, std::string_view topic, std::string_view body, bool block) {
+  const zmq::send_flags f = block ? zmq::send_flags::none : zmq::send_flags::dontwait;
+  if (!s.send(zmq::buffer(topic), f | zmq::send_flags::sndmore)) throw std::runtime_error("dropped");
+  s.send(zmq::buffer(body), zmq::send_flags::none);
+}
+
+// ---------------------------------------------------------------- agent process
+void runAgent(const AgentArgs& a) {
+  uwb::app::installStopHandlers();
+  const uwb::sim::SwarmScenario sc = uwb::sim::makeSwarmScenario(a.scenario, a.agents, a.duration);
+  const uwb::EkfParams params = uwb::EkfParams::defaults();
+  uwb::CooperativeAgent agent(a.id, params, uwb::anchorTableFromSurvey(sc.survey, params.anchor_sigma_m),
+                              agentOptions(a.fusion));
+  zmq::context_t ctx;
+  zmq::socket_t ev(ctx, zmq::socket_type::sub), bus_sub(ctx, zmq::socket_type::sub), bus_pub(ctx, zmq::socket_type::pub);
+  ev.set(zmq::sockopt::rcvhwm, 0);
+  ev.set(zmq::sockopt::linger, 0);
+  ev.set(zmq::sockopt::subscribe, uwb::swarmEventTopic(a.id));
+  ev.connect(a.events);
+  bus_sub.set(zmq::sockopt::linger, 0);
+  bus_sub.set(zmq::sockopt::subscribe, std::string(uwb::kSwarmBeliefTopic));
+  bus_sub.connect(a.bus_out);
+  bus_pub.set(zmq::sockopt::linger, 2000);
+  bus_pub.connect(a.bus_in);
+  uwb::LatencyStats lat_event, lat_belief;
+  std::size_t n_events = 0, n_beliefs_in = 0, n_beliefs_sent = 0, n_dropped = 0, n_est = 0, n_twr = 0;
+  double t_next_est = 0.0;
+  const auto publish = [&](std::string_view topic, const std::string& body) {
+    try {
+      sendPair(bus_pub, topic, body, false);
+      return true;
+    } catch (const std::runtime_error&) {
+      ++n_dropped;
+      return false;
+    }
+  };
+  zmq::pollitem_t items[2] = {{ev.handle(), 0, ZMQ_POLLIN, 0}, {bus_sub.handle(), 0, ZMQ_POLLIN, 0}};
+  bool done = false;
+  std::string topic, body;
+  std::size_t msg_no = 0;
+  while (!done && *uwb::app::stopFlag() == 0) {
+    try {
+      zmq::poll(items, 2, std::chrono::milliseconds(100));
+    } catch (const zmq::error_t& e) {
+      if (e.num() == EINTR) continue;
+      throw;
+    }
+    // beliefs first: the newest neighbours' beliefs before the next batch of measurements
+    while (recvPair(bus_sub, topic, body, 0)) {
+      std::int64_t send_ns = 0;
+      const uwb::NeighbourBelief b = uwb::parseBelief(body, ++msg_no, &send_ns);
+      if (b.agent == a.id) continue;
+      lat_belief.add(static_cast<double>(nowNs() - send_ns) * 1e-9);
+      agent.addBelief(b);
+      ++n_beliefs_in;
+    }
+    if (!recvPair(ev, topic, body, 0)) continue;
+    const std::int64_t t_arrival = nowNs();
+    if (body == uwb::kEndOfEvents) break;
+    std::size_t pos = 0, line_no = 0;
+    std::int64_t send_ns = 0;
+    while (pos < body.size()) {
+      const std::size_t nl = body.find('\n', pos);
+      const std::string_view line(body.data() + pos, (nl == std::string::npos ? body.size() : nl) - pos);
+      pos = nl == std::string::npos ? body.size() : nl + 1;
+      ++line_no;
+      if (line_no == 1 && line.size() > 2 && line[0] == '#') {
+        send_ns = std::stoll(std::string(line.substr(2)));
+        continue;
+      }
+      double t = 0.0, range = 0.0;
+      int peer = -1;
+      if (uwb::parseTwrLine(line, line_no, &t, &peer, &range)) {
+        agent.addRange(t, peer, range);
+        ++n_twr;
+      } else {
+        const uwb::StreamEvent e = uwb::parseEventLine(line, line_no, "<zmq>");
+        if (e.kind == uwb::StreamEvent::Kind::kImu) agent.addImu(e.t_s, e.imu);
+        else if (e.kind == uwb::StreamEvent::Kind::kTdoa) agent.addTdoa(e.tdoa);
+        else continue;
+      }
+      ++n_events;
+      if (agent.beliefDue() && publish(uwb::kSwarmBeliefTopic, uwb::formatBelief(agent.belief(), nowNs())))
+        ++n_beliefs_sent;
+      const double t_now = agent.cooperative().time();
+      if (t_now >= t_next_est && agent.cooperative().ready() && agent.independent().ready()) {
+        t_next_est = t_now + kEstimatePeriod_s;
+        const uwb::LocalizerEstimate c = agent.cooperative().estimate(), i = agent.independent().estimate();
+        uwb::SwarmEstimate se{a.id, t_now, c.x.w_p_b, i.x.w_p_b, c.cov_pose.topLeftCorner<3, 3>(),
+                              i.cov_pose.topLeftCorner<3, 3>()};
+        if (publish(uwb::kSwarmEstimateTopic, uwb::formatSwarmEstimate(se))) ++n_est;
+      }
+    }
+    (void)t_arrival;
+    lat_event.add(static_cast<double>(nowNs() - send_ns) * 1e-9);  // batch sent → last event of it handled
+  }
+  if (*uwb::app::stopFlag() != 0) return;  // interrupted: no report
+  const uwb::LocalizerSummary& s = agent.cooperative().summary();
+  json d = {{"agent", a.id},
+            {"events", n_events},
+            {"twr", n_twr},
+            {"twr_used", s.n_coop_used},
+            {"twr_rejected", s.n_coop_rejected},
+            {"twr_without_belief", agent.rangesWithoutBelief()},
+            {"mean_omega", s.n_coop_used ? s.coop_omega_sum / static_cast<double>(s.n_coop_used) : 1.0},
+            {"beliefs_sent", n_beliefs_sent},
+            {"beliefs_received", n_beliefs_in},
+            {"estimates_sent", n_est},
+            {"bus_dropped", n_dropped},
+            {"event_latency_p50_s", lat_event.quantile(0.5)},
+            {"event_latency_p99_s", lat_event.quantile(0.99)},
+            {"belief_latency_p50_s", lat_belief.quantile(0.5)},
+            {"belief_latency_p99_s", lat_belief.quantile(0.99)}};
+  sendPair(bus_pub, uwb::kSwarmDoneTopic, d.dump(), true);
+}
+
+// ---------------------------------------------------------------- parent: simulator, bus, collector
+struct Children {
+  std::vector<pid_t> pids;
+  void terminateAll() {
+    for (pid_t p : pids)
+      if (p > 0) ::kill(p, SIGTERM);
+    reapAll(3000);
+    for (pid_t p : pids)
+      if (p > 0) ::kill(p, SIGKILL);
+    reapAll(1000);
+  }
+  /// Reaps exited children; returns how many are still running.
+  std::size_t reap() {
+    std::size_t running = 0;
+    for (pid_t& p : pids) {
+      if (p <= 0) continue;
+      int st = 0;
+      const pid_t r = ::waitpid(p, &st, WNOHANG);
+      if (r == p) {
+        if (!(WIFEXITED(st) && WEXITSTATUS(st) == 0)) ++failed;
+        p = 0;
+      } else {
+        ++running;
+      }
+    }
+    return running;
+  }
+  void reapAll(int timeout_ms) {
+    const auto end = Clock::now() + std::chrono::milliseconds(timeout_ms);
+    while (reap() > 0 && Clock::now() < end) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  std::size_t failed = 0;
+};
+
+std::string selfExe() { return std::filesystem::read_symlink("/proc/self/exe").string(); }
+
+void runSwarm(const SwarmArgs& a) {
+  if (a.speed != "1" && a.speed != "max") throw uwb::InputError("--speed: expected 1 or max, got '" + a.speed + "'");
+  agentOptions(a.fusion);  // validates --fusion
+  if (!(a.imu_rate >= 50.0 && a.imu_rate <= 1000.0)) throw uwb::InputError("--imu-rate: expected 50 … 1000 Hz");
+  if (!a.out.empty()) uwb::checkOutputDirectory(a.out, "--out");
+  uwb::app::installStopHandlers();
+  const bool realtime = a.speed == "1";
+  const uwb::sim::SwarmScenario sc = uwb::sim::makeSwarmScenario(a.scenario, a.agents, a.duration);
+  uwb::sim::SimParams sp;
+  sp.imu.rate_hz = a.imu_rate;
+  const auto t_sim0 = Clock::now();
+  const uwb::sim::SwarmSimResult sim = uwb::sim::simulateSwarm(sc, sp, a.seed);
+  const double sim_wall_s = std::chrono::duration<double>(Clock::now() - t_sim0).count();
+  if (a.in_process) {
+    // the same agents in this process, events merged in sensor time, beliefs delivered after 10 ms (no ZeroMQ)
+    uwb::SwarmRunOptions o;
+    o.agent = agentOptions(a.fusion);
+    o.belief_latency_s = 0.01;
+    const uwb::SwarmScore sc_in = uwb::runSwarmInProcess(sc, sim, o);
+    const uwb::SwarmScore::Row r = sc_in.overall();
+    json j = {{"scenario", a.scenario}, {"agents", a.agents}, {"fusion", a.fusion}, {"in_process", true},
+              {"overall", {{"samples", r.n}, {"rmse_coop_m", r.rmse_coop_m}, {"rmse_indep_m", r.rmse_indep_m},
+                           {"nees_coop", r.nees_coop}, {"nees_indep", r.nees_indep}}}};
+    std::cout << (a.json_out ? j.dump() : j.dump(2)) << "\n";
+    return;
+  }
+
+  // endpoints in a private directory
+  char dir_tmpl[] = "/tmp/uwbtdoa-swarm-XXXXXX";
+  if (::mkdtemp(dir_tmpl) == nullptr) throw uwb::FileError("swarm: cannot create a directory for the ipc endpoints");
+  const std::string dir = dir_tmpl;
+  const std::string ep_events = "ipc://" + dir + "/events", ep_in = "ipc://" + dir + "/bus-in",
+                    ep_out = "ipc://" + dir + "/bus-out";
+  zmq::context_t ctx;
+  zmq::socket_t events(ctx, zmq::socket_type::xpub), xsub(ctx, zmq::socket_type::xsub),
+      xpub(ctx, zmq::socket_type::xpub);
+  events.set(zmq::sockopt::xpub_nodrop, 1);  // sensor events are never dropped: the publisher waits
+  events.set(zmq::sockopt::sndhwm, 100000);
+  events.set(zmq::sockopt::linger, 0);
+  events.bind(ep_events);
+  xsub.set(zmq::sockopt::linger, 0);
+  xpub.set(zmq::sockopt::linger, 0);
+  xsub.bind(ep_in);
+  xpub.bind(ep_out);
+  // collector: subscribed before any agent runs
+  zmq::socket_t collector(ctx, zmq::socket_type::sub);
+  collector.set(zmq::sockopt::rcvhwm, 0);
+  collector.set(zmq::sockopt::linger, 0);
+  collector.set(zmq::sockopt::subscribe, std::string(uwb::kSwarmEstimateTopic));
+  collector.set(zmq::sockopt::subscribe, std::string(uwb::kSwarmDoneTopic));
+  collector.set(zmq::sockopt::subscribe, std::string(uwb::kSwarmBeliefTopic));
+  collector.connect(ep_out);
+  std::thread proxy([&] {
+    try {
+      zmq::proxy(xsub, xpub);
+    } catch (const zmq::error_t&) {
+      // context shut down: the bus is closed
+    }
+  });
+
+  Children children;
+  std::atomic<bool> collecting{true};
+  std::mutex mu;
+  uwb::SwarmScore score(a.agents);
+  std::vector<json> done(static_cast<std::size_t>(a.agents));
+  std::size_t n_done = 0, n_est = 0, n_beliefs = 0;
+  std::string collector_error;
+  std::thread collect([&] {
+    std::string topic, body;
+    std::size_t no = 0;
+    std::vector<uwb::sim::Trajectory> truth;
+    for (const auto& ag : sc.agents) truth.emplace_back(ag.trajectory);
+    try {
+      while (collecting.load()) {
+        if (!recvPair(collector, topic, body, 50)) continue;
+        ++no;
+        std::lock_guard<std::mutex> lock(mu);
+        if (topic == uwb::kSwarmEstimateTopic) {
+          const uwb::SwarmEstimate e = uwb::parseSwarmEstimate(body, no);
+          ++n_est;
+          if (e.agent >= 0 && e.agent < a.agents && uwb::swarmScoringWindow(sc, e.agent, e.t_s))
+            score.add(e.agent, truth[static_cast<std::size_t>(e.agent)].evaluate(e.t_s).w_p, e.p_coop, e.cov_coop,
+                      e.p_indep, e.cov_indep);
+        } else if (topic == uwb::kSwarmDoneTopic) {
+          const json d = json::parse(body);
+          const int k = d.at("agent").get<int>();
+          if (k >= 0 && k < a.agents && done[static_cast<std::size_t>(k)].is_null()) {
+            done[static_cast<std::size_t>(k)] = d;
+            ++n_done;
+          }
+        } else if (topic == uwb::kSwarmBeliefTopic) {
+          ++n_beliefs;
+        }
+      }
+    } catch (const std::exception& ex) {
+      std::lock_guard<std::mutex> lock(mu);
+      collector_error = ex.what();
+    }
+  });
+  const auto shutdown = [&] {
+    collecting = false;
+    collect.join();
+    ctx.shutdown();
+    proxy.join();
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+  };
+
+  // agents
+  const std::string exe = selfExe();
+  for (int k = 0; k < a.agents; ++k) {
+    const std::vector<std::string> argv_s = {exe, "swarm-agent", "--id", std::to_string(k), "--agents",
+                                             std::to_string(a.agents), "--scenario", a.scenario, "--duration",
+                                             fmt::format("{}", a.duration), "--fusion", a.fusion, "--events",
+                                             ep_events, "--bus-in", ep_in, "--bus-out", ep_out};
+    const pid_t pid = ::fork();
+    if (pid < 0) {
+      children.terminateAll();
+      shutdown();
+      throw std::runtime_error("swarm: fork failed");
+    }
+    if (pid == 0) {
+      ::prctl(PR_SET_PDEATHSIG, SIGTERM);  // an agent never outlives the swarm
+      std::vector<char*> argv;
+      for (const std::string& s : argv_s) argv.push_back(const_cast<char*>(s.c_str()));
+      argv.push_back(nullptr);
+      ::execv(exe.c_str(), argv.data());
+      ::_exit(127);
+    }
+    children.pids.push_back(pid);
+  }
+  const auto interrupted = [&] { return *uwb::app::stopFlag() != 0; };
+  const auto abort = [&](const std::string& why) {
+    children.terminateAll();
+    shutdown();
+    if (why.empty()) {
+      std::cerr << "swarm: interrupted; all agents stopped, nothing written\n";
+      std::exit(kExitInterrupted);
+    }
+    throw std::runtime_error("swarm: " + why);
+  };
+  // wait until every agent subscribed to its event topic (XPUB sees the subscriptions)
+  {
+    std::set<std::string> subscribed;
+    const auto deadline = Clock::now() + std::chrono::seconds(30);
+    while (static_cast<int>(subscribed.size()) < a.agents) {
+      if (interrupted()) abort("");
+      if (Clock::now() > deadline) abort("agents did not subscribe within 30 s");
+      if (children.reap() < static_cast<std::size_t>(a.agents)) abort("an agent exited at start-up");
+      zmq::pollitem_t item{events.handle(), 0, ZMQ_POLLIN, 0};
+      try {
+        if (zmq::poll(&item, 1, std::chrono::milliseconds(50)) == 0) continue;
+      } catch (const zmq::error_t& e) {
+        if (e.num() == EINTR) continue;
+        throw;
+      }
+      zmq::message_t m;
+      if (events.recv(m, zmq::recv_flags::dontwait) && m.size() > 1 && m.data<char>()[0] == 1)
+        subscribed.insert(std::string(m.data<char>() + 1, m.size() - 1));
+    }
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the agents' bus connections settle
+
+  // publish: per agent, batches of kBatch_s of sensor time, paced to the wall clock at --speed 1
+  std::vector<uwb::SensorLog> logs;
+  for (const auto& ag : sim.agents) logs.push_back(uwb::sensorLogFromFlight(ag.flight));
+  std::vector<std::vector<std::size_t>> twr_of(static_cast<std::size_t>(a.agents));
+  for (std::size_t i = 0; i < sim.twr.size(); ++i) {
+    twr_of[static_cast<std::size_t>(sim.twr[i].agent_i)].push_back(i);
+    twr_of[static_cast<std::size_t>(sim.twr[i].agent_j)].push_back(i);
+  }
+  struct Cursor {
+    std::size_t imu = 0, tdoa = 0, twr = 0;
+  };
+  std::vector<Cursor> cur(static_cast<std::size_t>(a.agents));
+  uwb::LatencyStats lateness;
+  std::size_t n_msgs = 0, n_lines = 0;
+  const auto t_wall0 = Clock::now();
+  std::string body;
+  for (double t_end = kBatch_s; t_end < a.duration + kBatch_s; t_end += kBatch_s) {
+    if (interrupted()) abort("");
+    if (realtime) {
+      const auto due = t_wall0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(t_end));
+      std::this_thread::sleep_until(due);
+      lateness.add(std::chrono::duration<double>(Clock::now() - due).count());
+    }
+    if (children.reap() < static_cast<std::size_t>(a.agents)) abort("an agent exited early");
+    for (int k = 0; k < a.agents; ++k) {
+      const uwb::SensorLog& log = logs[static_cast<std::size_t>(k)];
+      Cursor& c = cur[static_cast<std::size_t>(k)];
+      body = fmt::format("# {}\n", nowNs());
+      const std::size_t n0 = n_lines;
+      // merged in time order: IMU before TDoA before TWR at equal stamps
+      while (true) {
+        const double ti = c.imu < log.imu.size() ? log.imu[c.imu].t_s : 1e300;
+        const double td = c.tdoa < log.tdoa.size() ? log.tdoa[c.tdoa].t_s : 1e300;
+        const auto& tw = twr_of[static_cast<std::size_t>(k)];
+        const double tr = c.twr < tw.size() ? sim.twr[tw[c.twr]].t_s : 1e300;
+        const double t = std::min({ti, td, tr});
+        if (!(t < t_end)) break;
+        if (ti == t) {
+          body += uwb::formatImuLine(ti, log.imu[c.imu++].imu);
+        } else if (td == t) {
+          body += uwb::formatTdoaLine(log.tdoa[c.tdoa++]);
+        } else {
+          const uwb::sim::TwrObservation& r = sim.twr[tw[c.twr++]];
+          body += uwb::formatTwrLine(r.t_s, r.agent_i == k ? r.agent_j : r.agent_i, r.range_m);
+        }
+        body += '\n';
+        ++n_lines;
+      }
+      if (n_lines == n0) continue;
+      body.pop_back();
+      sendPair(events, uwb::swarmEventTopic(k), body, true);
+      ++n_msgs;
+    }
+  }
+  for (int k = 0; k < a.agents; ++k) sendPair(events, uwb::swarmEventTopic(k), uwb::kEndOfEvents, true);
+  const double publish_wall_s = std::chrono::duration<double>(Clock::now() - t_wall0).count();
+  // wait for every agent's report
+  const auto deadline = Clock::now() + std::chrono::seconds(60);
+  while (true) {
+    if (interrupted()) abort("");
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      if (n_done == static_cast<std::size_t>(a.agents) || !collector_error.empty()) break;
+    }
+    if (Clock::now() > deadline) abort("agents did not report within 60 s of the end");
+    if (children.reap() == 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the last reports in flight
+      std::lock_guard<std::mutex> lock(mu);
+      if (n_done < static_cast<std::size_t>(a.agents)) {
+        children.failed += static_cast<std::size_t>(a.agents) - n_done;
+        break;
+      }
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  const double total_wall_s = std::chrono::duration<double>(Clock::now() - t_wall0).count();
+  children.reapAll(10000);
+  shutdown();
+  if (!collector_error.empty()) throw uwb::InputError("swarm collector: " + collector_error);
+  if (children.failed > 0 || n_done < static_cast<std::size_t>(a.agents))
+    throw std::runtime_error(fmt::format("swarm: {} agent(s) failed or did not report", a.agents - static_cast<int>(n_done)));
+
+  // ---- report
+  uwb::LatencyStats ev50, ev99, bl50, bl99;
+  std::size_t bus_dropped = 0, beliefs_sent = 0, twr_used = 0, twr_total = 0;
+  json agents_j = json::array();
+  for (int k = 0; k < a.agents; ++k) {
+    const json& d = done[static_cast<std::size_t>(k)];
+    const uwb::SwarmScore::Row r = score.agent(k);
+    ev50.add(d.value("event_latency_p50_s", 0.0));
+    ev99.add(d.value("event_latency_p99_s", 0.0));
+    if (!d.at("belief_latency_p50_s").is_null()) {
+      bl50.add(d.value("belief_latency_p50_s", 0.0));
+      bl99.add(d.value("belief_latency_p99_s", 0.0));
+    }
+    bus_dropped += d.at("bus_dropped").get<std::size_t>();
+    beliefs_sent += d.at("beliefs_sent").get<std::size_t>();
+    twr_used += d.at("twr_used").get<std::size_t>();
+    twr_total += d.at("twr").get<std::size_t>();
+    json aj = d;
+    aj["samples"] = r.n;
+    aj["rmse_coop_m"] = r.rmse_coop_m;
+    aj["rmse_indep_m"] = r.rmse_indep_m;
+    aj["nees_coop"] = r.nees_coop;
+    aj["nees_indep"] = r.nees_indep;
+    agents_j.push_back(aj);
+  }
+  const uwb::SwarmScore::Row all = score.overall();
+  const double dur = a.duration;
+  json rep = {{"scenario", a.scenario},
+              {"agents", a.agents},
+              {"duration_s", dur},
+              {"seed", a.seed},
+              {"speed", a.speed},
+              {"imu_rate_hz", a.imu_rate},
+              {"fusion", a.fusion},
+              {"overall",
+               {{"samples", all.n},
+                {"rmse_coop_m", all.rmse_coop_m},
+                {"rmse_indep_m", all.rmse_indep_m},
+                {"nees_coop", all.nees_coop},
+                {"nees_indep", all.nees_indep}}},
+              {"rates",
+               {{"event_messages_per_s", static_cast<double>(n_msgs) / publish_wall_s},
+                {"event_lines_per_s", static_cast<double>(n_lines) / publish_wall_s},
+                {"beliefs_per_s", static_cast<double>(beliefs_sent) / publish_wall_s},
+                {"estimates_per_s", static_cast<double>(n_est) / publish_wall_s},
+                {"twr_per_s", static_cast<double>(twr_total) / publish_wall_s},
+                {"twr_used", twr_used},
+                {"bus_dropped", bus_dropped},
+                {"sensor_events_dropped", 0}}},
+              {"latency_s",
+               {{"event_p50_median_over_agents", ev50.quantile(0.5)},
+                {"event_p99_max_over_agents", ev99.quantile(1.0)},
+                {"belief_p50_median_over_agents", bl50.quantile(0.5)},
+                {"belief_p99_max_over_agents", bl99.quantile(1.0)},
+                {"publisher_lateness_p99", lateness.quantile(0.99)},
+                {"publisher_lateness_max", lateness.quantile(1.0)}}},
+              {"wall_s", {{"simulate", sim_wall_s}, {"publish", publish_wall_s}, {"total", total_wall_s}}},
+              {"per_agent", agents_j}};
+  if (!a.out.empty()) {
+    std::string csv = "agent,samples,rmse_coop_m,rmse_indep_m,nees_coop,nees_indep\n";
+    for (int k = 0; k < a.agents; ++k) {
+      const uwb::SwarmScore::Row r = score.agent(k);
+      csv += fmt::format("{},{},{},{},{},{}\n", k, r.n, r.rmse_coop_m, r.rmse_indep_m, r.nees_coop, r.nees_indep);
+    }
+    uwb::writeFileAtomically((std::filesystem::path(a.out) / "swarm_agents.csv").string(), csv, "swarm --out");
+    uwb::writeFileAtomically((std::filesystem::path(a.out) / "swarm_report.json").string(), rep.dump(2) + "\n",
+                             "swarm --out");
+  }
+  if (a.json_out) {
+    std::cout << rep.dump() << "\n";
+    return;
+  }
+  std::cout << fmt::format("swarm: {} agents, scenario {}, {} s, seed {}, speed {}, IMU {} Hz, fusion {}\n", a.agents,
+                           a.scenario, dur, a.seed, a.speed, a.imu_rate, a.fusion);
+  std::cout << "agent  samples  RMSE coop [m]  RMSE indep [m]  NEES coop  NEES indep  TWR used  beliefs in\n";
+  for (int k = 0; k < a.agents; ++k) {
+    const uwb::SwarmScore::Row r = score.agent(k);
+    const json& d = done[static_cast<std::size_t>(k)];
+    std::cout << fmt::format("{:5d}  {:7d}  {:13.3f}  {:14.3f}  {:9.2f}  {:10.2f}  {:8d}  {:10d}\n", k, r.n,
+                             r.rmse_coop_m, r.rmse_indep_m, r.nees_coop, r.nees_indep,
+                             d.at("twr_used").get<std::size_t>(), d.at("beliefs_received").get<std::size_t>());
+  }
+  std::cout << fmt::format("overall  {:5d}  {:13.3f}  {:14.3f}  {:9.2f}  {:10.2f}\n", all.n, all.rmse_coop_m,
+                           all.rmse_indep_m, all.nees_coop, all.nees_indep);
+  std::cout << fmt::format(
+      "rates: {:.0f} event messages/s ({:.0f} lines/s), {:.0f} beliefs/s, {:.0f} estimates/s, {:.0f} TWR/s; "
+      "dropped: 0 sensor events, {} bus messages\n",
+      static_cast<double>(n_msgs) / publish_wall_s, static_cast<double>(n_lines) / publish_wall_s,
+      static_cast<double>(beliefs_sent) / publish_wall_s, static_cast<double>(n_est) / publish_wall_s,
+      static_cast<double>(twr_total) / publish_wall_s, bus_dropped);
+  std::cout << fmt::format(
+      "latency: event batch sent → handled p50 {:.3f} ms (median over agents), p99 {:.3f} ms (worst agent); "
+      "belief sent → received p50 {:.3f} ms, p99 {:.3f} ms{}\n",
+      ev50.quantile(0.5) * 1e3, ev99.quantile(1.0) * 1e3, bl50.quantile(0.5) * 1e3, bl99.quantile(1.0) * 1e3,
+      realtime ? fmt::format("; publisher behind schedule p99 {:.3f} ms, max {:.3f} ms", lateness.quantile(0.99) * 1e3,
+                             lateness.quantile(1.0) * 1e3)
+               : std::string());
+  std::cout << fmt::format("wall: simulate {:.2f} s, publish {:.2f} s for {:.1f} s of flight, total {:.2f} s\n", sim_wall_s,
+                           publish_wall_s, dur, total_wall_s);
+}
+
+const bool kRegistered = uwb::app::registerCommand(
+    {"swarm", "Cooperative localization of N simulated agents, one process each, over ZeroMQ on loopback",
+     [](CLI::App& sub) {
+       auto a = std::make_shared<SwarmArgs>();
+       sub.add_option("--agents", a->agents, "Number of agents (1 … 200)")->required();
+       sub.add_option("--scenario", a->scenario, "nominal | few-anchors | outside-hull | occluded")
+           ->check(CLI::IsMember(uwb::sim::swarmScenarioNames()));
+       sub.add_option("--duration", a->duration, "Flight duration [s] (≥ 4)");
+       sub.add_option("--seed", a->seed, "Simulation seed");
+       sub.add_option("--speed", a->speed, "1: sensor events in real time; max: as fast as possible")
+           ->check(CLI::IsMember({"1", "max"}));
+       sub.add_option("--imu-rate", a->imu_rate, "Simulated IMU rate [Hz] (50 … 1000)");
+       sub.add_option("--fusion", a->fusion,
+                      "extrinsic: broadcast anchors-only beliefs (default); ci: cooperative beliefs by covariance "
+                      "intersection; naive: cooperative beliefs as if independent")
+           ->check(CLI::IsMember({"extrinsic", "ci", "naive"}));
+       sub.add_flag("--json", a->json_out, "Print one JSON object");
+       sub.add_flag("--in-process", a->in_process,
+                    "Run the same agents in this process in sensor time (no ZeroMQ, deterministic): overall scores only");
+       sub.add_option("--out", a->out, "Write swarm_report.json and swarm_agents.csv here (atomically, at the end)");
+       sub.callback([a] { runSwarm(*a); });
+     }});
+
+const bool kRegisteredAgent = uwb::app::registerCommand({"swarm-agent", "", [](CLI::App& sub) {
+                                                           auto a = std::make_shared<AgentArgs>();
+                                                           sub.group("");  // hidden: started by `swarm`
+                                                           sub.add_option("--id", a->id)->required();
+                                                           sub.add_option("--agents", a->agents)->required();
+                                                           sub.add_option("--scenario", a->scenario)->required();
+                                                           sub.add_option("--duration", a->duration)->required();
+                                                           sub.add_option("--fusion", a->fusion)->required();
+                                                           sub.add_option("--events", a->events)->required();
+                                                           sub.add_option("--bus-in", a->bus_in)->required();
+                                                           sub.add_option("--bus-out", a->bus_out)->required();
+                                                           sub.callback([a] { runAgent(*a); });
+                                                         }});
+
+}  // namespace
