@@ -306,8 +306,8 @@ const bool kRegistered = uwb::app::registerCommand(
        uwb::app::addFilterOptions(sub, a->filter);
        sub.add_option("--output-period", a->output_period, "Trajectory sample spacing [s]");
        sub.add_flag("--no-diagnostics", a->no_diagnostics,
-                    "Skip the checks after the run (survey fit, per-anchor survey, TDoA/IMU clock offset; they re-run "
-                    "the filter about 15 times)");
+                    "Skip the checks after the run (survey fit, per-anchor survey; they re-run the filter once per "
+                    "anchor)");
        sub.add_flag("--fix-survey", a->fix_survey,
                     "When the checks name a mis-surveyed anchor, re-run with it moved by its fitted offset and report "
                     "that run");

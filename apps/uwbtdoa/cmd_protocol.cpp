@@ -345,7 +345,9 @@ void runChecks(const ProtocolArgs& a, const uwb::LocalizationOptions& opt) {
       uwb::AnchorSurvey sv = survey;
       if (faulted) uwb::injectFault({kind, 0.0, 1e9, survey.anchors.front().id, 1}, fl, sv);
       const uwb::LocalizationRun run = uwb::localizeFlight(fl, sv, opt);
-      return uwb::diagnoseRun(fl, sv, opt, run);
+      uwb::RunDiagnosticParams checks;
+      checks.clock_offset = true;  // the table shows what the lag search finds, though it is off in `localize`
+      return uwb::diagnoseRun(fl, sv, opt, run, {}, checks);
     };
     const uwb::RunDiagnostics clean = diagnose(uwb::FaultKind::kOutlierBurst, false);
     const uwb::RunDiagnostics arena = diagnose(uwb::FaultKind::kSurveyOtherArena, true);

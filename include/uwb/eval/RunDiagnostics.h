@@ -36,7 +36,9 @@ namespace uwb {
 struct RunDiagnosticParams {
   bool survey_fit = true;    ///< residual level of the whole survey (no re-run)
   bool anchor_survey = true; ///< leave-one-anchor-out offsets (one re-run per anchor)
-  bool clock_offset = true;  ///< TDoA/IMU lag search (IMU runs only; clock_lags_s.size() re-runs at most)
+  /// TDoA/IMU lag search (IMU runs only; clock_lags_s.size() re-runs at most). Off by default: it finds the offset on
+  /// simulated flights but not on real ones (docs/robustness.md), so it would only cost time.
+  bool clock_offset = false;
   double max_gap_s = 0.1;    ///< trajectory samples farther apart are not interpolated across [s]
   /// Residuals are clipped at this in the residual power and left out of the anchor fits [m]
   /// (kGrossResidual_m of io/ResidualStats.h).
