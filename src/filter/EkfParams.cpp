@@ -40,6 +40,13 @@ void EkfParams::validate() const {
     throw std::invalid_argument("EkfParams.robust_iterations must be in [1, 20]");
   requirePositive(max_lost_s, "max_lost_s");
   requireNonNegative(pair_bias_tau_s, "pair_bias_tau_s");
+  if (antenna_bias_degree != 0 && (antenna_bias_degree < 2 || antenna_bias_degree > 4))
+    throw std::invalid_argument("EkfParams.antenna_bias_degree must be 0 (off) or in [2, 4]");
+  requirePositive(antenna_bias_sigma_m, "antenna_bias_sigma_m");
+  requireNonNegative(antenna_bias_memory_s, "antenna_bias_memory_s");
+  requireNonNegative(antenna_bias_offset_sigma_m, "antenna_bias_offset_sigma_m");
+  requirePositive(antenna_bias_offset_memory_s, "antenna_bias_offset_memory_s");
+  requirePositive(antenna_bias_noise_scale, "antenna_bias_noise_scale");
   requirePositive(bias_guard_tau_s, "bias_guard_tau_s");
   requirePositive(max_predict_dt_s, "max_predict_dt_s");
   requireNonNegative(cov_period_s, "cov_period_s");

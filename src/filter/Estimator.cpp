@@ -54,6 +54,8 @@ constexpr double kContactSustained_s = 1.5;
 constexpr double kLowFlight_m = 0.25;
 /// Constant time of the take-off detector's leaky vertical-velocity integrator [s] (F15).
 constexpr double kTakeoffLeak_s = 1.0;
+/// (F25) whether the learned pattern's variance hᵀ P_θ h is added to the filter's TDoA variance.
+constexpr bool kAntennaVarianceInFilter = false;
 
 }  // namespace
 
@@ -100,6 +102,24 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
   tof_opt_.floor_z_m = params_.floor_z_m;
   tof_opt_.max_range_m = params_.tof_max_range_m;
   if (params_.pair_bias_tau_s > 0.0) pair_offsets_.resize(kMaxPairId * kMaxPairId);
+  if (params_.antenna_bias_degree > 0) {
+    // (F25) the learned antenna pattern adds to the (optional) bias model's correction
+    antenna_.emplace(AntennaBiasParams{params_.antenna_bias_degree, params_.antenna_bias_sigma_m,
+                                       params_.antenna_bias_memory_s, params_.b_t_tag,
+                                       params_.antenna_bias_offset_sigma_m, params_.antenna_bias_offset_memory_s});
+    corrections_ = [this](const TdoaFeature& feature) {
+      BiasPrediction b = bias_ ? bias_(feature) : BiasPrediction{};
+      // a prediction the update discards (F12) must not leave a regressor for learning
+      antenna_predicted_ = std::isfinite(b.mean_m) && std::isfinite(b.variance_m2) && b.variance_m2 >= 0.0 &&
+                           std::isfinite(b.noise_scale) && b.noise_scale > 0.0;
+      if (!antenna_predicted_) return b;
+      const BiasPrediction a = antenna_->predict(feature);
+      b.mean_m += a.mean_m;
+      antenna_var_m2_ = kAntennaVarianceInFilter ? a.variance_m2 : 0.0;
+      b.variance_m2 += antenna_var_m2_;
+      return b;
+    };
+  }
   bias_floor_ = Mat3::Identity() * params_.output_bias_sigma_m * params_.output_bias_sigma_m;
   recent_pairs_.reserve(64);
 }
@@ -485,8 +505,20 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   // (F14) TDoA near the floor carry the large floor-level bias: down-weighted on the ground and just above it
   const bool near_floor = on_ground_ || ekf_.state().w_p_b.z() - params_.ground_z_m < kLowFlight_m;
   const TdoaUpdateOptions& opt = acquiring ? acq_opt_ : (near_floor ? rest_opt_ : track_opt_);
-  const TdoaUpdateResult r = updateTdoa(ekf_, anchors_, zc, opt, bias_ ? &bias_ : nullptr);
+  if (antenna_) {
+    antenna_->advance(t);
+    antenna_predicted_ = false;
+  }
+  const BiasPredictor* predictor = antenna_ ? &corrections_ : (bias_ ? &bias_ : nullptr);
+  const TdoaUpdateResult r = updateTdoa(ekf_, anchors_, zc, opt, predictor);
   last_tdoa_ = r;
+  if (antenna_ && antenna_predicted_ && !acquiring && !near_floor && r.outcome == UpdateOutcome::kApplied) {
+    // (F25d) learned while tracking in the air only: near the floor the TDoA carry the ground bias (F14). The
+    // robust weight of the update down-weights the same TDoA for the pattern.
+    // The TDoA error is correlated in time (F12): the innovations carry far less than one independent sample each
+    antenna_->learn(r.innovation_m,
+                    params_.antenna_bias_noise_scale * (r.innovation_var_m2 - antenna_var_m2_) / r.weight);
+  }
   if (po && !acquiring && r.outcome == UpdateOutcome::kApplied) {
     const double dt_pair = std::isnan(po->t_last_s) ? 0.0 : std::min(t - po->t_last_s, 0.2);
     po->offset_m =

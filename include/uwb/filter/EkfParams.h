@@ -82,6 +82,16 @@ struct EkfParams {
   double robust_k = 1.0;                 ///< loss scale on the normalised innovation
   int robust_iterations = 2;             ///< IRLS iterations per TDoA update (≥ 1)
   double pair_bias_tau_s = 0.0;          ///< >0: per-pair TDoA offset learned from innovations, time constant [s] (F19)
+  /// Tag antenna-pattern bias learned in flight from the innovations (F25): spherical harmonics of degrees
+  /// 2…antenna_bias_degree (2–4) of the anchor's body-frame direction; 0 off.
+  int antenna_bias_degree = 0;
+  double antenna_bias_sigma_m = 0.1;     ///< prior std of each antenna-pattern coefficient [m] (F25c)
+  double antenna_bias_memory_s = 0.0;    ///< forgetting time constant of the antenna pattern [s]; 0: none (F25c)
+  double antenna_bias_offset_sigma_m = 0.3;   ///< std of the filter's position error in the learner [m]; 0 off (F25e)
+  double antenna_bias_offset_memory_s = 1.0;  ///< correlation time of that position error [s] (F25e)
+  /// Factor on the innovation variance when learning the pattern (F25d): the TDoA error is correlated in time, so
+  /// 400 Hz innovations carry far less than one independent sample each. Chosen on 0426 (docs/math/filter.md F25).
+  double antenna_bias_noise_scale = 1000.0;
   double max_lost_s = 1.0;               ///< all TDoA rejected this long → re-acquire (inflate P, open gate)
   /// With a bias model: run the uncorrected filter beside the corrected one and output their mixture, weighted by
   /// how well each predicted the recent TDoA (F24). Off by default: it halves the worst loss of a model that does not

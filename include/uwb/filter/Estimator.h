@@ -21,9 +21,11 @@
 #include <array>
 #include <cstddef>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "uwb/filter/AntennaBias.h"
 #include "uwb/filter/CooperativeRange.h"
 #include "uwb/filter/Ekf.h"
 #include "uwb/filter/EkfParams.h"
@@ -134,6 +136,8 @@ class Estimator {
   /// The update of the TDoA last given to addTdoa; outcome kSkipped when it reached no update (not initialized,
   /// start-up collection, out of order). Its innovation and S are the filter's one-step prediction of it (F24).
   const TdoaUpdateResult& lastTdoaUpdate() const { return last_tdoa_; }
+  /// The antenna-pattern bias learned in flight (F25); nullptr when EkfParams::antenna_bias_degree is 0.
+  const OnlineAntennaBias* antennaBias() const { return antenna_ ? &*antenna_ : nullptr; }
 
  private:
   void initialize(double t_s, const Vec3& acc_mean_b, bool moving);
@@ -154,6 +158,10 @@ class Estimator {
   EkfParams params_;
   AnchorTable anchors_;
   BiasPredictor bias_;
+  std::optional<OnlineAntennaBias> antenna_;  ///< learned antenna pattern (F25), with antenna_bias_degree > 0
+  BiasPredictor corrections_;  ///< bias_ plus the learned antenna pattern (F25b); empty without learning
+  bool antenna_predicted_ = false;  ///< the last TDoA's correction included the antenna pattern
+  double antenna_var_m2_ = 0.0;     ///< of it, the variance added to the filter's TDoA variance [m²]
   bool imu_mode_;
   Ekf ekf_;
   RestDetector rest_;
