@@ -109,6 +109,22 @@ std::vector<SimScenarioRun> protocolSimulations(const std::string& data_dir, con
       }
       // a yawing figure eight started in the air (unknown yaw at the log's start)
       if (want("yawing-start")) cutInAir("yawing-start", sim::TrajectoryShape::kFigureEight, 50.0, 6.0);
+      if (want("hand-carried")) {
+        // carried by a walking person: 1.1 m high, 1 m/s on a 2 m circle while turning, a 2 Hz, ±2 cm gait bob
+        // (≈ 3 m/s² peak vertical acceleration); the log starts while walking at full speed
+        sim::Scenario sc = sim::makeScenario(layout.survey, sim::TrajectoryShape::kCircleSine, 50.0);
+        sim::TrajectoryParams& tp = sc.trajectory;
+        tp.height_m = 1.1;
+        tp.radius_m = 2.0;
+        tp.omega_rps = 1.0 / tp.radius_m;
+        tp.sine_amplitude_m = 0.02;
+        tp.sine_omega_ratio = 2.0 * M_PI * 2.0 / tp.omega_rps;
+        const sim::SimResult r = sim::simulateFlight(sc, sp, seed);
+        const double t0 = tp.ground_before_s + tp.takeoff_s + tp.speed_ramp_s + 1.0;
+        const double t1 = tp.duration_s - tp.ground_after_s - tp.landing_s - 1.0;
+        out.push_back({"hand-carried-" + tag, "hand-carried", "cut in the air", sliceFlight(r.flight, t0, t1), r.survey,
+                       true});
+      }
     }
   }
   return out;

@@ -1,6 +1,7 @@
 /** @file GeneralizationTest.cpp
  *  @brief Flights the defaults were not chosen on (docs/math/filter.md F14–F23, `uwbtdoa protocol`): a real flight
- *         whose log starts in the air, a simulated start in hover, a simulated flight with two take-offs. Bounds are
+ *         whose log starts in the air, a simulated start in hover, a hand-carried start, a simulated flight with two
+ *         take-offs. Bounds are
  *         the protocol's values at the time of commit plus a margin.
  */
 #include <gtest/gtest.h>
@@ -63,6 +64,25 @@ TEST(Generalization, SimulatedStartInHover) {
   EXPECT_LT(c.rmse_3_to_5s_m, 0.40);
   const LocalizerSummary& sum = run.summary;
   EXPECT_GE(static_cast<double>(sum.n_tdoa_used + sum.n_tdoa_rejected + sum.n_tdoa_start), 0.9 * sum.n_tdoa_total);
+}
+
+TEST(Generalization, SimulatedHandCarriedStartWhileWalking) {
+  // GIVEN a simulated flight carried by a walking person (1 m/s, turning, 2 Hz gait bob), logged from mid-walk
+  const std::vector<SimScenarioRun> runs = protocolSimulations("", {12}, "hand-carried-paper");
+  const SimScenarioRun& s = scenario(runs, "hand-carried-paper-s12");
+  ASSERT_TRUE(s.cut);
+  // WHEN localizing
+  const LocalizationRun run = localizeFlight(s.flight, s.survey);
+  // THEN it is found within a second, tracked like a flight, nothing is read as on the ground, no output jumps
+  ASSERT_TRUE(run.metrics);
+  EXPECT_LT(run.summary.ready_t_s - s.flight.tdoa.front().t_s, 1.0);
+  EXPECT_LT(run.metrics->airborne.rmse_m, 0.30);
+  const EstimateChecks c = checks(run, s.flight, s.survey);
+  EXPECT_LT(c.rmse_3_to_5s_m, 0.40);
+  EXPECT_LT(c.max_airborne_step_m, 0.2);
+  EXPECT_EQ(run.summary.n_reacquisitions, 0u);
+  const LocalizerSummary& sum = run.summary;
+  EXPECT_GE(static_cast<double>(sum.n_tdoa_used + sum.n_tdoa_rejected + sum.n_tdoa_start), 0.95 * sum.n_tdoa_total);
 }
 
 TEST(Generalization, SimulatedTwoTakeoffs) {

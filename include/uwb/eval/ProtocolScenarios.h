@@ -21,7 +21,8 @@ struct SimScenarioRun {
   bool cut = false;   ///< the log starts in the air
 };
 
-/// Start in hover, a 10 s still hover, two take-offs, fast flight, a yawing start in the air; each over the seeds
+/// Start in hover, a 16 s still hover, two take-offs, fast flight, a yawing start in the air, carried by a walking
+/// person (log started while walking); each over the seeds
 /// (the drone and room: bias field_seed = seed) and anchor layouts (the paper's, the same moved and turned, and UTIL
 /// constellation 4 when data_dir holds it). `only` keeps the scenarios whose name contains it.
 std::vector<SimScenarioRun> protocolSimulations(const std::string& data_dir,
