@@ -188,11 +188,20 @@ void BM_WholeFlightReal0425Traj2(benchmark::State& state) {
   const AnchorSurvey survey = readAnchorSurvey((data / "real/util-pilot/survey/anchor_0425_survey.txt").string());
   const Flight f = readFlightCsv(flight.string());
   const SensorLog log = sensorLogFromFlight(f);
-  const TdoaLocalizer localizer(EkfParams{}, anchorTableFromSurvey(survey));
+  // arg 0: defaults; 1: the tag antenna pattern learned in flight (F25, degree 3); 2: the bias guard (F24) with a
+  // zero-mean bias model, i.e. two filters side by side
+  EkfParams p;
+  BiasPredictor bias;
+  if (state.range(0) == 1) p.antenna_bias_degree = 3;
+  if (state.range(0) == 2) {
+    p.bias_guard = true;
+    bias = [](const TdoaFeature&) { return BiasPrediction{}; };
+  }
+  const TdoaLocalizer localizer(p, anchorTableFromSurvey(survey), bias);
   const double duration = f.timeSpan().second - f.timeSpan().first;
   runFlightBenchmark(state, localizer, log, duration);
 }
-BENCHMARK(BM_WholeFlightReal0425Traj2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WholeFlightReal0425Traj2)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace uwb
