@@ -14,6 +14,10 @@ EstimateStream::EstimateStream(const EkfParams& params, AnchorTable anchors, dou
     : estimator_(params, std::move(anchors), std::move(bias)), output_period_s_(output_period_s) {
   if (!(output_period_s >= 0.0) || !std::isfinite(output_period_s))
     throw std::invalid_argument("EstimateStream: the output period must be finite and ≥ 0");
+  if (params.bias_guard && estimator_.hasBiasModel())
+    throw std::invalid_argument(
+        "EstimateStream: bias_guard (docs/math/filter.md F24) runs in the batch path only (localize, evaluate); "
+        "the stream would give other estimates than `localize` with the same flags");
 }
 
 bool EstimateStream::add(const StreamEvent& ev) {

@@ -74,6 +74,18 @@ TEST(EstimateStream, NoEstimateBeforeThePositionIsKnownAndNoneForComments) {
   EXPECT_THROW(EstimateStream(EkfParams{}, c.anchors, -1.0), std::invalid_argument);
 }
 
+TEST(EstimateStream, BiasGuardIsRefusedRatherThanIgnored) {
+  // GIVEN a bias model and the bias guard, which only the batch path runs (F24)
+  const SimulatedCase& c = simulatedCase();
+  const BiasPredictor bias = [](const TdoaFeature&) { return BiasPrediction{}; };
+  EkfParams p;
+  p.bias_guard = true;
+  // THEN the stream refuses it instead of giving estimates that differ from `localize` with the same flags
+  EXPECT_THROW(EstimateStream(p, c.anchors, 0.01, bias), std::invalid_argument);
+  // AND without a bias model the flag has nothing to guard and the stream runs
+  EXPECT_NO_THROW(EstimateStream(p, c.anchors, 0.01));
+}
+
 TEST(EstimateFormat, JsonAndCsvLinesReadBackBitForBit) {
   // GIVEN a real estimate of the simulated flight
   const SimulatedCase& c = simulatedCase();

@@ -123,6 +123,8 @@ class Estimator {
 
   /// The position is known (after the first multilateration or from a given start).
   bool ready() const { return ready_; }
+  /// A bias model corrects the TDoA (the third constructor argument was given).
+  bool hasBiasModel() const { return static_cast<bool>(bias_); }
   /// Time of the latest event folded in [s].
   double time() const { return t_last_event_; }
   const NavState& state() const { return ekf_.state(); }
