@@ -4,6 +4,8 @@
  */
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "uwb/eval/Localization.h"
 #include "uwb/filter/TdoaLocalizer.h"
 #include "uwb/sim/FlightSimulator.h"
@@ -31,8 +33,9 @@ const SimulatedCase& simulatedCase() {
 }
 
 /// The log's events through their text lines into an EstimateStream.
-std::vector<LocalizerEstimate> streamThroughText(const SimulatedCase& c, const EkfParams& p, double period_s) {
-  EstimateStream stream(p, c.anchors, period_s);
+std::vector<LocalizerEstimate> streamThroughText(const SimulatedCase& c, const EkfParams& p, double period_s,
+                                                const BiasPredictor& bias = {}) {
+  EstimateStream stream(p, c.anchors, period_s, bias);
   std::vector<LocalizerEstimate> out;
   SensorEventCursor cursor(c.log);
   std::size_t line_no = 0;
@@ -74,16 +77,31 @@ TEST(EstimateStream, NoEstimateBeforeThePositionIsKnownAndNoneForComments) {
   EXPECT_THROW(EstimateStream(EkfParams{}, c.anchors, -1.0), std::invalid_argument);
 }
 
-TEST(EstimateStream, BiasGuardIsRefusedRatherThanIgnored) {
-  // GIVEN a bias model and the bias guard, which only the batch path runs (F24)
+TEST(EstimateStream, WithTheBiasGuardGivesTheBatchEstimates) {
+  // GIVEN a simulated flight, a bias model that shifts every TDoA of anchor 1 (wrong for this flight), and the bias
+  // guard (F24), which runs the corrected and the uncorrected filter side by side
   const SimulatedCase& c = simulatedCase();
-  const BiasPredictor bias = [](const TdoaFeature&) { return BiasPrediction{}; };
+  const BiasPredictor bias = [](const TdoaFeature& f) { return BiasPrediction{f.id_a == 1 ? 0.3 : 0.0, 0.0, 1.0}; };
   EkfParams p;
   p.bias_guard = true;
-  // THEN the stream refuses it instead of giving estimates that differ from `localize` with the same flags
-  EXPECT_THROW(EstimateStream(p, c.anchors, 0.01, bias), std::invalid_argument);
-  // AND without a bias model the flag has nothing to guard and the stream runs
-  EXPECT_NO_THROW(EstimateStream(p, c.anchors, 0.01));
+  // WHEN the batch path runs, and the same events go through the stream one at a time
+  const LocalizerResult batch = TdoaLocalizer(p, c.anchors, bias).run(c.log, 0.01);
+  const std::vector<LocalizerEstimate> online = streamThroughText(c, p, 0.01, bias);
+  // THEN the guard is in use (a weight is reported) and the stream gives the batch estimates exactly
+  EXPECT_FALSE(std::isnan(batch.summary.bias_guard_final_weight));
+  ASSERT_GT(batch.estimates.size(), 100u);
+  ASSERT_EQ(online.size(), batch.estimates.size());
+  for (std::size_t i = 0; i < online.size(); ++i) {
+    ASSERT_EQ(online[i].t_s, batch.estimates[i].t_s) << i;
+    ASSERT_EQ(online[i].x.w_p_b, batch.estimates[i].x.w_p_b) << i;
+    ASSERT_EQ(online[i].cov_pose, batch.estimates[i].cov_pose) << i;
+  }
+  // AND the guarded output differs from the corrected filter alone (the mixture is not a no-op here)
+  EkfParams off = p;
+  off.bias_guard = false;
+  const LocalizerResult unguarded = TdoaLocalizer(off, c.anchors, bias).run(c.log, 0.01);
+  ASSERT_EQ(unguarded.estimates.size(), batch.estimates.size());
+  EXPECT_NE(unguarded.estimates.back().x.w_p_b, batch.estimates.back().x.w_p_b);
 }
 
 TEST(EstimateFormat, JsonAndCsvLinesReadBackBitForBit) {

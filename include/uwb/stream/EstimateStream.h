@@ -15,6 +15,10 @@
 
 #include <limits>
 
+#include <memory>
+#include <optional>
+
+#include "uwb/filter/BiasGuard.h"
 #include "uwb/filter/Estimator.h"
 #include "uwb/stream/LineProtocol.h"
 
@@ -31,12 +35,21 @@ class EstimateStream {
   /// End of input: true when a final estimate is due (then last() holds it).
   bool finish();
   const LocalizerEstimate& last() const { return last_; }
-  const Estimator& estimator() const { return estimator_; }
+  /// The online estimator (with the bias guard, F24: its corrected filter).
+  const Estimator& estimator() const { return guarded_ ? guarded_->corrected() : *plain_; }
   std::size_t eventsIn() const { return n_events_; }
+  bool ready() const { return guarded_ ? guarded_->ready() : plain_->ready(); }
 
  private:
   bool emit(double t_s);
-  Estimator estimator_;
+  /// Calls f with the estimator in use: the guarded pair (a bias model and bias_guard, F24) or the single filter.
+  template <class F>
+  void withEstimator(F&& f) {
+    if (guarded_) f(*guarded_);
+    else f(*plain_);
+  }
+  std::optional<Estimator> plain_;
+  std::unique_ptr<GuardedEstimator> guarded_;
   double output_period_s_;
   double t_last_out_ = -1e300;
   double t_max_ = -std::numeric_limits<double>::infinity();
