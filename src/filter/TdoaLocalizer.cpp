@@ -70,7 +70,7 @@ LocalizerResult TdoaLocalizer::run(const SensorLog& input, double output_period_
   EkfParams p = params_;
   if (log.imu.empty() && p.process_model == ProcessModel::kImu) p.process_model = ProcessModel::kConstantVelocity;
   if (p.process_model != ProcessModel::kImu) p.ground_phase = GroundPhase::kNone;
-  if (bias_ && p.bias_guard) {
+  if (usesBiasGuard(p, bias_)) {
     // (F24) the corrected filter beside the uncorrected one, mixed by their recent predictive likelihood
     GuardedEstimator estimator(p, anchors_, bias_);
     runEvents(estimator, log, events, output_period_s, result);

@@ -15,7 +15,7 @@ EstimateStream::EstimateStream(const EkfParams& params, AnchorTable anchors, dou
   if (!(output_period_s >= 0.0) || !std::isfinite(output_period_s))
     throw std::invalid_argument("EstimateStream: the output period must be finite and ≥ 0");
   // as TdoaLocalizer::run: with a bias model and bias_guard the corrected and the uncorrected filter run side by side
-  if (bias && params.bias_guard) guarded_ = std::make_unique<GuardedEstimator>(params, anchors, std::move(bias));
+  if (usesBiasGuard(params, bias)) guarded_ = std::make_unique<GuardedEstimator>(params, anchors, std::move(bias));
   else plain_.emplace(params, std::move(anchors), std::move(bias));
 }
 

@@ -27,6 +27,11 @@ namespace uwb {
 /// (k = 3): a gross outlier costs linearly, so one bad TDoA cannot decide the comparison. +∞ when S ≤ 0.
 double predictiveNll(double nis, double innovation_var_m2);
 
+/// Whether the online paths (TdoaLocalizer::run, EstimateStream) run the guarded pair: a bias model and bias_guard.
+inline bool usesBiasGuard(const EkfParams& params, const BiasPredictor& bias) {
+  return static_cast<bool>(bias) && params.bias_guard;
+}
+
 class GuardedEstimator {
  public:
   /// params.bias_guard_tau_s is the comparison's memory. Throws as Estimator does.
