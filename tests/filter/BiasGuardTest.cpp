@@ -39,25 +39,27 @@ struct HoverRun {
   double guarded_error_m, plain_error_m, corrected_error_m, weight;
 };
 
+const Vec3 kHoverPosition(0.5, -0.3, 1.5);
+
+/// 20 s of a still hover at kHoverPosition with the pairOffset() errors on the TDoA.
+SensorLog hoverLog(unsigned seed) {
+  const auto truth = [](double) { return Truth{kHoverPosition, Vec3::Zero(), Vec3::Zero()}; };
+  return filtertest::flightLog(filtertest::arenaAnchors(), truth, 0.0, 20.0, 0.1, true, seed,
+                               [](double, int id_a) { return pairOffset(id_a); });
+}
+
 HoverRun hoverWith(const BiasPredictor& bias) {
-  const AnchorTable anchors = filtertest::arenaAnchors();
-  const Vec3 p(0.5, -0.3, 1.5);
-  const auto truth = [&](double) { return Truth{p, Vec3::Zero(), Vec3::Zero()}; };
-  const SensorLog log = filtertest::flightLog(anchors, truth, 0.0, 20.0, 0.1, true, 3,
-                                              [](double, int id_a) { return pairOffset(id_a); });
+  const SensorLog log = hoverLog(3);
   EkfParams params;
   params.ground_phase = GroundPhase::kNone;
-  GuardedEstimator est(params, anchors, bias);
-  std::size_t i = 0, k = 0;
-  while (i < log.imu.size() || k < log.tdoa.size()) {
-    if (k >= log.tdoa.size() || (i < log.imu.size() && log.imu[i].t_s <= log.tdoa[k].t_s)) {
-      est.addImu(log.imu[i].t_s, log.imu[i].imu);
-      ++i;
-    } else {
-      est.addTdoa(log.tdoa[k++]);
-    }
+  GuardedEstimator est(params, filtertest::arenaAnchors(), bias);
+  SensorEventCursor events(log);
+  for (SensorEvent ev; events.next(ev);) {
+    if (ev.kind == SensorEvent::Kind::kImu) est.addImu(ev.t_s, log.imu[ev.index].imu);
+    else if (ev.kind == SensorEvent::Kind::kTdoa) est.addTdoa(log.tdoa[ev.index]);
   }
   EXPECT_TRUE(est.ready());
+  const Vec3& p = kHoverPosition;
   return {(est.estimate().x.w_p_b - p).norm(), (est.uncorrected().estimate().x.w_p_b - p).norm(),
           (est.corrected().estimate().x.w_p_b - p).norm(), est.weight()};
 }
@@ -89,10 +91,8 @@ TEST(BiasGuard, LeavesACorrectionThatDoesNotFit) {
 TEST(BiasGuard, LocalizerUsesTheGuardOnlyWithABiasModelAndWhenOn) {
   // GIVEN a hovering flight with per-pair offsets and the wrong-sign bias model
   const AnchorTable anchors = filtertest::arenaAnchors();
-  const Vec3 p(0.5, -0.3, 1.5);
-  const auto truth = [&](double) { return Truth{p, Vec3::Zero(), Vec3::Zero()}; };
-  const SensorLog log = filtertest::flightLog(anchors, truth, 0.0, 20.0, 0.1, true, 4,
-                                              [](double, int id_a) { return pairOffset(id_a); });
+  const Vec3& p = kHoverPosition;
+  const SensorLog log = hoverLog(4);
   EkfParams off;
   off.ground_phase = GroundPhase::kNone;
   EXPECT_FALSE(off.bias_guard);  // off by default (F24)
