@@ -170,7 +170,7 @@ void runLocalize(const LocalizeArgs& a) {
   // these times are not to be trusted
   for (double t_r : s.reacquisition_t_s)
     warnings.add("position lost and re-acquired by multilateration at t = " + std::to_string(t_r) +
-                 " s (TDoA inconsistent with the estimate, divergence, or a sensor-time jump)");
+                 " s (TDoA inconsistent with the estimate or missing, divergence, or a sensor-time jump)");
   if (s.n_time_jumps > 0)
     warnings.add(std::to_string(s.n_time_jumps) + " sensor-time gap(s) or backward jump(s): the IMU was not integrated "
                  "across them");
@@ -197,6 +197,7 @@ void runLocalize(const LocalizeArgs& a) {
   j["ready_t_s"] = std::isnan(s.ready_t_s) ? json(nullptr) : json(s.ready_t_s);
   j["n_tdoa_degenerate"] = s.n_tdoa_degenerate;
   j["n_reacquisitions"] = s.n_reacquisitions;
+  j["n_rejection_faults"] = s.n_rejection_faults;
   j["fuse_tof"] = params.fuse_tof;
   j["n_tof"] = s.n_tof_total;
   j["n_tof_used"] = s.n_tof_used;

@@ -144,6 +144,10 @@ std::vector<EkfParamInfo> makeRegistry() {
            "Memory of the bias guard's likelihood comparison (F24)"),
       real("max_lost_s", &P::max_lost_s, "s", kPositive,
            "All TDoA rejected this long: re-acquire (inflate P, open the gate)"),
+      real("lost_velocity_tau_s", &P::lost_velocity_tau_s, "s", kNonNegative,
+           "Re-acquiring in flight: the velocity relaxes towards rest with this time constant (F16e); 0 off"),
+      real("max_rejection_rate", &P::max_rejection_rate, "", EkfParamRange{0.0, 1.0, true, false},
+           "A larger fraction of the TDoA rejected in flight (0.3 s memory): re-acquire (F16d); 1 turns it off"),
       // --- scheduling ---
       real("max_predict_dt_s", &P::max_predict_dt_s, "s", kPositive, "IMU samples are averaged over at most this"),
       real("update_predict_dt_s", &P::update_predict_dt_s, "s", kNonNegative,

@@ -39,6 +39,9 @@ void EkfParams::validate() const {
   if (robust_iterations < 1 || robust_iterations > 20)
     throw std::invalid_argument("EkfParams.robust_iterations must be in [1, 20]");
   requirePositive(max_lost_s, "max_lost_s");
+  requireNonNegative(lost_velocity_tau_s, "lost_velocity_tau_s");
+  if (!(max_rejection_rate > 0.0 && max_rejection_rate <= 1.0))
+    throw std::invalid_argument("EkfParams.max_rejection_rate must be in (0, 1]");
   requireNonNegative(pair_bias_tau_s, "pair_bias_tau_s");
   if (antenna_bias_degree != 0 && (antenna_bias_degree < 2 || antenna_bias_degree > 4))
     throw std::invalid_argument("EkfParams.antenna_bias_degree must be 0 (off) or in [2, 4]");

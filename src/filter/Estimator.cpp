@@ -28,6 +28,16 @@ constexpr int kLevelSamples = 100;
 constexpr double kLevelRestAccStd_mps2 = 0.15;
 /// Lost (F16): nothing accepted for max_lost_s and at least this many rejections in a row.
 constexpr std::size_t kLostMinRejections = 20;
+/// Memory of the TDoA rejection rate (F16d) [s], ...
+constexpr double kRejectionMemory_s = 0.3;
+/// ... counted this high above the floor only: a touch-down that the estimate has not followed yet rejects the TDoA
+/// of the floor-level bias (F14) for a moment (0425-traj1 and traj3 at 0.25–0.5 m) [m].
+constexpr double kRejectionMinHeight_m = 0.6;
+/// ... and from this long after an acquisition on: a climb that the estimate lags (simulated take-offs, 0.6 m high at
+/// 1.3 m/s) also rejects most TDoA for a moment, and a re-acquisition during it does worse than the filter [s].
+constexpr double kRejectionSettle_s = 2.0;
+/// ... and over at least this many (forgotten) TDoA.
+constexpr double kRejectionMinSamples = 20.0;
 /// Diverged (F16): the estimate left the anchors' box by this much [m], or moves faster than this [m/s].
 constexpr double kDivergedBoxMargin_m = 3.0;
 constexpr double kDivergedSpeed_mps = 8.0;
@@ -177,6 +187,7 @@ void Estimator::finishStart(double t_s, const StartFix& fix) {
   t_acq_end_ = t_s + params_.acquisition_s;
   t_last_accept_ = t_s;
   n_rejected_streak_ = 0;
+  n_rejected_recent_ = n_gated_recent_ = 0.0;
 }
 
 void Estimator::predictTo(double t_s) {
@@ -188,7 +199,21 @@ void Estimator::predictTo(double t_s) {
       m.b_acc_mps2 = acc_sum_ / n_imu_acc_;
       m.b_gyro_radps = gyro_sum_ / n_imu_acc_;
     }
+    const NavState before = ekf_.state();
     ekf_.predict(m, dt);
+    if (ready_ && start_.active() && !on_ground_ && params_.lost_velocity_tau_s > 0.0) {
+      // (F16e) re-acquiring in flight: the IMU alone drifts metres in a second horizontally (thrust model: the
+      // horizontal acceleration rests on the tilt), while a position-controlled body stays near its course. The
+      // horizontal velocity relaxes towards rest instead, v' = v e^{−Δt/τ}, p' = p + v τ (1 − e^{−Δt/τ}); the vertical
+      // channel (thrust axis) stays the IMU's; the covariance keeps growing with the process noise.
+      const double e = std::exp(-dt / params_.lost_velocity_tau_s);
+      ErrVec dx = ErrVec::Zero();
+      for (int i = 0; i < 2; ++i) {
+        dx(kPos + i) = before.w_p_b(i) + before.w_v_b(i) * params_.lost_velocity_tau_s * (1.0 - e) - ekf_.state().w_p_b(i);
+        dx(kVel + i) = before.w_v_b(i) * e - ekf_.state().w_v_b(i);
+      }
+      ekf_.inject(dx);
+    }
   } else {
     ekf_.predictTdoaOnly(dt);
   }
@@ -388,7 +413,10 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
     t_last_zupt_ = t_s;
     applyFloorConstraint(false);
     // (F16) divergence is checked at the same 10 ms period
-    if (ready_ && !start_.active() && diverged()) {
+    // (F16) and in flight without any TDoA accepted for max_lost_s (none received, e.g. a radio outage): the
+    // prediction gets the re-acquisition's relaxed horizontal motion (F16e) until fresh TDoA fix the position
+    const bool lost_in_flight = !on_ground_ && phase_ != FlightPhase::kAcquisition && t_s - t_last_accept_ > params_.max_lost_s;
+    if (ready_ && !start_.active() && (diverged() || lost_in_flight)) {
       propagate(true);
       startAcquisition(t_s, true);
     }
@@ -540,6 +568,18 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     case UpdateOutcome::kUnknownAnchor: ++summary_.n_tdoa_unknown_anchor; break;
     default: ++summary_.n_tdoa_degenerate; break;
   }
+  // in flight only: on and near the floor the TDoA carry the floor-level bias (F14), and a body at rest or in ground
+  // contact (F18: still, or shaking on the legs) is not flying even before the ground phase is entered
+  const bool flying = !acquiring && std::min(t - t_acq_end_, t - t_left_ground_) >= kRejectionSettle_s && !near_floor && ekf_.state().w_p_b.z() - params_.ground_z_m > kRejectionMinHeight_m &&
+                      !(imu_mode_ && (rest_.stillNow() || rest_.shaking()));
+  if (flying &&
+      (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier)) {
+    // (F16d) rejection rate in flight, exponentially forgotten over kRejectionMemory_s
+    const double w = std::isnan(t_rejection_) ? 0.0 : std::exp(-std::max(t - t_rejection_, 0.0) / kRejectionMemory_s);
+    n_rejected_recent_ = w * n_rejected_recent_ + (r.outcome == UpdateOutcome::kRejectedOutlier ? 1.0 : 0.0);
+    n_gated_recent_ = w * n_gated_recent_ + 1.0;
+    t_rejection_ = t;
+  }
   if (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier) {
     // anchor pairs in view, for the reported bias floor (F23)
     auto it = std::find_if(recent_pairs_.begin(), recent_pairs_.end(),
@@ -553,7 +593,12 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     t_bias_floor_s_ = t;
   }
   // (F16) lost: nothing accepted for max_lost_s → find the position again by multilateration from fresh TDoA
-  if (!acquiring && t - t_last_accept_ > params_.max_lost_s && n_rejected_streak_ > kLostMinRejections) {
+  // (F16d) most TDoA rejected in flight: the stream is faulty or the estimate is off; the few that pass the gate
+  // (which widens as P grows) would drag the state away, so the position is found again from fresh TDoA at once
+  const bool rejecting = params_.max_rejection_rate < 1.0 && n_gated_recent_ >= kRejectionMinSamples &&
+                         n_rejected_recent_ > params_.max_rejection_rate * n_gated_recent_;
+  if (!acquiring && (rejecting || (t - t_last_accept_ > params_.max_lost_s && n_rejected_streak_ > kLostMinRejections))) {
+    if (rejecting) ++summary_.n_rejection_faults;
     startAcquisition(t, true);
     t_last_accept_ = t;
     n_rejected_streak_ = 0;

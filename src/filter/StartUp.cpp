@@ -52,6 +52,13 @@ std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x
     const double t_keep = z.t_s - std::min(params_.max_window_s, 0.5 * params_.window_s);
     std::erase_if(samples_, [&](const MultilaterationSample& m) { return m.z.t_s < t_keep; });
     t_try_ = z.t_s - 0.5 * params_.window_s;
+    // (F16b) the reference moves to the newest prediction: a displacement predicted over a long failed search
+    // (seconds of IMU dead reckoning) would put p0 and v0 out of bounds however good the fresh TDoA are.
+    // d'_i = p̂(t_i) − p̂_now − (t_i − t_now) v̂_now with p̂(t_i) = d_i + p̂_ref + (t_i − t_ref) v̂_ref.
+    for (MultilaterationSample& m : samples_)
+      m.w_d_b += x_ref_.w_p_b - x_now.w_p_b + (m.z.t_s - t_ref_) * x_ref_.w_v_b - (m.z.t_s - z.t_s) * x_now.w_v_b;
+    x_ref_ = x_now;
+    t_ref_ = z.t_s;
     return std::nullopt;
   }
   StartFix fix;

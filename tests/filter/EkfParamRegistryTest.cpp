@@ -67,7 +67,8 @@ EkfParamValue otherValidValue(const EkfParamInfo& info, const EkfParams& default
     case EkfParamKind::kInteger: {
       const double x = std::get<double>(d);
       const double candidate = info.kind == EkfParamKind::kInteger ? x + 1.0 : x * 1.5 + 0.25;
-      return info.range.contains(candidate) ? candidate : x - 1.0;
+      if (info.range.contains(candidate)) return candidate;
+      return info.range.contains(x - 1.0) ? x - 1.0 : 0.5 * x;  // 0.5 x: a fraction in (0, 1]
     }
     case EkfParamKind::kBool: return !std::get<bool>(d);
     case EkfParamKind::kVec3: return Vec3(std::get<Vec3>(d) + Vec3(0.1, -0.2, 0.3));

@@ -117,6 +117,65 @@ TEST(Estimator, ReacquiresAfterGarbageTdoa) {
   EXPECT_LT(worst, 0.3);
 }
 
+/// Worst position error of the estimates in [t0, t1) against the circle.
+double worstCircleError(const LocalizerResult& r, double t0_s, double t1_s) {
+  double worst = 0.0;
+  for (const LocalizerEstimate& e : r.estimates)
+    if (e.t_s >= t0_s && e.t_s < t1_s) worst = std::max(worst, (e.x.w_p_b - circle(e.t_s).p).norm());
+  return worst;
+}
+
+TEST(Estimator, LongGarbageBurstIsDetectedByItsRejectionRateAndReacquired) {
+  // GIVEN the circle log with 5 s of uniformly random TDoA in [−10, 10] m: some pass the gate, which widens as the
+  // covariance grows, so the "nothing accepted" test of F16 alone does not fire
+  SensorLog log = circleLog(0.0, 18.0, 4);
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> u(-10.0, 10.0);
+  for (auto& z : log.tdoa)
+    if (z.t_s > 6.0 && z.t_s < 11.0) z.tdoa_m = u(rng);
+  // WHEN localizing with the rejection-rate test (F16d) and without it
+  const LocalizerResult on = TdoaLocalizer(lateralFullParams(), arenaAnchors()).run(log);
+  EkfParams p_off = lateralFullParams();
+  p_off.max_rejection_rate = 1.0;
+  const LocalizerResult off = TdoaLocalizer(p_off, arenaAnchors()).run(log);
+  // THEN it fires within 0.5 s of the burst's start, the estimate stays within the circle's reach (r = 1 m, plus the
+  // relaxed velocity's v τ = 0.8 m, F16e) while lost, and is back within 0.3 m 3 s after the burst (the search keeps
+  // its reference near the prediction, F16)
+  EXPECT_GE(on.summary.n_rejection_faults, 1u);
+  ASSERT_FALSE(on.summary.reacquisition_t_s.empty());
+  EXPECT_GT(on.summary.reacquisition_t_s.front(), 6.0);
+  EXPECT_LT(on.summary.reacquisition_t_s.front(), 6.5);
+  EXPECT_EQ(off.summary.n_rejection_faults, 0u);
+  EXPECT_LT(worstCircleError(on, 14.0, 18.0), 0.3);
+  EXPECT_LT(worstCircleError(on, 6.0, 11.0), 2.0 + 0.8 + 0.2);
+}
+
+TEST(Estimator, WithoutTdoaInFlightTheHorizontalMotionRelaxesInsteadOfDrifting) {
+  // GIVEN the circle log without TDoA for 4 s, and an IMU whose horizontal acceleration is off by 1 m/s² meanwhile
+  // (a tilt error of 6°: what the thrust model's horizontal channel rests on)
+  SensorLog log = circleLog(0.0, 16.0, 8);
+  std::erase_if(log.tdoa, [](const TdoaObservation& z) { return z.t_s > 6.0 && z.t_s < 10.0; });
+  for (auto& s : log.imu)
+    if (s.t_s > 6.0 && s.t_s < 10.0) s.imu.b_acc_mps2.x() += 1.0;
+  // WHEN localizing with the relaxation (F16e) and without it
+  const LocalizerResult relaxed = TdoaLocalizer(lateralFullParams(), arenaAnchors()).run(log);
+  EkfParams p_off = lateralFullParams();
+  p_off.lost_velocity_tau_s = 0.0;
+  const LocalizerResult drifting = TdoaLocalizer(p_off, arenaAnchors()).run(log);
+  // THEN after max_lost_s without TDoA the re-acquisition starts; the relaxed estimate stays within the circle's reach
+  // (2r = 2 m) plus the first second's drift (0.5 m) and the relaxed velocity's (0.8 + 1) m/s · τ, while the IMU alone
+  // drifts off by ½·1 m/s²·(4 s)² = 8 m; both are back 3 s after the outage
+  ASSERT_FALSE(relaxed.summary.reacquisition_t_s.empty());
+  EXPECT_NEAR(relaxed.summary.reacquisition_t_s.front(), 7.0, 0.1);
+  EXPECT_LT(worstCircleError(relaxed, 6.0, 10.0), 2.0 + 0.5 + 1.8);
+  EXPECT_GT(worstCircleError(drifting, 6.0, 10.0), 6.0);
+  // and the reported σ covers the error while lost
+  for (const LocalizerEstimate& e : relaxed.estimates)
+    if (e.t_s > 6.0 && e.t_s < 10.0) EXPECT_LT((e.x.w_p_b - circle(e.t_s).p).head<2>().norm(), 3.0 * e.sigma_p_m.head<2>().norm()) << e.t_s;
+  EXPECT_LT(worstCircleError(relaxed, 13.0, 16.0), 0.3);
+  EXPECT_LT(worstCircleError(drifting, 13.0, 16.0), 0.3);
+}
+
 TEST(Estimator, GroundTdoaAreDownWeightedNotDropped) {
   // GIVEN a take-off log whose TDoA on the floor carry a height bias of +1 m (floor multipath) for 2 s
   filtertest::TakeoffLogSpec spec;

@@ -87,6 +87,7 @@ struct LocalizerSummary {
   std::size_t n_zero_velocity_updates = 0;
   std::size_t n_floor_updates = 0;     ///< floor constraint applied (F22)
   std::size_t n_rest_periods = 0;      ///< times the body came to rest
+  std::size_t n_rejection_faults = 0; ///< re-acquisitions because most TDoA were rejected (F16d)
   std::size_t n_reacquisitions = 0;    ///< lost or diverged → position found again by multilateration (F16)
   std::size_t n_time_jumps = 0;        ///< sensor-time gaps or backward jumps handled (F17)
   std::vector<double> reacquisition_t_s;  ///< when each re-acquisition started (first 100)
@@ -192,6 +193,8 @@ class Estimator {
   double t_last_accept_ = 0.0;
   double t_last_tof_accept_ = -1e300;
   std::size_t n_rejected_streak_ = 0;
+  double n_rejected_recent_ = 0.0, n_gated_recent_ = 0.0;  ///< forgotten counts of TDoA rejected / gated in flight (F16d)
+  double t_rejection_ = std::numeric_limits<double>::quiet_NaN();
   // IMU averaging between predictions (F17) and the levelling window before initialization (F15)
   Vec3 acc_sum_ = Vec3::Zero(), gyro_sum_ = Vec3::Zero();
   int n_imu_acc_ = 0;
