@@ -198,6 +198,7 @@ void runLocalize(const LocalizeArgs& a) {
   j["n_tdoa_degenerate"] = s.n_tdoa_degenerate;
   j["n_reacquisitions"] = s.n_reacquisitions;
   j["n_rejection_faults"] = s.n_rejection_faults;
+  j["n_reverted_motion"] = s.n_reverted_motion;
   j["fuse_tof"] = params.fuse_tof;
   j["n_tof"] = s.n_tof_total;
   j["n_tof_used"] = s.n_tof_used;

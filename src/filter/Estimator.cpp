@@ -31,13 +31,19 @@ constexpr std::size_t kLostMinRejections = 20;
 /// Memory of the TDoA rejection rate (F16d) [s], ...
 constexpr double kRejectionMemory_s = 0.3;
 /// ... counted this high above the floor only: a touch-down that the estimate has not followed yet rejects the TDoA
-/// of the floor-level bias (F14) for a moment (0425-traj1 and traj3 at 0.25–0.5 m) [m].
-constexpr double kRejectionMinHeight_m = 0.6;
+/// of the floor-level bias (F14) for a moment (0425-traj1 and traj3 at 0.25–0.5 m, simulated landings at 0.65 m) [m].
+constexpr double kRejectionMinHeight_m = 0.9;
 /// ... and from this long after an acquisition on: a climb that the estimate lags (simulated take-offs, 0.6 m high at
 /// 1.3 m/s) also rejects most TDoA for a moment, and a re-acquisition during it does worse than the filter [s].
 constexpr double kRejectionSettle_s = 2.0;
 /// ... and over at least this many (forgotten) TDoA.
 constexpr double kRejectionMinSamples = 20.0;
+/// The motion is recorded every kHealthyPeriod_s while at most this fraction is rejected; a fault reverts to the
+/// newest record at least kRevertLead_s and at most kRevertMaxAge_s old (F16d).
+constexpr double kHealthyRejectionRate = 0.3;
+constexpr double kHealthyPeriod_s = 0.05;
+constexpr double kRevertLead_s = 0.6;
+constexpr double kRevertMaxAge_s = 1.2;
 /// Diverged (F16): the estimate left the anchors' box by this much [m], or moves faster than this [m/s].
 constexpr double kDivergedBoxMargin_m = 3.0;
 constexpr double kDivergedSpeed_mps = 8.0;
@@ -279,6 +285,14 @@ void Estimator::enterGround(double t_s) {
   ++summary_.n_rest_periods;
   if (moved_) summary_.landing_t_s = t_s;
   if (imu_mode_ && rest_.atRest()) ekf_.setAccelModel(params_.ground_accel_model);  // (F15) levelled from all axes
+  if (ready_ && start_.active()) {
+    // (F16) a search begun in flight ends at the touch-down: on the floor the height is known (F22) and the TDoA,
+    // down-weighted, place the body (F14); their floor-level bias would keep a multilateration from passing its test
+    start_.cancel();
+    phase_ = FlightPhase::kTracking;
+    t_last_accept_ = t_s;
+    n_rejected_streak_ = 0;
+  }
   if (ready_ && phase_ != FlightPhase::kAcquisition) phase_ = moved_ ? FlightPhase::kLanded : FlightPhase::kGround;
 }
 
@@ -579,6 +593,13 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     n_rejected_recent_ = w * n_rejected_recent_ + (r.outcome == UpdateOutcome::kRejectedOutlier ? 1.0 : 0.0);
     n_gated_recent_ = w * n_gated_recent_ + 1.0;
     t_rejection_ = t;
+    // (F16d) the recent motion while the TDoA agree, to fall back on when a fault is found
+    if (n_rejected_recent_ <= kHealthyRejectionRate * n_gated_recent_ && t - t_healthy_sample_ >= kHealthyPeriod_s) {
+      healthy_[i_healthy_] = {t, ekf_.state().w_p_b, ekf_.state().w_v_b};
+      i_healthy_ = (i_healthy_ + 1) % healthy_.size();
+      n_healthy_ = std::min(n_healthy_ + 1, healthy_.size());
+      t_healthy_sample_ = t;
+    }
   }
   if (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier) {
     // anchor pairs in view, for the reported bias floor (F23)
@@ -598,11 +619,38 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   const bool rejecting = params_.max_rejection_rate < 1.0 && n_gated_recent_ >= kRejectionMinSamples &&
                          n_rejected_recent_ > params_.max_rejection_rate * n_gated_recent_;
   if (!acquiring && (rejecting || (t - t_last_accept_ > params_.max_lost_s && n_rejected_streak_ > kLostMinRejections))) {
-    if (rejecting) ++summary_.n_rejection_faults;
+    if (rejecting) {
+      ++summary_.n_rejection_faults;
+      revertToHealthyMotion(t);
+    }
     startAcquisition(t, true);
     t_last_accept_ = t;
     n_rejected_streak_ = 0;
   }
+}
+
+void Estimator::revertToHealthyMotion(double t_s) {
+  // (F16d) the TDoA that passed the gate since the fault began pulled the state off (the rate needs ≈ 0.5 s to cross
+  // its threshold): back to the newest motion recorded kRevertLead_s before, carried to now by the relaxed motion
+  // of F16e, with the covariance grown meanwhile plus that motion's own uncertainty
+  const PastMotion* best = nullptr;
+  for (std::size_t k = 0; k < n_healthy_; ++k) {
+    const PastMotion& m = healthy_[k];
+    if (m.t_s <= t_s - kRevertLead_s && t_s - m.t_s <= kRevertMaxAge_s && (!best || m.t_s > best->t_s)) best = &m;
+  }
+  n_healthy_ = 0;
+  if (!best || !(params_.lost_velocity_tau_s > 0.0)) return;
+  // horizontally only, as F16e: the vertical channel keeps the thrust-axis IMU's and the TDoA's account
+  const double tau = params_.lost_velocity_tau_s, dt = t_s - best->t_s, e = std::exp(-dt / tau);
+  Eigen::Matrix<double, 6, 6> cov = ekf_.covariance().block<6, 6>(kPos, kPos);
+  const double reach = best->w_v_b.head<2>().norm() * std::min(dt, tau);
+  cov(0, 0) += reach * reach;
+  cov(1, 1) += reach * reach;
+  Vec3 p = ekf_.state().w_p_b, v = ekf_.state().w_v_b;
+  p.head<2>() = best->w_p_b.head<2>() + best->w_v_b.head<2>() * tau * (1.0 - e);
+  v.head<2>() = best->w_v_b.head<2>() * e;
+  ekf_.resetPositionVelocity(p, v, cov);
+  ++summary_.n_reverted_motion;
 }
 
 Mat3 Estimator::reportedPositionCovariance() const {

@@ -142,6 +142,7 @@ TEST(Estimator, LongGarbageBurstIsDetectedByItsRejectionRateAndReacquired) {
   // relaxed velocity's v τ = 0.8 m, F16e) while lost, and is back within 0.3 m 3 s after the burst (the search keeps
   // its reference near the prediction, F16)
   EXPECT_GE(on.summary.n_rejection_faults, 1u);
+  EXPECT_EQ(on.summary.n_reverted_motion, on.summary.n_rejection_faults);  // back to the motion before the burst
   ASSERT_FALSE(on.summary.reacquisition_t_s.empty());
   EXPECT_GT(on.summary.reacquisition_t_s.front(), 6.0);
   EXPECT_LT(on.summary.reacquisition_t_s.front(), 6.5);

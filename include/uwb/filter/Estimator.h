@@ -88,6 +88,7 @@ struct LocalizerSummary {
   std::size_t n_floor_updates = 0;     ///< floor constraint applied (F22)
   std::size_t n_rest_periods = 0;      ///< times the body came to rest
   std::size_t n_rejection_faults = 0; ///< re-acquisitions because most TDoA were rejected (F16d)
+  std::size_t n_reverted_motion = 0;  ///< of them, with the state put back to the motion before the fault (F16d)
   std::size_t n_reacquisitions = 0;    ///< lost or diverged → position found again by multilateration (F16)
   std::size_t n_time_jumps = 0;        ///< sensor-time gaps or backward jumps handled (F17)
   std::vector<double> reacquisition_t_s;  ///< when each re-acquisition started (first 100)
@@ -151,6 +152,8 @@ class Estimator {
   void enterGround(double t_s);
   void startAcquisition(double t_s, bool reacquisition);
   void finishStart(double t_s, const StartFix& fix);
+  /// F16d: position and velocity back to the recent motion recorded before a TDoA fault.
+  void revertToHealthyMotion(double t_s);
   void applyFloorConstraint(bool on_ground);
   bool diverged() const;
   /// Reported position covariance: the filter's plus the bias floor (F23).
@@ -193,6 +196,13 @@ class Estimator {
   double t_last_accept_ = 0.0;
   double t_last_tof_accept_ = -1e300;
   std::size_t n_rejected_streak_ = 0;
+  struct PastMotion {
+    double t_s = 0.0;
+    Vec3 w_p_b = Vec3::Zero(), w_v_b = Vec3::Zero();
+  };
+  std::array<PastMotion, 24> healthy_{};  ///< recent motion while the TDoA agreed (F16d)
+  std::size_t i_healthy_ = 0, n_healthy_ = 0;
+  double t_healthy_sample_ = -1e300;
   double n_rejected_recent_ = 0.0, n_gated_recent_ = 0.0;  ///< forgotten counts of TDoA rejected / gated in flight (F16d)
   double t_rejection_ = std::numeric_limits<double>::quiet_NaN();
   // IMU averaging between predictions (F17) and the levelling window before initialization (F15)
