@@ -218,6 +218,9 @@ void Estimator::predictTo(double t_s) {
         dx(kPos + i) = before.w_p_b(i) + before.w_v_b(i) * params_.lost_velocity_tau_s * (1.0 - e) - ekf_.state().w_p_b(i);
         dx(kVel + i) = before.w_v_b(i) * e - ekf_.state().w_v_b(i);
       }
+      // vertically the thrust-axis IMU drives the velocity, which is damped as well: a bias error b then moves the
+      // height at b τ instead of b t
+      dx(kVel + 2) = -(1.0 - e) * ekf_.state().w_v_b.z();
       ekf_.inject(dx);
     }
   } else {
