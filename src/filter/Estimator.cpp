@@ -288,14 +288,6 @@ void Estimator::enterGround(double t_s) {
   ++summary_.n_rest_periods;
   if (moved_) summary_.landing_t_s = t_s;
   if (imu_mode_ && rest_.atRest()) ekf_.setAccelModel(params_.ground_accel_model);  // (F15) levelled from all axes
-  if (ready_ && start_.active()) {
-    // (F16) a search begun in flight ends at the touch-down: on the floor the height is known (F22) and the TDoA,
-    // down-weighted, place the body (F14); their floor-level bias would keep a multilateration from passing its test
-    start_.cancel();
-    phase_ = FlightPhase::kTracking;
-    t_last_accept_ = t_s;
-    n_rejected_streak_ = 0;
-  }
   if (ready_ && phase_ != FlightPhase::kAcquisition) phase_ = moved_ ? FlightPhase::kLanded : FlightPhase::kGround;
 }
 
