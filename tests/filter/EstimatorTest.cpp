@@ -171,8 +171,11 @@ TEST(Estimator, WithoutTdoaInFlightTheHorizontalMotionRelaxesInsteadOfDrifting) 
   EXPECT_LT(worstCircleError(relaxed, 6.0, 10.0), 2.0 + 0.5 + 1.8);
   EXPECT_GT(worstCircleError(drifting, 6.0, 10.0), 6.0);
   // and the reported σ covers the error while lost
-  for (const LocalizerEstimate& e : relaxed.estimates)
-    if (e.t_s > 6.0 && e.t_s < 10.0) EXPECT_LT((e.x.w_p_b - circle(e.t_s).p).head<2>().norm(), 3.0 * e.sigma_p_m.head<2>().norm()) << e.t_s;
+  for (const LocalizerEstimate& e : relaxed.estimates) {
+    if (e.t_s > 6.0 && e.t_s < 10.0) {
+      EXPECT_LT((e.x.w_p_b - circle(e.t_s).p).head<2>().norm(), 3.0 * e.sigma_p_m.head<2>().norm()) << e.t_s;
+    }
+  }
   EXPECT_LT(worstCircleError(relaxed, 13.0, 16.0), 0.3);
   EXPECT_LT(worstCircleError(drifting, 13.0, 16.0), 0.3);
 }
@@ -188,8 +191,11 @@ TEST(Estimator, GroundTdoaAreDownWeightedNotDropped) {
   // THEN the floor TDoA were used (down-weighted), the estimate stayed near the floor before the climb, and the
   // hover at the end is accurate
   EXPECT_GT(r.summary.n_tdoa_used_at_rest, 100u);
-  for (const LocalizerEstimate& e : r.estimates)
-    if (e.t_s > 1.0 && e.t_s < 1.9) EXPECT_LT(e.x.w_p_b.z(), 0.4) << e.t_s;
+  for (const LocalizerEstimate& e : r.estimates) {
+    if (e.t_s > 1.0 && e.t_s < 1.9) {
+      EXPECT_LT(e.x.w_p_b.z(), 0.4) << e.t_s;
+    }
+  }
   const LocalizerEstimate& last = r.estimates.back();
   EXPECT_LT((last.x.w_p_b - Vec3(0.8, -0.5, 1.05)).norm(), 0.15);
   EXPECT_FALSE(std::isnan(r.summary.takeoff_t_s));

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "support/TestSupport.h"
+#include "uwb/eval/FaultInjection.h"
 #include "uwb/eval/Localization.h"
 #include "uwb/io/UtilCsv.h"
 
@@ -40,6 +41,36 @@ TEST(RealDataLocalization, Pilot0425Traj2AirborneRmseUnderBound) {
   EXPECT_LT(run.metrics->airborne.p99_m, 1.0);
   EXPECT_GT(run.summary.n_tdoa_used, 10000u);
   EXPECT_FALSE(std::isnan(run.summary.takeoff_t_s));
+}
+
+TEST(RealDataLocalization, GarbageTdoaMidFlightAreCaughtAndCostLittle) {
+  // GIVEN a flight of the session the fault handling was not chosen on, with 5 s of uniformly random TDoA mid-flight
+  // (docs/math/filter.md F16d, F16e; without them: airborne RMSE 4.2 m, the estimate walked off)
+  const auto flight = test::pilotFlight("0426-traj11");
+  UWB_REQUIRE_REAL_DATA(flight);
+  const AnchorSurvey survey = readAnchorSurvey(test::pilotSurvey("0426").string());
+  Flight f = readFlightCsv(flight->string());
+  const LocalizationRun clean = localizeFlight(f, survey);
+  ASSERT_TRUE(clean.metrics);
+  AnchorSurvey s = survey;
+  const FaultSpec garbage{FaultKind::kGarbageTdoa, 25.9, 30.9, 0, 2};
+  injectFault(garbage, f, s);
+  // WHEN localizing with the defaults
+  const LocalizationRun run = localizeFlight(f, s);
+  // THEN the rejection rate starts a re-acquisition within 0.6 s of the burst, and the flight's airborne RMSE stays
+  // within 4× the clean one (0.78 against 0.24 m; no position information for 5 s while it circles at 1–2 m/s)
+  ASSERT_TRUE(run.metrics);
+  EXPECT_GE(run.summary.n_rejection_faults, 1u);
+  ASSERT_FALSE(run.summary.reacquisition_t_s.empty());
+  EXPECT_GT(run.summary.reacquisition_t_s.front(), garbage.t0_s);
+  EXPECT_LT(run.summary.reacquisition_t_s.front(), garbage.t0_s + 0.6);
+  EXPECT_LT(run.metrics->airborne.rmse_m, 4.0 * clean.metrics->airborne.rmse_m);
+  // and 3 s after the burst the error is that of the clean flight again
+  for (const PositionErrorSample& e : run.metrics->samples) {
+    if (e.airborne && e.t_s > garbage.t1_s + 3.0 && e.t_s < garbage.t1_s + 6.0) {
+      EXPECT_LT(e.error_norm_m, 0.6) << e.t_s;
+    }
+  }
 }
 
 TEST(RealDataLocalization, Pilot0425LandingDetectedAndPositionHeld) {
