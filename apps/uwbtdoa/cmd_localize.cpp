@@ -5,6 +5,7 @@
  */
 #include <chrono>
 #include <filesystem>
+#include <fmt/format.h>
 #include <deque>
 #include <ctime>
 #include <iostream>
@@ -168,9 +169,16 @@ void runLocalize(const LocalizeArgs& a) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   // the estimate lost the TDoA or diverged and was found again (docs/math/filter.md F16): the positions around
   // these times are not to be trusted
-  for (double t_r : s.reacquisition_t_s)
-    warnings.add("position lost and re-acquired by multilateration at t = " + std::to_string(t_r) +
-                 " s (TDoA inconsistent with the estimate or missing, divergence, or a sensor-time jump)");
+  for (std::size_t k = 0; k < s.reacquisition_t_s.size(); ++k) {
+    const double t_lost = s.reacquisition_t_s[k];
+    const std::string found = k < s.reacquired_t_s.size()
+                                  ? ", found again at t = " + fmt::format("{:.2f}", s.reacquired_t_s[k]) + " s (" +
+                                        fmt::format("{:.1f}", s.reacquired_t_s[k] - t_lost) +
+                                        " s predicted without TDoA: see the position std)"
+                                  : ", not found again before the end";
+    warnings.add("position lost at t = " + fmt::format("{:.2f}", t_lost) + " s" + found +
+                 " (TDoA inconsistent with the estimate or missing, divergence, or a sensor-time jump)");
+  }
   if (s.n_time_jumps > 0)
     warnings.add(std::to_string(s.n_time_jumps) + " sensor-time gap(s) or backward jump(s): the IMU was not integrated "
                  "across them");
@@ -194,6 +202,7 @@ void runLocalize(const LocalizeArgs& a) {
   j["n_rest_periods"] = s.n_rest_periods;
   j["n_time_jumps"] = s.n_time_jumps;
   j["reacquisition_t_s"] = s.reacquisition_t_s;
+  j["reacquired_t_s"] = s.reacquired_t_s;
   j["ready_t_s"] = std::isnan(s.ready_t_s) ? json(nullptr) : json(s.ready_t_s);
   j["n_tdoa_degenerate"] = s.n_tdoa_degenerate;
   j["n_reacquisitions"] = s.n_reacquisitions;

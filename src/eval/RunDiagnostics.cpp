@@ -25,6 +25,19 @@ std::pair<double, double> movingWindow(const LocalizationRun& run) {
   return {t0, t1};
 }
 
+/// The residuals without those of the times the estimator was lost (from each re-acquisition's start to its fix, or
+/// to the end): a TDoA fault that the filter caught is not the survey's or the clock's misfit.
+std::vector<EstimateResidual> whileTracking(std::vector<EstimateResidual> res, const LocalizerSummary& s) {
+  std::erase_if(res, [&](const EstimateResidual& r) {
+    for (std::size_t k = 0; k < s.reacquisition_t_s.size(); ++k) {
+      const double t_found = k < s.reacquired_t_s.size() ? s.reacquired_t_s[k] : 1e300;
+      if (r.t_s >= s.reacquisition_t_s[k] && r.t_s <= t_found) return true;
+    }
+    return false;
+  });
+  return res;
+}
+
 std::string fmtVec(const Vec3& v) {
   char buf[96];
   std::snprintf(buf, sizeof buf, "(%+.2f, %+.2f, %+.2f)", v.x(), v.y(), v.z());
@@ -42,8 +55,8 @@ SurveyFitCheck checkSurveyFit(const Flight& flight, const AnchorSurvey& survey, 
   SurveyFitCheck c;
   c.done = true;
   const auto [t0, t1] = movingWindow(run);
-  const std::vector<EstimateResidual> res =
-      estimateResiduals(flight.tdoa, survey, run.trajectory, options.params.b_t_tag, t0, t1, p.max_gap_s);
+  const std::vector<EstimateResidual> res = whileTracking(
+      estimateResiduals(flight.tdoa, survey, run.trajectory, options.params.b_t_tag, t0, t1, p.max_gap_s), run.summary);
   c.n = res.size();
   c.truncated_rms_m = truncatedRms(res, p.gross_residual_m);
   const auto n_gross = std::count_if(res.begin(), res.end(),
@@ -104,8 +117,9 @@ AnchorSurveyCheck checkAnchorSurvey(const Flight& flight, const AnchorSurvey& su
     } catch (const std::invalid_argument&) {  // the others alone cannot localize (too few anchors)
       continue;
     }
-    const std::vector<EstimateResidual> res =
-        estimateResiduals(flight.tdoa, survey, rerun.trajectory, options.params.b_t_tag, t0, t1, p.max_gap_s, a.id);
+    const std::vector<EstimateResidual> res = whileTracking(
+        estimateResiduals(flight.tdoa, survey, rerun.trajectory, options.params.b_t_tag, t0, t1, p.max_gap_s, a.id),
+        rerun.summary);
     if (static_cast<double>(res.size()) < p.anchor_min_residuals) continue;
     c.anchors.push_back(fitAnchorOffset(a.id, res, p.gross_residual_m));
   }
@@ -153,6 +167,7 @@ ClockOffsetCheck checkClockOffset(const Flight& flight, const AnchorSurvey& surv
     Flight shifted = flight;  // TDoA stamped `lag` late: the true time is t − lag
     for (TdoaMeasurement& m : shifted.tdoa) m.t_s -= lag;
     const LocalizationRun r = localizeFlight(shifted, survey, options, bias);
+    // all residuals, lost times included: a wrong lag that loses the estimate is evidence against that lag
     const double rms = truncatedRms(
         estimateResiduals(shifted.tdoa, survey, r.trajectory, options.params.b_t_tag, t0, t1, p.max_gap_s),
         p.gross_residual_m);

@@ -183,6 +183,8 @@ void Estimator::startAcquisition(double t_s, bool reacquisition) {
 
 void Estimator::finishStart(double t_s, const StartFix& fix) {
   ekf_.resetPositionVelocity(fix.w_p_b, fix.w_v_b, fix.cov);
+  if (ready_ && summary_.reacquired_t_s.size() < summary_.reacquisition_t_s.size())
+    summary_.reacquired_t_s.push_back(t_s);
   if (!ready_) {
     summary_.ready_t_s = t_s;
     summary_.start_w_p_b = fix.w_p0;

@@ -92,6 +92,8 @@ struct LocalizerSummary {
   std::size_t n_reacquisitions = 0;    ///< lost or diverged → position found again by multilateration (F16)
   std::size_t n_time_jumps = 0;        ///< sensor-time gaps or backward jumps handled (F17)
   std::vector<double> reacquisition_t_s;  ///< when each re-acquisition started (first 100)
+  /// when each of those ended with a fix (same order; fewer when the last one had not ended)
+  std::vector<double> reacquired_t_s;
   double takeoff_t_s = std::numeric_limits<double>::quiet_NaN();  ///< first time it left rest
   double landing_t_s = std::numeric_limits<double>::quiet_NaN();  ///< last time it came to rest after moving
   double ready_t_s = std::numeric_limits<double>::quiet_NaN();    ///< first position fix
