@@ -213,11 +213,12 @@ void Estimator::predictTo(double t_s) {
       // (F16e) re-acquiring in flight: the IMU alone drifts metres in a second horizontally (thrust model: the
       // horizontal acceleration rests on the tilt), while a position-controlled body stays near its course. The
       // horizontal velocity relaxes towards rest instead, v' = v e^{−Δt/τ}, p' = p + v τ (1 − e^{−Δt/τ}); the vertical
-      // channel (thrust axis) stays the IMU's; the covariance keeps growing with the process noise.
+      // channel keeps the thrust-axis IMU's acceleration (below); the covariance keeps growing with the process noise.
       const double e = std::exp(-dt / params_.lost_velocity_tau_s);
       ErrVec dx = ErrVec::Zero();
       for (int i = 0; i < 2; ++i) {
-        dx(kPos + i) = before.w_p_b(i) + before.w_v_b(i) * params_.lost_velocity_tau_s * (1.0 - e) - ekf_.state().w_p_b(i);
+        dx(kPos + i) =
+            before.w_p_b(i) + before.w_v_b(i) * params_.lost_velocity_tau_s * (1.0 - e) - ekf_.state().w_p_b(i);
         dx(kVel + i) = before.w_v_b(i) * e - ekf_.state().w_v_b(i);
       }
       // vertically the thrust-axis IMU drives the velocity, which is damped as well: a bias error b then moves the
@@ -426,7 +427,8 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
     // (F16) divergence is checked at the same 10 ms period
     // (F16) and in flight without any TDoA accepted for max_lost_s (none received, e.g. a radio outage): the
     // prediction gets the re-acquisition's relaxed horizontal motion (F16e) until fresh TDoA fix the position
-    const bool lost_in_flight = !on_ground_ && phase_ != FlightPhase::kAcquisition && t_s - t_last_accept_ > params_.max_lost_s;
+    const bool lost_in_flight =
+        !on_ground_ && phase_ != FlightPhase::kAcquisition && t_s - t_last_accept_ > params_.max_lost_s;
     if (ready_ && !start_.active() && (diverged() || lost_in_flight)) {
       propagate(true);
       startAcquisition(t_s, true);
@@ -581,7 +583,8 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   }
   // in flight only: on and near the floor the TDoA carry the floor-level bias (F14), and a body at rest or in ground
   // contact (F18: still, or shaking on the legs) is not flying even before the ground phase is entered
-  const bool flying = !acquiring && std::min(t - t_acq_end_, t - t_left_ground_) >= kRejectionSettle_s && !near_floor && ekf_.state().w_p_b.z() - params_.ground_z_m > kRejectionMinHeight_m &&
+  const bool flying = !acquiring && !near_floor && std::min(t - t_acq_end_, t - t_left_ground_) >= kRejectionSettle_s &&
+                      ekf_.state().w_p_b.z() - params_.ground_z_m > kRejectionMinHeight_m &&
                       !(imu_mode_ && (rest_.stillNow() || rest_.shaking()));
   if (flying &&
       (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier)) {
@@ -615,7 +618,8 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   // (which widens as P grows) would drag the state away, so the position is found again from fresh TDoA at once
   const bool rejecting = params_.max_rejection_rate < 1.0 && n_gated_recent_ >= kRejectionMinSamples &&
                          n_rejected_recent_ > params_.max_rejection_rate * n_gated_recent_;
-  if (!acquiring && (rejecting || (t - t_last_accept_ > params_.max_lost_s && n_rejected_streak_ > kLostMinRejections))) {
+  const bool nothing_accepted = t - t_last_accept_ > params_.max_lost_s && n_rejected_streak_ > kLostMinRejections;
+  if (!acquiring && (rejecting || nothing_accepted)) {
     if (rejecting) {
       ++summary_.n_rejection_faults;
       revertToHealthyMotion(t);
