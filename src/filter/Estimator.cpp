@@ -44,6 +44,14 @@ constexpr double kHealthyRejectionRate = 0.3;
 constexpr double kHealthyPeriod_s = 0.05;
 constexpr double kRevertLead_s = 0.6;
 constexpr double kRevertMaxAge_s = 1.2;
+/// (F16e) The horizontal motion relaxed towards rest over Δt from (p0, v0): v = v0 e^{−Δt/τ},
+/// p = p0 + v0 τ (1 − e^{−Δt/τ}); writes x and y of *p and *v, leaves z.
+void relaxHorizontal(const Vec3& p0, const Vec3& v0, double dt, double tau, Vec3* p, Vec3* v) {
+  const double e = std::exp(-dt / tau);
+  p->head<2>() = p0.head<2>() + v0.head<2>() * (tau * (1.0 - e));
+  v->head<2>() = v0.head<2>() * e;
+}
+
 /// Diverged (F16): the estimate left the anchors' box by this much [m], or moves faster than this [m/s].
 constexpr double kDivergedBoxMargin_m = 3.0;
 constexpr double kDivergedSpeed_mps = 8.0;
@@ -207,24 +215,25 @@ void Estimator::predictTo(double t_s) {
       m.b_acc_mps2 = acc_sum_ / n_imu_acc_;
       m.b_gyro_radps = gyro_sum_ / n_imu_acc_;
     }
-    const NavState before = ekf_.state();
-    ekf_.predict(m, dt);
+    // (F16e) re-acquiring in flight: the IMU alone drifts metres in a second horizontally (thrust model: the
+    // horizontal acceleration rests on the tilt), while a position-controlled body stays near its course. The
+    // horizontal motion relaxes towards rest instead (relaxHorizontal); the vertical channel keeps the thrust-axis
+    // IMU's acceleration with its velocity damped; the covariance keeps growing with the process noise.
     if (ready_ && start_.active() && !on_ground_ && params_.lost_velocity_tau_s > 0.0) {
-      // (F16e) re-acquiring in flight: the IMU alone drifts metres in a second horizontally (thrust model: the
-      // horizontal acceleration rests on the tilt), while a position-controlled body stays near its course. The
-      // horizontal velocity relaxes towards rest instead, v' = v e^{−Δt/τ}, p' = p + v τ (1 − e^{−Δt/τ}); the vertical
-      // channel keeps the thrust-axis IMU's acceleration (below); the covariance keeps growing with the process noise.
-      const double e = std::exp(-dt / params_.lost_velocity_tau_s);
+      const Vec3 p0 = ekf_.state().w_p_b, v0 = ekf_.state().w_v_b;
+      ekf_.predict(m, dt);
+      const double tau = params_.lost_velocity_tau_s;
+      const Vec3 p = ekf_.state().w_p_b, v = ekf_.state().w_v_b;
+      Vec3 p_relaxed = p, v_relaxed = v;
+      relaxHorizontal(p0, v0, dt, tau, &p_relaxed, &v_relaxed);
+      // vertically a thrust-bias error b then moves the height at b τ instead of b t
+      v_relaxed.z() = v.z() * std::exp(-dt / tau);
       ErrVec dx = ErrVec::Zero();
-      for (int i = 0; i < 2; ++i) {
-        dx(kPos + i) =
-            before.w_p_b(i) + before.w_v_b(i) * params_.lost_velocity_tau_s * (1.0 - e) - ekf_.state().w_p_b(i);
-        dx(kVel + i) = before.w_v_b(i) * e - ekf_.state().w_v_b(i);
-      }
-      // vertically the thrust-axis IMU drives the velocity, which is damped as well: a bias error b then moves the
-      // height at b τ instead of b t
-      dx(kVel + 2) = -(1.0 - e) * ekf_.state().w_v_b.z();
+      dx.segment<3>(kPos) = p_relaxed - p;
+      dx.segment<3>(kVel) = v_relaxed - v;
       ekf_.inject(dx);
+    } else {
+      ekf_.predict(m, dt);
     }
   } else {
     ekf_.predictTdoaOnly(dt);
@@ -642,14 +651,13 @@ void Estimator::revertToHealthyMotion(double t_s) {
   n_healthy_ = 0;
   if (!best || !(params_.lost_velocity_tau_s > 0.0)) return;
   // horizontally only, as F16e: the vertical channel keeps the thrust-axis IMU's and the TDoA's account
-  const double tau = params_.lost_velocity_tau_s, dt = t_s - best->t_s, e = std::exp(-dt / tau);
+  const double tau = params_.lost_velocity_tau_s, dt = t_s - best->t_s;
   Eigen::Matrix<double, 6, 6> cov = ekf_.covariance().block<6, 6>(kPos, kPos);
   const double reach = best->w_v_b.head<2>().norm() * std::min(dt, tau);
   cov(0, 0) += reach * reach;
   cov(1, 1) += reach * reach;
   Vec3 p = ekf_.state().w_p_b, v = ekf_.state().w_v_b;
-  p.head<2>() = best->w_p_b.head<2>() + best->w_v_b.head<2>() * tau * (1.0 - e);
-  v.head<2>() = best->w_v_b.head<2>() * e;
+  relaxHorizontal(best->w_p_b, best->w_v_b, dt, tau, &p, &v);
   ekf_.resetPositionVelocity(p, v, cov);
   ++summary_.n_reverted_motion;
 }
