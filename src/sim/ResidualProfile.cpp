@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "uwb/io/PoseTrack.h"
 
@@ -72,6 +73,34 @@ ResidualProfile residualProfile(const Flight& flight, const AnchorSurvey& survey
   out.outlier_fraction = static_cast<double>(n_out) / static_cast<double>(all.size());
   for (std::size_t li = 0; li < 4; ++li) {
     out.autocorrelation.emplace_back(lags[li], ac_n[li] > 0 ? ac_sum[li] / ac_n[li] : 0.0);
+  }
+  return out;
+}
+
+std::vector<HeightBin> takeoffResidualProfile(const Flight& flight, const AnchorSurvey& survey,
+                                              const std::vector<double>& edges_m, double top_m, const Vec3& b_t_tag) {
+  std::vector<HeightBin> out;
+  for (std::size_t k = 0; k + 1 < edges_m.size(); ++k) out.push_back({edges_m[k], edges_m[k + 1], 0, std::nan("")});
+  if (flight.pose.size() < 2 || out.empty()) return out;
+  const double z_floor = flight.pose.front().w_p_b.z();
+  double t_top = std::numeric_limits<double>::infinity();
+  for (const PoseSample& p : flight.pose)
+    if (p.w_p_b.z() - z_floor > top_m) {
+      t_top = p.t_s;
+      break;
+    }
+  TdoaResidualParams rp;
+  rp.b_t_tag = b_t_tag;
+  std::vector<std::vector<double>> abs_r(out.size());
+  for (const TdoaResidual& r : tdoaResiduals(flight, survey, PoseTrack(flight), rp)) {
+    if (r.t_s >= t_top) continue;
+    const double h = r.w_p_b.z() - z_floor;
+    for (std::size_t k = 0; k < out.size(); ++k)
+      if (h >= out[k].h0_m && h < out[k].h1_m) abs_r[k].push_back(std::abs(r.residual_m));
+  }
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    out[k].n = abs_r[k].size();
+    if (out[k].n > 0) out[k].median_abs_m = residualStats(abs_r[k]).median_m;
   }
   return out;
 }

@@ -78,5 +78,48 @@ TEST(SimVsReal, AirborneResidualStatisticsAreOfTheSameSize) {
   std::printf("mean MAD: real %.3f m, simulated %.3f m\n", real_mad_sum / 5.0, sim_mad_sum / 5.0);
 }
 
+TEST(SimVsReal, FloorLevelBiasFadesWithinTheSameHeight) {
+  // S18: the floor-level bias of the simulator fades with the height above the floor as in the real take-offs
+  const char* names[] = {"0425-traj1", "0425-traj2", "0425-traj3", "0425-traj4", "0425-traj7"};
+  const auto first = test::pilotFlight(names[0]);
+  UWB_REQUIRE_REAL_DATA(first);
+  const AnchorSurvey survey = readAnchorSurvey(test::pilotSurvey("0425").string());
+  const std::vector<double> edges = {-1.0, 0.02, 0.05, 0.08, 0.12, 0.17, 0.25, 0.4};
+  // GIVEN the real take-offs and simulated flights of the same anchors, pooled (median of the per-flight medians)
+  std::vector<std::vector<double>> real(edges.size() - 1), sim(edges.size() - 1);
+  std::uint64_t seed = 1;
+  for (const char* name : names) {
+    const auto path = test::pilotFlight(name);
+    if (!path) continue;
+    const Flight f = readFlightCsv(path->string());
+    // WHEN the median |residual| is taken per height above the floor, before the body first rises 0.8 m
+    const std::vector<HeightBin> r = takeoffResidualProfile(f, survey, edges);
+    const SimResult s = simulateFlight(makeScenario(survey, TrajectoryShape::kCircle, 30.0), SimParams{}, seed++);
+    const std::vector<HeightBin> q = takeoffResidualProfile(s.flight, s.survey, edges);
+    for (std::size_t k = 0; k + 1 < edges.size(); ++k) {
+      if (r[k].n >= 20) real[k].push_back(r[k].median_abs_m);
+      if (q[k].n >= 20) sim[k].push_back(q[k].median_abs_m);
+    }
+  }
+  std::printf("| height above the floor [m] | real median |r| [m] | simulated [m] |\n|---|---|---|\n");
+  const auto median = [](std::vector<double> v) { return v.empty() ? std::nan("") : residualStats(v).median_m; };
+  std::vector<double> mr, ms;
+  for (std::size_t k = 0; k + 1 < edges.size(); ++k) {
+    mr.push_back(median(real[k]));
+    ms.push_back(median(sim[k]));
+    std::printf("| %.2f…%.2f | %.2f | %.2f |\n", std::max(edges[k], 0.0), edges[k + 1], mr.back(), ms.back());
+  }
+  // THEN both are metres on the floor, and both have faded to the airborne size (< 0.4 m) from 12 cm on
+  EXPECT_GT(mr[0], 1.5);
+  EXPECT_GT(ms[0], 1.5);
+  for (std::size_t k = 4; k + 1 < edges.size(); ++k) {
+    EXPECT_LT(mr[k], 0.4) << "real, bin " << k;
+    EXPECT_LT(ms[k], 0.4) << "simulated, bin " << k;
+  }
+  // and halfway up the fade (5–8 cm) the simulated bias is within a factor 2 of the real one
+  EXPECT_GT(ms[2], 0.5 * mr[2]);
+  EXPECT_LT(ms[2], 2.0 * mr[2]);
+}
+
 }  // namespace
 }  // namespace uwb::sim

@@ -33,4 +33,17 @@ enum class Phase { kAirborne, kGround, kAll };
 ResidualProfile residualProfile(const Flight& flight, const AnchorSurvey& survey, Phase phase,
                                 double airborne_min_z_m = kAirborneMinZ_m, const Vec3& b_t_tag = kUtilTagOffset_b);
 
+/// Size of the floor-level TDoA bias (S18) against the height above the floor during the take-off: the median |r| of
+/// the residuals (as in residualProfile) per height bin [edges[k], edges[k+1]), height = body z minus its first pose
+/// z (the body at rest on the floor), over the TDoA before the body first rises top_m above the floor. Bins without
+/// a residual report n = 0 and a NaN median.
+struct HeightBin {
+  double h0_m = 0.0, h1_m = 0.0;
+  std::size_t n = 0;
+  double median_abs_m = 0.0;
+};
+std::vector<HeightBin> takeoffResidualProfile(const Flight& flight, const AnchorSurvey& survey,
+                                              const std::vector<double>& edges_m, double top_m = 0.8,
+                                              const Vec3& b_t_tag = kUtilTagOffset_b);
+
 }  // namespace uwb::sim

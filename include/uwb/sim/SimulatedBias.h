@@ -64,7 +64,7 @@ struct BiasParams {
   double ground_low_max_m = 3.6;
   double ground_high_abs_m = 0.3;         ///< other anchors: ~ U(−abs, abs)
   double ground_noise_std_m = 0.05;       ///< extra scatter on the ground
-  double ground_blend_height_m = 0.25;    ///< offset fades out between 0 and this height above the ground (S18)
+  double ground_blend_height_m = 0.12;    ///< offset fades out between 0 and this height above the ground (S18)
 
   /// Throws std::invalid_argument naming the offending field.
   void validate() const;
