@@ -199,6 +199,7 @@ void runLocalize(const LocalizeArgs& a) {
   j["n_tdoa_out_of_order"] = s.n_tdoa_out_of_order;
   j["n_zero_velocity_updates"] = s.n_zero_velocity_updates;
   j["n_floor_updates"] = s.n_floor_updates;
+  j["n_descent_bound_updates"] = s.n_descent_bound_updates;
   j["n_rest_periods"] = s.n_rest_periods;
   j["n_time_jumps"] = s.n_time_jumps;
   j["reacquisition_t_s"] = s.reacquisition_t_s;

@@ -40,6 +40,7 @@ void EkfParams::validate() const {
     throw std::invalid_argument("EkfParams.robust_iterations must be in [1, 20]");
   requirePositive(max_lost_s, "max_lost_s");
   requireNonNegative(lost_velocity_tau_s, "lost_velocity_tau_s");
+  requireNonNegative(descent_margin_m, "descent_margin_m");
   if (!(max_rejection_rate > 0.0 && max_rejection_rate <= 1.0))
     throw std::invalid_argument("EkfParams.max_rejection_rate must be in (0, 1]");
   requireNonNegative(pair_bias_tau_s, "pair_bias_tau_s");

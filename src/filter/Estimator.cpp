@@ -76,6 +76,8 @@ constexpr double kContactRearm_s = 0.5;
 constexpr double kContactSustained_s = 1.5;
 /// Below this estimated height above the floor TDoA are down-weighted as on the ground (F14) [m].
 constexpr double kLowFlight_m = 0.25;
+/// Std of the height message that enforces the descent bound (F26) [m].
+constexpr double kDescentBoundSigma_m = 0.05;
 /// Constant time of the take-off detector's leaky vertical-velocity integrator [s] (F15).
 constexpr double kTakeoffLeak_s = 1.0;
 /// (F25) whether the learned pattern's variance hᵀ P_θ h is added to the filter's TDoA variance.
@@ -98,6 +100,7 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
       anchors_(std::move(anchors)),
       bias_(std::move(bias)),
       imu_mode_(params.process_model == ProcessModel::kImu),
+      descent_(DescentBoundParams{params.descent_margin_m}),
       ekf_(params),
       start_(anchors_, params.b_t_tag,
              StartUpParams{params.start_window_s, 40, 3.0, 0.2, params.init_pos_sigma_m, 0.15, 1.0}) {
@@ -181,6 +184,7 @@ void Estimator::initialize(double t_s, const Vec3& acc_mean_b, bool moving) {
 
 void Estimator::startAcquisition(double t_s, bool reacquisition) {
   phase_ = FlightPhase::kAcquisition;
+  descent_.clear();
   if (reacquisition) {
     ++summary_.n_reacquisitions;
     if (summary_.reacquisition_t_s.size() < 100) summary_.reacquisition_t_s.push_back(t_s);
@@ -255,6 +259,7 @@ void Estimator::propagate(bool force) {
 void Estimator::handleTimeJump(double t_s, double gap_s) {
   // (F17) nothing is integrated across a gap or a backward jump: the covariance grows by what a body could do in it
   ++summary_.n_time_jumps;
+  descent_.clear();
   propagate(true);
   acc_sum_.setZero();
   gyro_sum_.setZero();
@@ -270,6 +275,7 @@ void Estimator::handleTimeJump(double t_s, double gap_s) {
 
 void Estimator::leaveGround(double t_s, bool climbing) {
   on_ground_ = false;
+  descent_.clear();  // (F26) the climb is not dead-reckoned from the floor: the detector's climb speed lags
   t_left_ground_ = t_s;
   t_last_shake_ = -1e300;
   if (std::isnan(summary_.takeoff_t_s)) summary_.takeoff_t_s = t_s;
@@ -295,6 +301,7 @@ void Estimator::leaveGround(double t_s, bool climbing) {
 
 void Estimator::enterGround(double t_s) {
   on_ground_ = true;
+  descent_.clear();
   n_low_z_ = 0;
   v_climb_ = 0.0;
   ++summary_.n_rest_periods;
@@ -325,6 +332,19 @@ void Estimator::applyFloorConstraint(bool on_ground) {
     }
     ++summary_.n_floor_updates;
   }
+}
+
+void Estimator::applyDescentBound(double t_s) {
+  // (F26) landing: the estimate may not climb more than the margin above the IMU's dead-reckoned descent; a
+  // one-sided height message, applied only when violated (as the floor constraint, F22)
+  if (!(params_.descent_margin_m > 0.0) || !ready_ || start_.active() || on_ground_) return;
+  const NavState& x = ekf_.state();
+  const double h = x.w_p_b.z() - params_.ground_z_m;
+  const double bound = descent_.update(t_s, h, x.w_v_b.z());
+  if (!(h > bound)) return;  // no bound (NaN) or within it
+  propagate(true);
+  ekf_.positionUpdate(2, params_.ground_z_m + bound, kDescentBoundSigma_m);
+  ++summary_.n_descent_bound_updates;
 }
 
 bool Estimator::diverged() const {
@@ -377,6 +397,8 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
   // (F18) ground evidence is re-decided at every sample: at rest (motors off), or shaking as on the floor with the
   // motors running while the estimate is near the floor; a climb seen by the accelerometer contradicts both (F15)
   rest_.update(t_s, imu, dt_imu);
+  // (F26) the vertical motion from the accelerometer alone, for the descent bound
+  if (!on_ground_) descent_.integrate((ekf_.state().w_q_b * imu.b_acc_mps2).z() - g_ref_, dt_imu);
   if (params_.ground_phase == GroundPhase::kDetectTakeoff) {
     bool climbing = false;
     if (on_ground_) {
@@ -433,6 +455,7 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
   } else if (t_s - t_last_zupt_ >= kZuptPeriod_s) {
     t_last_zupt_ = t_s;
     applyFloorConstraint(false);
+    applyDescentBound(t_s);
     // (F16) divergence is checked at the same 10 ms period
     // (F16) and in flight without any TDoA accepted for max_lost_s (none received, e.g. a radio outage): the
     // prediction gets the re-acquisition's relaxed horizontal motion (F16e) until fresh TDoA fix the position

@@ -1,7 +1,7 @@
 /** @file GeneralizationTest.cpp
  *  @brief Flights the defaults were not chosen on (docs/math/filter.md F14–F23, `uwbtdoa protocol`): a real flight
  *         whose log starts in the air, a simulated start in hover, a hand-carried start, a simulated flight with two
- *         take-offs. Bounds are
+ *         take-offs, a simulated landing (F26). Bounds are
  *         the protocol's values at the time of commit plus a margin.
  */
 #include <gtest/gtest.h>
@@ -101,6 +101,26 @@ TEST(Generalization, SimulatedTwoTakeoffs) {
   EXPECT_LT(c.max_airborne_step_m, 0.3);
   const LocalizerSummary& sum = run.summary;
   EXPECT_GE(static_cast<double>(sum.n_tdoa_used + sum.n_tdoa_rejected + sum.n_tdoa_start), 0.9 * sum.n_tdoa_total);
+}
+
+TEST(Generalization, SimulatedLandingDoesNotClimbAway) {
+  // GIVEN a simulated 16 s still hover whose touchdown the estimate does not follow at once: the floor-biased TDoA
+  // (S18) pull it up until the IMU shows the rest about a second later
+  const std::vector<SimScenarioRun> runs = protocolSimulations("", {13}, "still-hover-paper");
+  const SimScenarioRun& s = scenario(runs, "still-hover-paper-s13");
+  // WHEN localizing with the descent bound (F26) and without it
+  const LocalizationRun run = localizeFlight(s.flight, s.survey);
+  LocalizationOptions off;
+  off.params.descent_margin_m = 0.0;
+  const LocalizationRun run_off = localizeFlight(s.flight, s.survey, off);
+  // THEN on the ground after the flight the estimate stays below 0.8 m (1.8 m without the bound), and the airborne
+  // RMSE is the same
+  ASSERT_TRUE(run.metrics && run_off.metrics);
+  const EstimateChecks c = checks(run, s.flight, s.survey), c_off = checks(run_off, s.flight, s.survey);
+  EXPECT_LT(c.max_z_on_ground_m, 0.8);
+  EXPECT_GT(c_off.max_z_on_ground_m, 1.5);
+  EXPECT_GT(run.summary.n_descent_bound_updates, 0u);
+  EXPECT_NEAR(run.metrics->airborne.rmse_m, run_off.metrics->airborne.rmse_m, 0.005);
 }
 
 }  // namespace

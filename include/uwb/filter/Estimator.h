@@ -29,6 +29,7 @@
 #include "uwb/filter/CooperativeRange.h"
 #include "uwb/filter/Ekf.h"
 #include "uwb/filter/EkfParams.h"
+#include "uwb/filter/DescentBound.h"
 #include "uwb/filter/RestDetector.h"
 #include "uwb/filter/SensorEvents.h"
 #include "uwb/filter/StartUp.h"
@@ -86,6 +87,7 @@ struct LocalizerSummary {
   std::size_t n_covariance_propagations = 0;
   std::size_t n_zero_velocity_updates = 0;
   std::size_t n_floor_updates = 0;     ///< floor constraint applied (F22)
+  std::size_t n_descent_bound_updates = 0;  ///< height held down to the dead-reckoned descent while landing (F26)
   std::size_t n_rest_periods = 0;      ///< times the body came to rest
   std::size_t n_rejection_faults = 0; ///< re-acquisitions because most TDoA were rejected (F16d)
   std::size_t n_reverted_motion = 0;  ///< of them, with the state put back to the motion before the fault (F16d)
@@ -157,6 +159,8 @@ class Estimator {
   /// F16d: position and velocity back to the recent motion recorded before a TDoA fault.
   void revertToHealthyMotion(double t_s);
   void applyFloorConstraint(bool on_ground);
+  /// F26: the height bounded from above by the IMU's dead-reckoned descent while landing.
+  void applyDescentBound(double t_s);
   bool diverged() const;
   /// Reported position covariance: the filter's plus the bias floor (F23).
   Mat3 reportedPositionCovariance() const;
@@ -171,6 +175,7 @@ class Estimator {
   bool antenna_predicted_ = false;  ///< the last TDoA's correction included the antenna pattern
   double antenna_var_m2_ = 0.0;     ///< of it, the variance added to the filter's TDoA variance [m²]
   bool imu_mode_;
+  DescentBound descent_;  ///< dead-reckoned descent while landing (F26)
   Ekf ekf_;
   RestDetector rest_;
   StartUp start_;
