@@ -147,7 +147,8 @@ std::vector<EkfParamInfo> makeRegistry() {
       real("lost_velocity_tau_s", &P::lost_velocity_tau_s, "s", kNonNegative,
            "Re-acquiring in flight: the velocity relaxes towards rest with this time constant (F16e); 0 off"),
       real("descent_margin_m", &P::descent_margin_m, "m", kNonNegative,
-           "Landing: the height may not rise more than this above the IMU's dead-reckoned descent (F26); 0 off"),
+           "Landing: the height may not rise more than this above the IMU's dead-reckoned descent (F26; 0.3 on "
+           "simulated landings); 0 off"),
       real("max_rejection_rate", &P::max_rejection_rate, "", EkfParamRange{0.0, 1.0, true, false},
            "A larger fraction of the TDoA rejected in flight (0.3 s memory): re-acquire (F16d); 1 turns it off"),
       // --- scheduling ---

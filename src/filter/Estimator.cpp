@@ -398,12 +398,13 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
   // motors running while the estimate is near the floor; a climb seen by the accelerometer contradicts both (F15)
   rest_.update(t_s, imu, dt_imu);
   // (F26) the vertical motion from the accelerometer alone, for the descent bound
-  if (!on_ground_) descent_.integrate((ekf_.state().w_q_b * imu.b_acc_mps2).z() - g_ref_, dt_imu);
+  if (!on_ground_ && descent_.running())
+    descent_.integrate(worldVertical(ekf_.state().w_q_b, imu.b_acc_mps2) - g_ref_, dt_imu);
   if (params_.ground_phase == GroundPhase::kDetectTakeoff) {
     bool climbing = false;
     if (on_ground_) {
       // (F15) take-off detector: leaky integral of the vertical specific-force excess over its level on the ground
-      const double a_up = (ekf_.state().w_q_b * imu.b_acc_mps2).z();
+      const double a_up = worldVertical(ekf_.state().w_q_b, imu.b_acc_mps2);
       v_climb_ = expNegative(dt_imu / kTakeoffLeak_s) * v_climb_ + dt_imu * (a_up - g_ref_);
       if (rest_.stillNow() || v_climb_ < 0.05) g_ref_ += (dt_imu / 2.0) * (a_up - g_ref_);
       // a body that shakes is still touching the floor (touchdown bounces, spin-up): no take-off

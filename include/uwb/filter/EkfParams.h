@@ -94,8 +94,9 @@ struct EkfParams {
   double antenna_bias_noise_scale = 1000.0;
   double max_lost_s = 1.0;               ///< all TDoA rejected this long → re-acquire (inflate P, open gate)
   double lost_velocity_tau_s = 1.0;      ///< re-acquiring in flight: velocity relaxes to rest with this τ (F16e); 0 off
-  /// Landing: the height may not rise more than this above the IMU's dead-reckoned descent (F26) [m]; 0 off.
-  double descent_margin_m = 0.3;
+  /// Landing: the height may not rise more than this above the IMU's dead-reckoned descent (F26) [m]; 0 off (the
+  /// default: on a real low flight the dead reckoning can drift below the estimate; docs/math/filter.md F26).
+  double descent_margin_m = 0.0;
   double max_rejection_rate = 0.7;       ///< more TDoA rejected in flight (0.3 s memory) → re-acquire (F16d); 1: off
   /// With a bias model: run the uncorrected filter beside the corrected one and output their mixture, weighted by
   /// how well each predicted the recent TDoA (F24). Off by default: it halves the worst loss of a model that does not

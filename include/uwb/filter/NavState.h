@@ -23,4 +23,12 @@ struct ImuReading {
   Vec3 b_gyro_radps = Vec3::Zero();                ///< angular rate [rad/s]
 };
 
+/// (R(q) b_v)_z, the vertical part of a body-frame vector in the world frame, from the third row of R(q) alone
+/// (R = I + 2w[u]× + 2[u]×², q = (w, u)): the IMU-rate paths need no full rotation.
+inline double worldVertical(const Quat& w_q_b, const Vec3& b_v) {
+  const Quat& q = w_q_b;
+  return 2.0 * (q.x() * q.z() - q.w() * q.y()) * b_v.x() + 2.0 * (q.y() * q.z() + q.w() * q.x()) * b_v.y() +
+         (1.0 - 2.0 * (q.x() * q.x() + q.y() * q.y())) * b_v.z();
+}
+
 }  // namespace uwb
