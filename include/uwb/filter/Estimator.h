@@ -27,9 +27,9 @@
 
 #include "uwb/filter/AntennaBias.h"
 #include "uwb/filter/CooperativeRange.h"
+#include "uwb/filter/DescentBound.h"
 #include "uwb/filter/Ekf.h"
 #include "uwb/filter/EkfParams.h"
-#include "uwb/filter/DescentBound.h"
 #include "uwb/filter/RestDetector.h"
 #include "uwb/filter/SensorEvents.h"
 #include "uwb/filter/StartUp.h"
