@@ -153,7 +153,10 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
 
 void Estimator::initialize(double t_s, const Vec3& acc_mean_b, bool moving) {
   NavState x0;
-  x0.w_q_b = imu_mode_ ? levelFromGravity(acc_mean_b) : Quat::Identity();
+  // (F15) at rest the specific force is gravity; in motion under the thrust model it is the thrust along body z
+  // whatever the tilt (the x/y readings are unused, F3): there the attitude starts level
+  const bool level_start = !imu_mode_ || (moving && params_.accel_model == AccelModel::kThrustOnly);
+  x0.w_q_b = level_start ? Quat::Identity() : levelFromGravity(acc_mean_b);
   x0.w_p_b = params_.has_start_position ? params_.start_w_p_b : Vec3(centroid_.x(), centroid_.y(), params_.ground_z_m);
   ErrMat P0 = initialCovariance(params_);
   if (moving) {

@@ -5,6 +5,7 @@
  */
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -82,6 +83,26 @@ TEST(Estimator, StartsInTheAirWithUnknownVelocity) {
   const LocalizerSummary& s = r.summary;
   EXPECT_GE(static_cast<double>(s.n_tdoa_used + s.n_tdoa_rejected + s.n_tdoa_start), 0.9 * s.n_tdoa_total);
   EXPECT_EQ(s.n_reacquisitions, 0u);
+}
+
+/// Tilt of the body z axis from the world vertical [rad].
+double tiltOf(const Quat& w_q_b) { return std::acos(std::clamp((w_q_b * Vec3::UnitZ()).z(), -1.0, 1.0)); }
+
+TEST(Estimator, StartInMotionUnderTheThrustModelIsLevelWhateverTheLateralReadings) {
+  // GIVEN the circle log (a level body) whose accelerometer also reads a steady lateral offset of 0.4 g in x and
+  // 0.2 g in y, as a Crazyflie's does in flight; the thrust model leaves those readings unused (F3)
+  SensorLog log = circleLog(3.0, 8.0, 5);
+  for (auto& s : log.imu) s.imu.b_acc_mps2 += Vec3(-0.4 * kGravity_mps2, -0.2 * kGravity_mps2, 0.0);
+  // WHEN the filter starts in motion under the thrust model (the default) and under the full model
+  const LocalizerResult thrust = TdoaLocalizer(EkfParams{}, arenaAnchors()).run(log);
+  const LocalizerResult full = TdoaLocalizer(lateralFullParams(), arenaAnchors()).run(log);
+  ASSERT_FALSE(thrust.estimates.empty());
+  ASSERT_FALSE(full.estimates.empty());
+  // THEN under the thrust model the attitude at the first fix is level, as the body is (F15); levelled from the
+  // specific force it would be tilted by atan(0.45) = 0.42 rad
+  EXPECT_LT(tiltOf(thrust.estimates.front().x.w_q_b), 0.05);
+  // and under the full model, where the x/y readings are specific force, the tilt follows them
+  EXPECT_GT(tiltOf(full.estimates.front().x.w_q_b), 0.3);
 }
 
 TEST(Estimator, RecoversFromATimeJumpInAllStreams) {
