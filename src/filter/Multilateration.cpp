@@ -27,10 +27,17 @@ std::optional<MultilaterationResult> solve(const std::vector<MultilaterationSamp
   if (samples.size() < kMinUsed) return std::nullopt;
   std::optional<MultilaterationResult> best;
   double best_cost = std::numeric_limits<double>::infinity();
-  for (const Vec3& guess : initial_guesses) {
+  for (std::size_t k = 0; k < initial_guesses.size(); ++k) {
     VecN x = VecN::Zero();
-    x.template head<3>() = guess;
-    if (fixed_z) x(2) = *fixed_z;
+    x.template head<3>() = initial_guesses[k];
+    if (fixed_z) {
+      // (F16c) guesses that differ only in height are one start on the floor: solved once (same result, a third of
+      // the cost with the default guesses, which share x and y)
+      x(2) = *fixed_z;
+      const auto same_xy = [&](const Vec3& g) { return g.x() == x(0) && g.y() == x(1); };
+      if (std::any_of(initial_guesses.begin(), initial_guesses.begin() + static_cast<std::ptrdiff_t>(k), same_xy))
+        continue;
+    }
     MultilaterationResult res;
     double cost = 0.0;
     MatN A = MatN::Zero();

@@ -327,5 +327,35 @@ TEST(Multilateration, OnTheFloorOnlyXAndYAreSolved) {
   EXPECT_GT(free->w_p0.z(), 0.8);
 }
 
+TEST(Multilateration, OnTheFloorGuessesThatDifferOnlyInHeightAreSolvedOnce) {
+  // GIVEN noisy TDoA of a body on the floor, and the start-up's guesses: two share x and y, one does not
+  const AnchorTable anchors = arenaAnchors();
+  const Vec3 p(1.0, -1.5, 0.03);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  std::vector<MultilaterationSample> s;
+  for (int k = 0; k < 120; ++k) {
+    const int a = k % 8, b = (k + 3) % 8;
+    const Vec3 p_tag = tagPosition(p, Quat::Identity(), kUtilTagOffset_b);
+    MultilaterationSample m;
+    m.z = {0.0025 * k, a, b, range(p_tag, anchors.find(b)->m) - range(p_tag, anchors.find(a)->m) + noise(rng)};
+    s.push_back(m);
+  }
+  const std::vector<Vec3> guesses = {Vec3(0.5, 0.0, 0.5), Vec3(0.5, 0.0, 1.5), Vec3(-2.0, 2.0, 1.0)};
+  // WHEN solving with all three guesses, and with each guess alone (the reference: every start solved)
+  const auto all = multilaterateOnFloor(s, anchors, kUtilTagOffset_b, guesses, 0.03);
+  const auto g0 = multilaterateOnFloor(s, anchors, kUtilTagOffset_b, {guesses[0]}, 0.03);
+  const auto g1 = multilaterateOnFloor(s, anchors, kUtilTagOffset_b, {guesses[1]}, 0.03);
+  const auto g2 = multilaterateOnFloor(s, anchors, kUtilTagOffset_b, {guesses[2]}, 0.03);
+  ASSERT_TRUE(all && g0 && g1 && g2);
+  // THEN the guesses that differ only in height give the same solve, bit for bit (so one of them is skipped) …
+  EXPECT_EQ(g0->w_p0, g1->w_p0);
+  EXPECT_EQ(g0->rms_residual_m, g1->rms_residual_m);
+  EXPECT_EQ(g0->covariance, g1->covariance);
+  // … the multi-start result is one of the single-start solves, and it lies at the body's x and y
+  EXPECT_TRUE(all->w_p0 == g0->w_p0 || all->w_p0 == g2->w_p0);
+  EXPECT_LT((all->w_p0.head<2>() - p.head<2>()).norm(), 0.2);
+}
+
 }  // namespace
 }  // namespace uwb
