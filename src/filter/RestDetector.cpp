@@ -42,13 +42,18 @@ void RestDetector::reset(const ImuReading& imu) {
 void RestDetector::update(double t_s, const ImuReading& imu, double dt_s) {
   if (dt_s > 0.0) {
     // (F18) EMA of |f|, its variance and the gyro mean square, weight 1 − exp(−Δt/τ)
-    const double a = expNegative(dt_s * rate_per_s_);
+    if (dt_s != dt_cached_s_) {
+      dt_cached_s_ = dt_s;
+      a_cached_ = expNegative(dt_s * rate_per_s_);
+      a_hp_cached_ = expNegative(dt_s * hp_rate_per_s_);
+    }
+    const double a = a_cached_;
     const double an = imu.b_acc_mps2.norm();
     acc_mean_ = a * acc_mean_ + (1 - a) * an;
     acc_var_ = a * acc_var_ + (1 - a) * (an - acc_mean_) * (an - acc_mean_);
     gyro_ms_ = a * gyro_ms_ + (1 - a) * imu.b_gyro_radps.squaredNorm();
     // high-passed gyro: deviation from its own short moving mean (rotor-frame shaking, not turning)
-    const double a_hp = expNegative(dt_s * hp_rate_per_s_);
+    const double a_hp = a_hp_cached_;
     gyro_mean_ = a_hp * gyro_mean_ + (1 - a_hp) * imu.b_gyro_radps;
     gyro_hp_ms_ = a * gyro_hp_ms_ + (1 - a) * (imu.b_gyro_radps - gyro_mean_).squaredNorm();
   }

@@ -276,6 +276,36 @@ TEST(RestDetector, RestIsDecidedAndRevisedFromTheImu) {
   EXPECT_TRUE(d.shaking());
 }
 
+TEST(RestDetector, StatisticsAreTheExponentialAveragesForAnyStepSequence) {
+  // GIVEN IMU samples at a jittered period (steps repeat and change, as logged stamps do)
+  RestDetector d;
+  ImuReading first;
+  first.b_acc_mps2 = Vec3(0.1, -0.2, 9.8);
+  d.reset(first);
+  const RestDetectorParams p;
+  std::mt19937 rng(4);
+  std::normal_distribution<double> n(0.0, 0.3);
+  const double steps[] = {0.001, 0.001, 0.0012, 0.001, 0.0008, 0.0008, 0.001};
+  // WHEN fed, and the F18 averages are computed alongside with std::exp for every step
+  double acc_mean = first.b_acc_mps2.norm(), acc_var = 1.0, gyro_ms = 1.0;
+  double t = 0.0;
+  for (int k = 0; k < 700; ++k) {
+    const double dt = steps[k % 7];
+    t += dt;
+    ImuReading m;
+    m.b_acc_mps2 = Vec3(n(rng), n(rng), 9.81 + n(rng));
+    m.b_gyro_radps = 0.1 * Vec3(n(rng), n(rng), n(rng));
+    d.update(t, m, dt);
+    const double a = std::exp(-dt / p.tau_s), an = m.b_acc_mps2.norm();
+    acc_mean = a * acc_mean + (1 - a) * an;
+    acc_var = a * acc_var + (1 - a) * (an - acc_mean) * (an - acc_mean);
+    gyro_ms = a * gyro_ms + (1 - a) * m.b_gyro_radps.squaredNorm();
+  }
+  // THEN the detector's statistics are those averages (its decay factors are recomputed only when the step changes)
+  EXPECT_NEAR(d.accVariance(), acc_var, 1e-12 * acc_var);
+  EXPECT_NEAR(d.gyroMeanSquare(), gyro_ms, 1e-12 * gyro_ms);
+}
+
 TEST(Multilateration, MovingSolveRecoversPositionAndVelocity) {
   // GIVEN noise-free TDoA of a body moving at (0.6, −0.4, 0.1) m/s from (0.3, 0.2, 1.2) for 0.6 s, with zero
   // predicted displacement (the filter knew nothing of the motion)

@@ -48,6 +48,8 @@ class RestDetector {
   double acc_var_max_, gyro_ms_max_, rate_per_s_, hp_rate_per_s_, contact_ms_min_;
   double acc_mean_ = 9.81, acc_var_ = 1.0, gyro_ms_ = 1.0, gyro_hp_ms_ = 0.0;
   Vec3 gyro_mean_ = Vec3::Zero();
+  /// The decay factors of the last Δt: the IMU period repeats, so they are recomputed only when it changes.
+  double dt_cached_s_ = -1.0, a_cached_ = 0.0, a_hp_cached_ = 0.0;
   double t_still_since_ = 0.0;
   bool still_ = false;
   bool at_rest_ = false;
