@@ -282,9 +282,13 @@ void runSwarm(const SwarmArgs& a) {
     return;
   }
 
-  // endpoints in a private directory
-  char dir_tmpl[] = "/tmp/uwbtdoa-swarm-XXXXXX";
-  if (::mkdtemp(dir_tmpl) == nullptr) throw uwb::FileError("swarm: cannot create a directory for the ipc endpoints");
+  // endpoints in a private directory under the system's temporary directory ($TMPDIR, else /tmp)
+  std::error_code tmp_ec;
+  const std::filesystem::path tmp_root = std::filesystem::temp_directory_path(tmp_ec);
+  std::string dir_tmpl = ((tmp_ec ? std::filesystem::path("/tmp") : tmp_root) / "uwbtdoa-swarm-XXXXXX").string();
+  if (::mkdtemp(dir_tmpl.data()) == nullptr)
+    throw uwb::FileError(fmt::format("swarm: cannot create a directory for the ipc endpoints in {}",
+                                     std::filesystem::path(dir_tmpl).parent_path().string()));
   const std::string dir = dir_tmpl;
   const std::string ep_events = "ipc://" + dir + "/events", ep_in = "ipc://" + dir + "/bus-in",
                     ep_out = "ipc://" + dir + "/bus-out";
