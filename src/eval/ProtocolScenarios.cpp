@@ -73,7 +73,8 @@ std::vector<SimScenarioRun> protocolSimulations(const std::string& data_dir, con
         const sim::TrajectoryParams& tp = sc.trajectory;
         const double t0 = tp.ground_before_s + tp.takeoff_s + after_climb_s;
         const double t1 = tp.duration_s - tp.ground_after_s - tp.landing_s - 1.0;
-        out.push_back({name + "-" + tag, name, "cut in the air", sliceFlight(r.flight, t0, t1), r.survey, true});
+        out.push_back(
+            {name + "-" + tag, name, "cut in the air", sliceFlight(r.flight, t0, t1), r.survey, true, r.flight});
       };
       // start in hover: a circle with a vertical sine, the log cut 2 s after the climb
       if (want("hover-start")) cutInAir("hover-start", sim::TrajectoryShape::kCircleSine, 60.0, 2.0);
@@ -123,7 +124,7 @@ std::vector<SimScenarioRun> protocolSimulations(const std::string& data_dir, con
         const double t0 = tp.ground_before_s + tp.takeoff_s + tp.speed_ramp_s + 1.0;
         const double t1 = tp.duration_s - tp.ground_after_s - tp.landing_s - 1.0;
         out.push_back({"hand-carried-" + tag, "hand-carried", "cut in the air", sliceFlight(r.flight, t0, t1), r.survey,
-                       true});
+                       true, r.flight});
       }
     }
   }

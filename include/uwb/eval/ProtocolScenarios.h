@@ -19,6 +19,9 @@ struct SimScenarioRun {
   Flight flight;
   AnchorSurvey survey;
   bool cut = false;   ///< the log starts in the air
+  /// For a cut: the simulated flight from the ground that the log was cut from (the reference on the same window:
+  /// what the error is there without the start in the air); empty otherwise.
+  Flight whole;
 };
 
 /// Start in hover, a 16 s still hover, two take-offs, fast flight, a yawing start in the air, carried by a walking
