@@ -142,6 +142,10 @@ std::vector<EkfParamInfo> makeRegistry() {
               "likelihood (F24)"),
       real("bias_guard_tau_s", &P::bias_guard_tau_s, "s", kPositive,
            "Memory of the bias guard's likelihood comparison (F24)"),
+      choice("bias_model_pose", &P::bias_model_pose, {"none", "variance", "jacobian"}, parseBiasPoseUncertainty,
+             toString,
+             "With a bias model: the pose uncertainty of the correction, as variance ∇µᵀ P ∇µ or in the row "
+             "∂(h + µ)/∂δx (gp.md P47)"),
       real("max_lost_s", &P::max_lost_s, "s", kPositive,
            "All TDoA rejected this long: re-acquire (inflate P, open the gate)"),
       real("lost_velocity_tau_s", &P::lost_velocity_tau_s, "s", kNonNegative,

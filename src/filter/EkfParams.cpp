@@ -141,5 +141,19 @@ GroundPhase parseGroundPhase(const std::string& s) {
   if (s == "none") return GroundPhase::kNone;
   throw std::invalid_argument("unknown ground phase '" + s + "' (detect, none)");
 }
+std::string toString(BiasPoseUncertainty b) {
+  switch (b) {
+    case BiasPoseUncertainty::kVariance: return "variance";
+    case BiasPoseUncertainty::kJacobian: return "jacobian";
+    case BiasPoseUncertainty::kNone: break;
+  }
+  return "none";
+}
+BiasPoseUncertainty parseBiasPoseUncertainty(const std::string& s) {
+  if (s == "none") return BiasPoseUncertainty::kNone;
+  if (s == "variance") return BiasPoseUncertainty::kVariance;
+  if (s == "jacobian") return BiasPoseUncertainty::kJacobian;
+  throw std::invalid_argument("unknown bias-model pose uncertainty '" + s + "' (none, variance, jacobian)");
+}
 
 }  // namespace uwb

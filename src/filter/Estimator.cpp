@@ -118,6 +118,7 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
   track_opt_.robust_k = params_.robust_k;
   track_opt_.robust_iterations = params_.robust_iterations;
   track_opt_.b_t_tag = params_.b_t_tag;
+  track_opt_.bias_pose = params_.bias_model_pose;
   acq_opt_ = track_opt_;
   acq_opt_.sigma_m = params_.acquisition_tdoa_sigma_m;
   acq_opt_.gate_sigma = 0.0;  // (F16) no gate while acquiring; the robust loss limits outliers

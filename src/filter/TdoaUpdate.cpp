@@ -7,6 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "uwb/filter/QuadImuProcess.h"
 #include "uwb/model/TdoaLinearization.h"
 #include "uwb/model/TdoaModel.h"
 
@@ -113,6 +114,30 @@ std::optional<ScalarLinearMessage<kDim>> tdoaMessage(const NavState& x, const An
   return tdoaMessageFromAnchors(x, anchor_a, anchor_b, z_corrected_m, var_m2, b_t_tag);
 }
 
+Eigen::Matrix<double, 1, 6> biasPoseJacobian(const BiasPredictor& bias, const NavState& x, int id_a, int id_b,
+                                             const Vec3& w_p_anchor_a, const Vec3& w_p_anchor_b) {
+  // (P47) the correction as a function of the error state: µ(x̂ ⊞ δx), δx = (δp, δθ)
+  constexpr double kStepPos_m = 1e-4, kStepAtt_rad = 1e-4;
+  Eigen::Matrix<double, 1, 6> g = Eigen::Matrix<double, 1, 6>::Zero();
+  for (int k = 0; k < 6; ++k) {
+    double mu[2];
+    const double h = k < 3 ? kStepPos_m : kStepAtt_rad;
+    for (int s = 0; s < 2; ++s) {
+      const double d = s == 0 ? h : -h;
+      Vec3 p = x.w_p_b;
+      Quat q = x.w_q_b;
+      if (k < 3)
+        p(k) += d;
+      else
+        q = (q * expQuat(Vec3::Unit(k - 3) * d)).normalized();
+      mu[s] = bias(makeTdoaFeature(id_a, id_b, p, q, w_p_anchor_a, w_p_anchor_b)).mean_m;
+    }
+    if (!std::isfinite(mu[0]) || !std::isfinite(mu[1])) return Eigen::Matrix<double, 1, 6>::Zero();
+    g(k) = (mu[0] - mu[1]) / (2.0 * h);
+  }
+  return g;
+}
+
 TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObservation& z,
                             const TdoaUpdateOptions& options, const BiasPredictor* bias) {
   TdoaUpdateResult res;
@@ -126,6 +151,10 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
   // (F12) bias correction from the predictor, evaluated at the filter's current estimate (paper III-B).
   double z_corr = z.tdoa_m;
   double var = options.sigma_m * options.sigma_m;
+  // (P47) before the nominal prediction: a predictor may keep the last prediction's state (F25)
+  Eigen::Matrix<double, 1, 6> bias_row = Eigen::Matrix<double, 1, 6>::Zero();
+  const bool bias_pose = options.bias_pose != BiasPoseUncertainty::kNone && bias && *bias;
+  if (bias_pose) bias_row = biasPoseJacobian(*bias, x, z.id_a, z.id_b, anchor_a->m, anchor_b->m);
   if (bias && *bias) {
     const BiasPrediction b =
         (*bias)(makeTdoaFeature(z.id_a, z.id_b, x.w_p_b, x.w_q_b, anchor_a->m, anchor_b->m));
@@ -134,6 +163,16 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
       z_corr -= b.mean_m;
       var = var * b.noise_scale + b.variance_m2;  // docs/math/gp.md (P45); noise_scale = 1: R + var_f
       res.bias_mean_m = b.mean_m;
+      if (bias_pose && options.bias_pose == BiasPoseUncertainty::kVariance) {
+        // (P47a) σ_in² = ∇µᵀ P ∇µ over the position and attitude blocks of P
+        const ErrMat& P = ekf.covariance();
+        Eigen::Matrix<double, 6, 6> P6;
+        P6 << P.block<3, 3>(kPos, kPos), P.block<3, 3>(kPos, kAtt), P.block<3, 3>(kAtt, kPos),
+            P.block<3, 3>(kAtt, kAtt);
+        var += (bias_row * P6 * bias_row.transpose())(0, 0);
+      }
+    } else {
+      bias_row.setZero();
     }
   }
   std::optional<ScalarLinearMessage<kDim>> msg =
@@ -141,6 +180,11 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
   if (!msg) {
     res.outcome = UpdateOutcome::kDegenerate;
     return res;
+  }
+  // (P47b) z − µ(x̂) − h(x̂) ≈ (∂h/∂δx + ∂µ/∂δx) δx: the corrected measurement's row
+  if (bias_pose && options.bias_pose == BiasPoseUncertainty::kJacobian) {
+    msg->a.segment<3>(kPos) += bias_row.head<3>();
+    msg->a.segment<3>(kAtt) += bias_row.tail<3>();
   }
   // (F11) χ² gate on the unweighted innovation
   // The message row a = B12 C is non-zero only in the position and attitude blocks, so u = P aᵀ needs only those

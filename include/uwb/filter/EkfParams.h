@@ -27,6 +27,13 @@ enum class ProcessModel {
 /// Robust loss of the iteratively reweighted TDoA update (docs/math/filter.md F13).
 enum class RobustLoss { kNone, kHuber, kCauchy };
 
+/// How a bias model's correction µ(x̂), evaluated at the estimated pose, enters the update (docs/math/gp.md P47).
+enum class BiasPoseUncertainty {
+  kNone,      ///< "none": µ at the estimate, as the paper
+  kVariance,  ///< "variance": the corrected measurement's variance gains ∇µᵀ P ∇µ (input uncertainty)
+  kJacobian,  ///< "jacobian": the row becomes ∂(h + µ)/∂δx (the EKF of h + µ; S then carries ∇µᵀ P ∇µ too)
+};
+
 /// Whether the IMU's evidence of the ground is used (docs/math/filter.md F14, F18).
 enum class GroundPhase {
   kDetectTakeoff,  ///< "detect": at rest or in floor contact (re-decided at every IMU sample) → zero-velocity updates,
@@ -110,6 +117,9 @@ struct EkfParams {
   /// transfer, but also gives up part of the gain of one that does (docs/math/filter.md F24).
   bool bias_guard = false;
   double bias_guard_tau_s = 10.0;        ///< memory of the F24 predictive-likelihood comparison [s]
+  /// With a bias model: how the pose uncertainty of µ(x̂) enters (docs/math/gp.md P47). Off by default: neither form
+  /// improved the leave-one-session-out splits (P47).
+  BiasPoseUncertainty bias_model_pose = BiasPoseUncertainty::kNone;
 
   // --- scheduling ---
   double max_predict_dt_s = 0.01;        ///< IMU samples are averaged over at most this interval [s]
@@ -173,10 +183,12 @@ std::string toString(AccelModel m);
 std::string toString(ProcessModel m);
 std::string toString(RobustLoss l);
 std::string toString(GroundPhase g);
+std::string toString(BiasPoseUncertainty b);
 /// Parse the names printed by toString; throws std::invalid_argument for an unknown name.
 AccelModel parseAccelModel(const std::string& s);
 ProcessModel parseProcessModel(const std::string& s);
 RobustLoss parseRobustLoss(const std::string& s);
 GroundPhase parseGroundPhase(const std::string& s);
+BiasPoseUncertainty parseBiasPoseUncertainty(const std::string& s);
 
 }  // namespace uwb

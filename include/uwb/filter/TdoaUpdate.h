@@ -55,7 +55,16 @@ struct TdoaUpdateOptions {
   double robust_k = 1.5;
   int robust_iterations = 2;
   Vec3 b_t_tag = kUtilTagOffset_b;
+  /// With a bias predictor: ∂µ/∂δx (position and attitude, central differences) as input variance ∇µᵀ P ∇µ on the
+  /// corrected measurement, or in its row so that the update linearizes h(x) + µ(x) (docs/math/gp.md P47).
+  BiasPoseUncertainty bias_pose = BiasPoseUncertainty::kNone;
 };
+
+/// ∂µ/∂δx of a bias predictor at the state x for the TDoA between anchors A and B: position (additive) and attitude
+/// (q ⊗ exp(δθ), as Ekf::inject) columns, by central differences of step 1e-4 m / 1e-4 rad (docs/math/gp.md P47).
+/// Zero where a perturbed prediction is not finite. Calls the predictor 12 times.
+Eigen::Matrix<double, 1, 6> biasPoseJacobian(const BiasPredictor& bias, const NavState& x, int id_a, int id_b,
+                                             const Vec3& w_p_anchor_a, const Vec3& w_p_anchor_b);
 
 struct TdoaUpdateResult {
   UpdateOutcome outcome = UpdateOutcome::kSkipped;
