@@ -96,6 +96,16 @@ def test_a_gp_trained_in_python_drives_the_filter(flights, trained):
                             params={"tdoa_sigma_m": 0.3, "fuse_tof": True, "tof_sigma_m": 0.05})
     assert tof["summary"]["n_tof_total"] == 0 and tof["summary"]["n_tof_used"] == 0
     np.testing.assert_array_equal(tof["trajectory"]["p"], run["trajectory"]["p"])
+    # the correction's pose dependence (docs/math/gp.md P47): as variance the estimate moves a little, in the row more
+    var = u.localize_flight(test["flight"], test["survey"], bias_model=model,
+                            params={"tdoa_sigma_m": 0.3, "bias_model_pose": "variance"})
+    row = u.localize_flight(test["flight"], test["survey"], bias_model=model,
+                            params={"tdoa_sigma_m": 0.3, "bias_model_pose": "jacobian"})
+    assert var["metrics"]["airborne"]["n"] == run["metrics"]["airborne"]["n"]
+    assert not np.array_equal(row["trajectory"]["p"], run["trajectory"]["p"])
+    assert abs(row["metrics"]["airborne"]["rmse_m"] - run["metrics"]["airborne"]["rmse_m"]) < 0.1
+    with pytest.raises(ValueError, match="bias_model_pose must be one of none, variance, jacobian"):
+        u.localize_flight(test["flight"], test["survey"], bias_model=model, params={"bias_model_pose": "both"})
 
 
 def test_eval_errors_are_value_and_os_errors(flights, trained, tmp_path):
