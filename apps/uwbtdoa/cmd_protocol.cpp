@@ -83,19 +83,6 @@ double maxOf(const std::vector<double>& v) {
   return m;
 }
 
-/// RMSE of the airborne samples of `m` within [t0, t1].
-double windowRmse(const uwb::TrajectoryMetrics& m, double t0, double t1, std::size_t* n_out = nullptr) {
-  double s = 0.0;
-  std::size_t n = 0;
-  for (const uwb::PositionErrorSample& e : m.samples)
-    if (e.airborne && e.t_s >= t0 && e.t_s <= t1) {
-      s += e.error_norm_m * e.error_norm_m;
-      ++n;
-    }
-  if (n_out) *n_out = n;
-  return n ? std::sqrt(s / n) : std::nan("");
-}
-
 struct Row {
   std::string name, session, kind;
   double t0 = 0.0, t1 = 0.0;
@@ -490,11 +477,11 @@ void runProtocol(const ProtocolArgs& a) {
         Row r = evaluateRun(run, f.name, f.session, "cut at " + fmt2(t0).substr(0, fmt2(t0).size() - 3) + " s", cp, cut);
         r.t0 = t0;
         r.t1 = t1;
-        if (run.metrics) r.rmse_air = windowRmse(*run.metrics, t0, t1);
-        r.rmse_ref = windowRmse(*full.metrics, t0, t1);
+        if (run.metrics) r.rmse_air = uwb::airborneRmseInWindow(*run.metrics, t0, t1);
+        r.rmse_ref = uwb::airborneRmseInWindow(*full.metrics, t0, t1);
         if (!cut.tdoa.empty()) {
           const double ts = cut.tdoa.front().t_s;
-          r.early_ref = windowRmse(*full.metrics, ts + 3.0, ts + 5.0);
+          r.early_ref = uwb::airborneRmseInWindow(*full.metrics, ts + 3.0, ts + 5.0);
         }
         cut_rows.push_back(r);
       }
@@ -516,12 +503,11 @@ void runProtocol(const ProtocolArgs& a) {
         // the same flight logged from the ground: its error on the same window is what the bias field gives
         // without the start in the air
         const uwb::LocalizationRun whole = uwb::localizeFlight(s.whole, s.survey, opt);
-        if (whole.metrics && run.metrics) {
-          r.rmse_air = windowRmse(*run.metrics, r.t0, r.t1);
-          r.rmse_ref = windowRmse(*whole.metrics, r.t0, r.t1);
+        if (whole.metrics) {
+          r.rmse_ref = uwb::airborneRmseInWindow(*whole.metrics, r.t0, r.t1);
           if (!s.flight.tdoa.empty()) {
             const double ts = s.flight.tdoa.front().t_s;
-            r.early_ref = windowRmse(*whole.metrics, ts + 3.0, ts + 5.0);
+            r.early_ref = uwb::airborneRmseInWindow(*whole.metrics, ts + 3.0, ts + 5.0);
           }
         }
         sim_cut_rows.push_back(r);

@@ -28,6 +28,17 @@ double percentile(const std::vector<double>& sorted, double q) {
 }
 }  // namespace
 
+double airborneRmseInWindow(const TrajectoryMetrics& m, double t0_s, double t1_s) {
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (const PositionErrorSample& e : m.samples)
+    if (e.airborne && e.t_s >= t0_s && e.t_s <= t1_s) {
+      sum += e.error_norm_m * e.error_norm_m;
+      ++n;
+    }
+  return n ? std::sqrt(sum / static_cast<double>(n)) : std::nan("");
+}
+
 PositionErrorStats positionErrorStats(const std::vector<PositionErrorSample>& samples, bool airborne_only) {
   PositionErrorStats s;
   std::vector<double> norms;

@@ -75,6 +75,19 @@ TEST(TrajectoryMetrics, GivenAHandComputedFlightWhenComparedThenEveryStatisticMa
   EXPECT_NEAR(m.airborne.p50_m, 0.5 * 0.5 + 0.5 * std::sqrt(1.25), tol);
 }
 
+TEST(TrajectoryMetrics, GivenATimeWindowThenTheAirborneRmseCountsOnlyItsAirborneInstants) {
+  // GIVEN the hand-computed flight (airborne at t = 1.5 s, |e| = √1.25, and t = 2 s, |e| = 0.5)
+  TrajectoryMetricsParams params;
+  params.max_interp_gap_s = 2.0;
+  const TrajectoryMetrics m = computeTrajectoryMetrics(handEstimate(), handTruth(), params);
+  // WHEN taking the RMSE over windows, THEN the bounds are inclusive, instants on the ground never count, and a
+  // window without airborne instants has none
+  EXPECT_NEAR(airborneRmseInWindow(m, 0.0, 2.0), m.airborne.rmse_m, 1e-12);
+  EXPECT_NEAR(airborneRmseInWindow(m, 1.5, 1.5), std::sqrt(1.25), 1e-12);
+  EXPECT_NEAR(airborneRmseInWindow(m, 1.6, 5.0), 0.5, 1e-12);
+  EXPECT_TRUE(std::isnan(airborneRmseInWindow(m, 0.0, 1.2)));
+}
+
 TEST(TrajectoryMetrics, GivenAGapInTheEstimateWhenComparedThenInstantsInTheGapAreNotCompared) {
   // GIVEN estimate samples 1 s apart and the default gap limit (0.1 s)
   // WHEN computing the metrics

@@ -50,6 +50,9 @@ struct TrajectoryMetrics {
 /// Statistics of a list of error samples (percentiles by linear interpolation of the sorted errors).
 PositionErrorStats positionErrorStats(const std::vector<PositionErrorSample>& samples, bool airborne_only);
 
+/// RMSE of the airborne samples of `m` with t0_s ≤ t ≤ t1_s (a window of the flight; NaN when there are none).
+double airborneRmseInWindow(const TrajectoryMetrics& m, double t0_s, double t1_s);
+
 /// Interpolates `estimate` (sorted by time) at each ground-truth time (io/PoseTrack.h interpolatePose, position
 /// only) and compares body origins.
 /// `truth` should be glitch-free (e.g. PoseTrack::samples()).
