@@ -89,6 +89,7 @@ struct Row {
   double rmse_air = std::nan(""), rmse_ref = std::nan(""), max_err = std::nan(""), max_err_air = std::nan("");
   double early = std::nan(""), early_ref = std::nan("");  ///< RMSE 3–5 s after the log's start; the whole flight's
   double step = std::nan(""), zmin = std::nan(""), zmax = std::nan(""), settle = std::nan(""), err3 = std::nan("");
+  double err_ground = std::nan("");
   uwb::Vec3 cov1 = uwb::Vec3::Constant(std::nan("")), cov2 = uwb::Vec3::Constant(std::nan(""));
   double used_frac = std::nan("");
   bool violated = false;
@@ -117,6 +118,7 @@ Row evaluateRun(const uwb::LocalizationRun& run, const std::string& name, const 
   r.step = c.max_airborne_step_m;
   r.zmin = c.min_z_on_ground_m;
   r.zmax = c.max_z_on_ground_m;
+  r.err_ground = c.max_error_before_takeoff_m;
   r.settle = c.settle_time_s;
   r.err3 = c.max_error_after_3s_m;
   r.early = c.rmse_3_to_5s_m;
@@ -156,6 +158,7 @@ json rowJson(const Row& r) {
           {"rmse_full_flight_same_window_m", num(r.rmse_ref)},
           {"max_error_m", num(r.max_err)},
           {"max_error_airborne_m", num(r.max_err_air)},
+          {"max_error_before_takeoff_m", num(r.err_ground)},
           {"max_airborne_step_m", num(r.step)},
           {"min_z_on_ground_m", num(r.zmin)},
           {"max_z_on_ground_m", num(r.zmax)},
@@ -184,12 +187,14 @@ void printTable(const std::string& title, const std::vector<Row>& rows, bool cut
                 << " | " << fmt3(r.step) << " | " << pct(r.used_frac) << " | " << r.reacq << " |\n";
     return;
   }
-  std::cout << "| flight | RMSE air [m] | max err [m] | max err air [m] | max step air [m] | z on ground after "
-               "flight [m] | 1σ cov x/y/z [%] | 2σ cov x/y/z [%] | TDoA used+gated [%] | reacq |\n"
-               "|---|---|---|---|---|---|---|---|---|---|\n";
+  std::cout << "| flight | RMSE air [m] | max err [m] | max err air [m] | max err on the ground before take-off [m] "
+               "| max step air [m] | z on ground after flight [m] | 1σ cov x/y/z [%] | 2σ cov x/y/z [%] | TDoA "
+               "used+gated [%] | reacq |\n"
+               "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows)
     std::cout << "| " << r.name << " | " << fmt3(r.rmse_air) << " | " << fmt3(r.max_err) << " | "
-              << fmt3(r.max_err_air) << " | " << fmt3(r.step) << " | " << fmt2(r.zmin) << "…" << fmt2(r.zmax)
+              << fmt3(r.max_err_air) << " | " << fmt3(r.err_ground) << " | " << fmt3(r.step) << " | "
+              << fmt2(r.zmin) << "…" << fmt2(r.zmax)
               << (r.violated ? " (!)" : "") << " | " << pct(r.cov1.x()) << "/" << pct(r.cov1.y()) << "/"
               << pct(r.cov1.z()) << " | " << pct(r.cov2.x()) << "/" << pct(r.cov2.y()) << "/" << pct(r.cov2.z())
               << " | " << pct(r.used_frac) << " | " << r.reacq << " |\n";
@@ -206,25 +211,28 @@ json summarize(const std::vector<Row>& rows, const std::string& label, bool prin
   json out = json::object();
   if (print)
     std::cout << "\n" << label << " — per session: median / worst airborne RMSE [m], worst max step [m], median 1σ "
-              << "coverage x/y/z [%], median 2σ coverage x/y/z [%]\n\n| session | n | median | worst | worst step | "
-              << "1σ cov | 2σ cov |\n|---|---|---|---|---|---|---|\n";
+              << "coverage x/y/z [%], median 2σ coverage x/y/z [%], median / worst of the largest error on the ground "
+              << "before take-off [m]\n\n| session | n | median | worst | worst step | 1σ cov | 2σ cov | on the ground "
+              << "before take-off |\n|---|---|---|---|---|---|---|---|\n";
   for (const auto& [session, rs] : by_session) {
-    std::vector<double> rm, st, c1[3], c2[3];
+    std::vector<double> rm, st, eg, c1[3], c2[3];
     for (const Row* r : rs) {
       rm.push_back(r->rmse_air);
       st.push_back(r->step);
+      eg.push_back(r->err_ground);
       for (int k = 0; k < 3; ++k) {
         c1[k].push_back(r->cov1(k));
         c2[k].push_back(r->cov2(k));
       }
     }
     out[session] = {{"n", rs.size()}, {"median_rmse_m", median(rm)}, {"worst_rmse_m", maxOf(rm)},
-                    {"worst_step_m", maxOf(st)}};
+                    {"worst_step_m", maxOf(st)}, {"median_max_error_before_takeoff_m", median(eg)},
+                    {"worst_max_error_before_takeoff_m", maxOf(eg)}};
     if (print)
       std::cout << "| " << session << " | " << rs.size() << " | " << fmt3(median(rm)) << " | " << fmt3(maxOf(rm))
                 << " | " << fmt3(maxOf(st)) << " | " << pct(median(c1[0])) << "/" << pct(median(c1[1])) << "/"
                 << pct(median(c1[2])) << " | " << pct(median(c2[0])) << "/" << pct(median(c2[1])) << "/"
-                << pct(median(c2[2])) << " |\n";
+                << pct(median(c2[2])) << " | " << fmt3(median(eg)) << " / " << fmt3(maxOf(eg)) << " |\n";
   }
   return out;
 }

@@ -64,6 +64,12 @@ EstimateChecks checkEstimate(const Trajectory& estimate, const TrajectoryMetrics
       t_first_air = s.t_s;
       break;
     }
+  for (const PositionErrorSample& s : samples) {
+    if (s.t_s >= t_first_air) break;
+    c.max_error_before_takeoff_m = std::isnan(c.max_error_before_takeoff_m)
+                                       ? s.error_norm_m
+                                       : std::max(c.max_error_before_takeoff_m, s.error_norm_m);
+  }
   for (std::size_t i = 0; i < estimate.size(); ++i) {
     const TrajectorySample& e = estimate[i];
     bool known = false;

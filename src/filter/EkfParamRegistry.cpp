@@ -185,6 +185,9 @@ std::vector<EkfParamInfo> makeRegistry() {
            "Tolerance below ground_z_m before the floor constraint acts (F22)"),
       real("rest_tdoa_sigma_m", &P::rest_tdoa_sigma_m, "m", kPositive,
            "TDoA std on the ground and just above it (F14)"),
+      real("floor_anchor_height_m", &P::floor_anchor_height_m, "m", kNonNegative,
+           "Anchors less than this above the floor: on the floor their range delay is solved for at the start and "
+           "removed from the TDoA on the ground (F16f); 0 off"),
       real("leave_rest_pos_sigma_m", &P::leave_rest_pos_sigma_m, "m", kNonNegative,
            "Horizontal position std added when the body leaves the ground (F15)"),
       real("start_window_s", &P::start_window_s, "s", kPositive,

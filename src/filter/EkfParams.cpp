@@ -64,6 +64,7 @@ void EkfParams::validate() const {
   if (!std::isfinite(ground_z_m)) throw std::invalid_argument("EkfParams.ground_z_m must be finite");
   requireNonNegative(floor_margin_m, "floor_margin_m");
   requirePositive(rest_tdoa_sigma_m, "rest_tdoa_sigma_m");
+  requireNonNegative(floor_anchor_height_m, "floor_anchor_height_m");
   requireNonNegative(leave_rest_pos_sigma_m, "leave_rest_pos_sigma_m");
   requirePositive(start_window_s, "start_window_s");
   requirePositive(moving_start_vel_sigma_mps, "moving_start_vel_sigma_mps");

@@ -106,6 +106,8 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
              StartUpParams{params.start_window_s, 40, 3.0, 0.2, params.init_pos_sigma_m, 0.15, 1.0}) {
   params_.validate();
   if (anchors_.size() < 4) throw std::invalid_argument("Estimator: at least 4 anchors are needed");
+  floor_anchors_ = FloorLevelAnchors(anchors_, params_.ground_z_m, params_.floor_anchor_height_m);
+  if (floor_anchors_.any()) start_.setFloorLevelAnchors(floor_anchors_.mask());
   summary_.process_model = params_.process_model;
   const AnchorBox box = anchorBox(anchors_);
   box_min_ = box.min;
@@ -199,6 +201,7 @@ void Estimator::startAcquisition(double t_s, bool reacquisition) {
 
 void Estimator::finishStart(double t_s, const StartFix& fix) {
   ekf_.resetPositionVelocity(fix.w_p_b, fix.w_v_b, fix.cov);
+  if (!fix.anchor_delay_m.empty()) floor_anchors_.setDelays(fix.anchor_delay_m);  // (F16f) a fix on the floor
   if (ready_ && summary_.reacquired_t_s.size() < summary_.reacquisition_t_s.size())
     summary_.reacquired_t_s.push_back(t_s);
   if (!ready_) {
@@ -583,6 +586,8 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   // (F14) TDoA near the floor carry the large floor-level bias: down-weighted on the ground and just above it
   const bool near_floor = on_ground_ || ekf_.state().w_p_b.z() - params_.ground_z_m < kLowFlight_m;
   const TdoaUpdateOptions& opt = acquiring ? acq_opt_ : (near_floor ? rest_opt_ : track_opt_);
+  // (F16f) on the ground the floor-level anchors are seen with the delays the start on the floor found
+  if (on_ground_ && floor_anchors_.hasDelays()) zc.tdoa_m -= floor_anchors_.pairDelay(z.id_a, z.id_b);
   if (antenna_) {
     antenna_->advance(t);
     antenna_predicted_ = false;

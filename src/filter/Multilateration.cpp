@@ -133,6 +133,132 @@ std::optional<MultilaterationResult> multilaterateOnFloor(const std::vector<Mult
   return r;
 }
 
+std::optional<MultilaterationResult> multilaterateOnFloorWithDelays(
+    const std::vector<MultilaterationSample>& samples, const AnchorTable& anchors, const Vec3& b_t_tag,
+    const std::vector<Vec3>& initial_guesses, double floor_z_m, const std::vector<unsigned char>& floor_level,
+    double huber_k_m, int max_iterations) {
+  // (F16f) unknowns u = (x, y, g_1 … g_L): one range delay per floor-level anchor seen in the batch
+  const auto isFloorLevel = [&](int id) {
+    return id >= 0 && static_cast<std::size_t>(id) < floor_level.size() && floor_level[id] != 0;
+  };
+  std::vector<int> column;  // by anchor id: the delay's column in u, −1 for none
+  std::vector<unsigned char> other_seen;
+  int n_other = 0, n_cols = 2;
+  for (const MultilaterationSample& s : samples) {
+    if (!anchors.find(s.z.id_a) || !anchors.find(s.z.id_b)) continue;
+    for (const int id : {s.z.id_a, s.z.id_b}) {
+      const auto i = static_cast<std::size_t>(id);
+      if (isFloorLevel(id)) {
+        if (column.size() <= i) column.resize(i + 1, -1);
+        if (column[i] < 0) column[i] = n_cols++;
+      } else {
+        if (other_seen.size() <= i) other_seen.resize(i + 1, 0);
+        if (!other_seen[i]) ++n_other;
+        other_seen[i] = 1;
+      }
+    }
+  }
+  // at most kMaxDelays delays (a fixed-size system: no heap; unused columns are identity rows with a zero step);
+  // more floor-level anchors in view than that: the plain solve
+  constexpr int kMaxDelays = 8;
+  if (n_other < 3 || n_cols - 2 > kMaxDelays) return std::nullopt;
+  if (n_cols == 2) return multilaterateOnFloor(samples, anchors, b_t_tag, initial_guesses, floor_z_m, huber_k_m,
+                                               max_iterations);
+  const auto delayColumn = [&](int id) {
+    return isFloorLevel(id) && static_cast<std::size_t>(id) < column.size() ? column[static_cast<std::size_t>(id)]
+                                                                             : -1;
+  };
+  // weak prior g ~ N(0, (5 m)²) in the units of the Huber cost (residual scale k): only an anchor whose delay the
+  // batch does not determine (seen in one pair only) is held by it
+  constexpr double kDelayPriorSigma_m = 5.0;
+  const double lambda = (huber_k_m / kDelayPriorSigma_m) * (huber_k_m / kDelayPriorSigma_m);
+  constexpr std::size_t kMinUsed = 4;
+  std::optional<MultilaterationResult> best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  using MatU = Eigen::Matrix<double, kMaxDelays + 2, kMaxDelays + 2>;
+  using VecU = Eigen::Matrix<double, kMaxDelays + 2, 1>;
+  MatU A;
+  VecU grad, u, row;
+  for (std::size_t k = 0; k < initial_guesses.size(); ++k) {
+    const Vec3& guess = initial_guesses[k];
+    const auto same_xy = [&](const Vec3& g) { return g.x() == guess.x() && g.y() == guess.y(); };
+    if (std::any_of(initial_guesses.begin(), initial_guesses.begin() + static_cast<std::ptrdiff_t>(k), same_xy))
+      continue;
+    u.setZero();
+    u(0) = guess.x();
+    u(1) = guess.y();
+    MultilaterationResult res;
+    double cost = 0.0;
+    for (int it = 0; it < max_iterations; ++it) {
+      A.setZero();
+      grad.setZero();
+      cost = 0.0;
+      double wr2 = 0.0, wsum = 0.0;
+      std::size_t n = 0;
+      for (const MultilaterationSample& s : samples) {
+        const Moments3* a = anchors.find(s.z.id_a);
+        const Moments3* b = anchors.find(s.z.id_b);
+        if (!a || !b) continue;
+        const Vec3 w_p = Vec3(u(0), u(1), floor_z_m) + s.w_d_b;
+        TdoaJacobians J;
+        const std::optional<double> h = evaluateTdoa(w_p, s.w_q_b, a->m, b->m, {b_t_tag, 1e-6}, &J);
+        if (!h) continue;
+        // (F16f) z = h(p) + g_B − g_A: the delay of B lengthens d_B, the delay of A lengthens d_A
+        const int ca = delayColumn(s.z.id_a), cb = delayColumn(s.z.id_b);
+        row.setZero();
+        row(0) = J.J_z_p_b(0);
+        row(1) = J.J_z_p_b(1);
+        double h_total = *h;
+        if (cb >= 0) {
+          row(cb) += 1.0;
+          h_total += u(cb);
+        }
+        if (ca >= 0) {
+          row(ca) -= 1.0;
+          h_total -= u(ca);
+        }
+        const double r = s.z.tdoa_m - h_total;
+        const double ar = std::abs(r);
+        const double w = ar <= huber_k_m ? 1.0 : huber_k_m / ar;
+        cost += ar <= huber_k_m ? 0.5 * r * r : huber_k_m * (ar - 0.5 * huber_k_m);
+        A.noalias() += w * row * row.transpose();
+        grad.noalias() += w * row * r;
+        wr2 += w * r * r;
+        wsum += w;
+        ++n;
+      }
+      if (n < kMinUsed) break;
+      for (int c = 2; c < n_cols; ++c) {
+        A(c, c) += lambda;
+        grad(c) -= lambda * u(c);
+        cost += 0.5 * lambda * u(c) * u(c);
+      }
+      for (int c = n_cols; c < kMaxDelays + 2; ++c) A(c, c) = 1.0;
+      A.diagonal().array() += 1e-9;
+      VecU step = A.ldlt().solve(grad);
+      if (!step.allFinite()) break;
+      const double sn = step.head<2>().norm();  // as in solve(): at most 2 m of position per step
+      if (sn > 2.0) step.head<2>() *= 2.0 / sn;
+      u += step;
+      res.iterations = it + 1;
+      res.n_used = n;
+      res.rms_residual_m = std::sqrt(wr2 / std::max(wsum, 1e-12));
+      if (step.norm() < 1e-5) break;
+    }
+    if (res.n_used < kMinUsed || !u.allFinite() || !(cost < best_cost)) continue;
+    best_cost = cost;
+    res.w_p0 = Vec3(u(0), u(1), floor_z_m);
+    const MatU Ainv = A.ldlt().solve(MatU::Identity()) * (res.rms_residual_m * res.rms_residual_m);
+    res.covariance.setZero();
+    res.covariance.topLeftCorner<2, 2>() = Ainv.topLeftCorner<2, 2>();
+    res.anchor_delay_m.assign(column.size(), std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t id = 0; id < column.size(); ++id)
+      if (column[id] >= 0) res.anchor_delay_m[id] = u(column[id]);
+    best = res;
+  }
+  return best;
+}
+
 std::optional<MultilaterationResult> multilaterateMoving(const std::vector<MultilaterationSample>& samples,
                                                          const AnchorTable& anchors, const Vec3& b_t_tag,
                                                          const std::vector<Vec3>& initial_guesses, double t_ref_s,

@@ -40,10 +40,16 @@ std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x
   if (!(z.t_s - t_try_ >= params_.window_s && samples_.size() >= params_.min_samples)) return std::nullopt;
 
   const bool moving = moving_ && !floor_z_m;
-  std::optional<MultilaterationResult> r =
-      floor_z_m ? multilaterateOnFloor(samples_, anchors_, b_t_tag_, guesses_, *floor_z_m)
-      : moving  ? multilaterateMoving(samples_, anchors_, b_t_tag_, guesses_, t_ref_)
-                : multilaterate(samples_, anchors_, b_t_tag_, guesses_);
+  std::optional<MultilaterationResult> r;
+  if (floor_z_m) {
+    // (F16f) with floor-level anchors, their delays are solved for; without 3 other anchors in view, the plain solve
+    if (!floor_level_.empty())
+      r = multilaterateOnFloorWithDelays(samples_, anchors_, b_t_tag_, guesses_, *floor_z_m, floor_level_);
+    if (!r) r = multilaterateOnFloor(samples_, anchors_, b_t_tag_, guesses_, *floor_z_m);
+  } else {
+    r = moving ? multilaterateMoving(samples_, anchors_, b_t_tag_, guesses_, t_ref_)
+               : multilaterate(samples_, anchors_, b_t_tag_, guesses_);
+  }
   const bool inside = r && (!reacquisition_ || r->rms_residual_m <= params_.max_rms_residual_m) && (r->w_p0.array() >= box_min_.array() - params_.box_margin_m).all() &&
                       (r->w_p0.array() <= box_max_.array() + params_.box_margin_m).all() &&
                       (!moving || r->w_v0.norm() < 5.0);
@@ -65,6 +71,7 @@ std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x
   fix.with_velocity = moving;
   fix.w_p0 = r->w_p0;
   fix.rms_residual_m = r->rms_residual_m;
+  fix.anchor_delay_m = r->anchor_delay_m;
   const double T = z.t_s - t_ref_;
   const Vec3 d_now = x_now.w_p_b - x_ref_.w_p_b - T * x_ref_.w_v_b;
   // (F16b) p_now = p0 + v0 T + d_now, v_now = v0 + (v_pred_now − v_pred_ref)

@@ -14,6 +14,7 @@
 
 #include <cmath>
 
+#include "uwb/eval/EstimateChecks.h"
 #include "uwb/eval/TrajectoryMetrics.h"
 
 namespace uwb {
@@ -86,6 +87,20 @@ TEST(TrajectoryMetrics, GivenATimeWindowThenTheAirborneRmseCountsOnlyItsAirborne
   EXPECT_NEAR(airborneRmseInWindow(m, 1.5, 1.5), std::sqrt(1.25), 1e-12);
   EXPECT_NEAR(airborneRmseInWindow(m, 1.6, 5.0), 0.5, 1e-12);
   EXPECT_TRUE(std::isnan(airborneRmseInWindow(m, 0.0, 1.2)));
+}
+
+TEST(EstimateChecks, GivenTheHandComputedFlightThenTheLargestErrorBeforeTheFirstAirborneInstantIsReported) {
+  // GIVEN the hand-computed flight: on the ground at t = 0.5 s (|e| = 0.2) and t = 1 s (|e| = 0.3), airborne from
+  // t = 1.5 s (|e| = √1.25)
+  TrajectoryMetricsParams params;
+  params.max_interp_gap_s = 2.0;
+  const TrajectoryMetrics m = computeTrajectoryMetrics(handEstimate(), handTruth(), params);
+  // WHEN checking the estimate, THEN the largest error before take-off is 0.3 m, not the airborne 1.1 m
+  EXPECT_NEAR(checkEstimate(handEstimate(), m).max_error_before_takeoff_m, 0.3, 1e-12);
+  // and a flight that is airborne from its first compared instant has none
+  TrajectoryMetrics air = m;
+  for (PositionErrorSample& s : air.samples) s.airborne = true;
+  EXPECT_TRUE(std::isnan(checkEstimate(handEstimate(), air).max_error_before_takeoff_m));
 }
 
 TEST(TrajectoryMetrics, GivenAGapInTheEstimateWhenComparedThenInstantsInTheGapAreNotCompared) {

@@ -117,5 +117,94 @@ TEST(Multilaterate, GivenTwoStartsWhenOneIsBadThenTheLowerCostSolutionWins) {
   EXPECT_LT((res->w_p0 - Vec3(0, 0, 1)).norm(), 1e-9);
 }
 
+
+/// (F16f) A room like the util-pilot arena: four anchors near the floor (z = 0.2 m) and four at 3 m, the body on the
+/// floor; the floor-level anchors are seen by paths longer by `delay` (per anchor), the others directly. The pairs
+/// of the LPS TDoA2 ring (k, k + 1 mod 8: floor-level and high anchors alternate), each measured `repeat` times.
+struct FloorRoom {
+  AnchorTable anchors;
+  std::vector<unsigned char> floor_level;
+  std::vector<MultilaterationSample> samples;
+};
+FloorRoom floorRoom(const Vec3& w_p_b, const std::vector<double>& delay, int repeat = 3) {
+  FloorRoom r;
+  const Vec3 corners[] = {{-3.5, -4.0, 0.0}, {-3.3, 3.8, 0.0}, {3.6, 3.7, 0.0}, {4.0, -4.2, 0.0}};
+  for (int k = 0; k < 4; ++k) {
+    r.anchors.set(2 * k, corners[k] + Vec3(0, 0, 0.2));                          // floor-level
+    r.anchors.set(2 * k + 1, corners[(k + 1) % 4] + Vec3(0.3, -0.2, 3.0));       // high
+  }
+  r.floor_level.assign(8, 0);
+  for (int k = 0; k < 4; ++k) r.floor_level[2 * k] = 1;
+  const auto range = [&](int id) {
+    const double g = r.floor_level[id] ? delay[id / 2] : 0.0;
+    return (w_p_b - r.anchors.find(id)->m).norm() + g;
+  };
+  for (int n = 0; n < repeat; ++n)
+    for (int a = 0; a < 8; ++a) {
+      const int b = (a + 1) % 8;
+      MultilaterationSample s;
+      s.z.id_a = a;
+      s.z.id_b = b;
+      s.z.tdoa_m = range(b) - range(a);
+      r.samples.push_back(s);
+    }
+  return r;
+}
+
+TEST(MultilaterateOnFloorWithDelays, GivenFloorLevelAnchorsSeenLateWhenSolvedThenFindsTheBodyAndTheDelays) {
+  // GIVEN a body on the floor at (1.5, 0.2, 0) and the four floor-level anchors seen 2.8 / 3.2 / 3.9 / 2.9 m late (the
+  // delays of the util-pilot 0425 floor starts)
+  const Vec3 truth(1.5, 0.2, 0.0);
+  const std::vector<double> delay = {2.8, 3.2, 3.9, 2.9};
+  const FloorRoom room = floorRoom(truth, delay);
+  const std::vector<Vec3> guesses = {Vec3(0.0, 0.0, 0.5), Vec3(0.0, 0.0, 1.5)};
+  // WHEN solving on the floor without and with the delays
+  const auto plain = multilaterateOnFloor(room.samples, room.anchors, Vec3::Zero(), guesses, 0.0);
+  const auto with = multilaterateOnFloorWithDelays(room.samples, room.anchors, Vec3::Zero(), guesses, 0.0,
+                                                   room.floor_level);
+  // THEN the plain solve is pulled far off, the solve with delays finds the body and each delay (to within the
+  // shrinkage of the weak N(0, (5 m)²) prior on the delays: λ/Σw ≈ 0.1 % of a delay with three samples per pair)
+  ASSERT_TRUE(plain);
+  ASSERT_TRUE(with);
+  EXPECT_GT((plain->w_p0 - truth).norm(), 0.5) << plain->w_p0.transpose();
+  EXPECT_LT((with->w_p0 - truth).norm(), 0.01) << with->w_p0.transpose();
+  EXPECT_EQ(with->w_p0.z(), 0.0);
+  ASSERT_EQ(with->anchor_delay_m.size(), 7u);  // up to the highest floor-level id seen
+  for (int k = 0; k < 4; ++k) EXPECT_NEAR(with->anchor_delay_m[2 * k], delay[k], 0.01) << "anchor " << 2 * k;
+  for (int k = 0; k < 3; ++k) EXPECT_TRUE(std::isnan(with->anchor_delay_m[2 * k + 1])) << "anchor " << 2 * k + 1;
+  EXPECT_EQ(with->covariance(2, 2), 0.0);
+  EXPECT_GT(with->covariance(0, 0), 0.0);
+}
+
+TEST(MultilaterateOnFloorWithDelays, GivenNoDelaysWhenSolvedThenAgreesWithThePlainSolve) {
+  // GIVEN exact TDoAs (no delay): the delays are free parameters that should come out zero
+  const Vec3 truth(-0.7, 1.1, 0.0);
+  const FloorRoom room = floorRoom(truth, {0.0, 0.0, 0.0, 0.0});
+  const auto with = multilaterateOnFloorWithDelays(room.samples, room.anchors, Vec3::Zero(), {Vec3(0, 0, 1)}, 0.0,
+                                                   room.floor_level);
+  ASSERT_TRUE(with);
+  EXPECT_LT((with->w_p0 - truth).norm(), 1e-4);
+  for (int k = 0; k < 4; ++k) EXPECT_NEAR(with->anchor_delay_m[2 * k], 0.0, 1e-4);
+}
+
+TEST(MultilaterateOnFloorWithDelays, GivenFewerThanThreeOtherAnchorsThenNoSolution) {
+  // GIVEN only pairs among the floor-level anchors and two high ones: x and y are not determined by the others
+  const FloorRoom room = floorRoom(Vec3(1, 1, 0), {3.0, 3.0, 3.0, 3.0});
+  std::vector<MultilaterationSample> few;
+  for (const MultilaterationSample& s : room.samples)
+    if ((room.floor_level[s.z.id_a] || s.z.id_a <= 3) && (room.floor_level[s.z.id_b] || s.z.id_b <= 3))
+      few.push_back(s);
+  ASSERT_FALSE(few.empty());
+  EXPECT_FALSE(
+      multilaterateOnFloorWithDelays(few, room.anchors, Vec3::Zero(), {Vec3(0, 0, 1)}, 0.0, room.floor_level));
+  // and without any floor-level anchor marked it is the plain solve
+  const auto none = multilaterateOnFloorWithDelays(room.samples, room.anchors, Vec3::Zero(), {Vec3(0, 0, 1)}, 0.0,
+                                                   std::vector<unsigned char>(8, 0));
+  const auto plain = multilaterateOnFloor(room.samples, room.anchors, Vec3::Zero(), {Vec3(0, 0, 1)}, 0.0);
+  ASSERT_TRUE(none && plain);
+  EXPECT_EQ(none->w_p0, plain->w_p0);
+  EXPECT_TRUE(none->anchor_delay_m.empty());
+}
+
 }  // namespace
 }  // namespace uwb

@@ -50,6 +50,27 @@ TEST(Generalization, RealFlightLoggedFromMidAir) {
   EXPECT_EQ(run.summary.n_reacquisitions, 0u);
 }
 
+TEST(Generalization, RealStartOnTheFloorSeesTheFloorLevelAnchorsLate) {
+  // GIVEN a real flight of the other session whose first 1 s on the floor carries the floor-level delays (0426-traj1:
+  // the pairs with one anchor at 0.2 m and one at 3 m are off by 3 m)
+  const auto path = test::pilotFlight("0426-traj1");
+  UWB_REQUIRE_REAL_DATA(path);
+  const AnchorSurvey survey = readAnchorSurvey(test::pilotSurvey("0426").string());
+  const Flight flight = readFlightCsv(path->string());
+  // WHEN localizing with the defaults, and with the floor-level delays not modelled (F16f off)
+  const LocalizationRun run = localizeFlight(flight, survey);
+  LocalizationOptions off;
+  off.params.floor_anchor_height_m = 0.0;
+  const LocalizationRun run_off = localizeFlight(flight, survey, off);
+  // THEN the estimate on the floor before the take-off is within 0.7 m of the body (the plain start: 2.4 m), and
+  // the flight is unchanged
+  ASSERT_TRUE(run.metrics && run_off.metrics);
+  const EstimateChecks c = checks(run, flight, survey), c_off = checks(run_off, flight, survey);
+  EXPECT_LT(c.max_error_before_takeoff_m, 0.7);
+  EXPECT_GT(c_off.max_error_before_takeoff_m, 2.0);
+  EXPECT_LT(run.metrics->airborne.rmse_m, 0.26);
+}
+
 TEST(Generalization, SimulatedStartInHover) {
   // GIVEN a simulated circle flight whose log starts 2 s after the climb (paper anchors, drone/room seed 11)
   const std::vector<SimScenarioRun> runs = protocolSimulations("", {11}, "hover-start-paper");

@@ -30,6 +30,8 @@ struct EstimateChecks {
   double max_airborne_step_m = 0.0;     ///< largest |p_k − p_{k−1}| between consecutive airborne outputs
   double min_z_on_ground_m = std::numeric_limits<double>::quiet_NaN();  ///< estimates while the truth is on the
   double max_z_on_ground_m = std::numeric_limits<double>::quiet_NaN();  ///< ground, after the first airborne one
+  /// Largest error of the estimates before the first airborne one (on the ground before take-off; NaN: none)
+  double max_error_before_takeoff_m = std::numeric_limits<double>::quiet_NaN();
   bool floor_or_ceiling_violated = false;
   double first_estimate_t_s = std::numeric_limits<double>::quiet_NaN();
   /// Time from the first estimate until the error stays ≤ settle_error_m for the rest of the airborne flight

@@ -148,6 +148,10 @@ struct EkfParams {
   /// TDoA std while the IMU says the body is at rest (F14, F18): near the floor the TDoA bias is large and
   /// correlated, so rest TDoA keep the position without pinning it; a moving body returns to tdoa_sigma_m at once.
   double rest_tdoa_sigma_m = 1.0;
+  /// Anchors less than this above the floor (anchor z − ground_z_m) are floor-level: a body on the floor sees them by a
+  /// path metres longer than the direct one. The start on the floor solves one range delay per such anchor with the
+  /// position, and on the ground the TDoA are corrected by the delays found (F16f) [m]; 0 off.
+  double floor_anchor_height_m = 1.0;
   /// Position std added when the body leaves rest (F20): the floor-level TDoA bias the rest position absorbed is not
   /// the bias in the air.
   double leave_rest_pos_sigma_m = 0.2;

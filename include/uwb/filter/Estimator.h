@@ -28,6 +28,7 @@
 #include "uwb/filter/AntennaBias.h"
 #include "uwb/filter/CooperativeRange.h"
 #include "uwb/filter/DescentBound.h"
+#include "uwb/filter/FloorLevelAnchors.h"
 #include "uwb/filter/Ekf.h"
 #include "uwb/filter/EkfParams.h"
 #include "uwb/filter/RestDetector.h"
@@ -179,6 +180,7 @@ class Estimator {
   Ekf ekf_;
   RestDetector rest_;
   StartUp start_;
+  FloorLevelAnchors floor_anchors_;  ///< floor-level anchors and their delays on the floor (F16f)
   TdoaUpdateOptions track_opt_, acq_opt_, rest_opt_;
   TofUpdateOptions tof_opt_;
   LocalizerSummary summary_;

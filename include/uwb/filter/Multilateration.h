@@ -27,6 +27,9 @@ struct MultilaterationResult {
   double rms_residual_m = 0.0;      ///< robustly weighted RMS residual
   int iterations = 0;
   std::size_t n_used = 0;
+  /// (F16f, multilaterateOnFloorWithDelays only) the range delay found for each floor-level anchor, indexed by anchor
+  /// id; NaN for an anchor whose delay was not solved for (not floor-level, or not seen) [m]
+  std::vector<double> anchor_delay_m;
 };
 
 /// Huber-IRLS Gauss–Newton on p0 (F16), started from each of `initial_guesses`; returns the lowest-cost solution,
@@ -42,6 +45,16 @@ std::optional<MultilaterationResult> multilaterateOnFloor(const std::vector<Mult
                                                           const AnchorTable& anchors, const Vec3& b_t_tag,
                                                           const std::vector<Vec3>& initial_guesses, double floor_z_m,
                                                           double huber_k_m = 0.3, int max_iterations = 30);
+
+/// (F16f) multilaterateOnFloor() for a body on the floor that sees the floor-level anchors (floor_level[id] != 0) by
+/// a path longer than the direct one: each such anchor's range carries its own unknown delay g_i, solved for with
+/// x and y (the body at p0 + d_i as above; model z = h(p) + g_B − g_A, delays with a weak N(0, (5 m)²) prior). The
+/// position then rests on the other anchors. nullopt when fewer than 3 other anchors are seen in the batch (x and y
+/// are not determined by them; use multilaterateOnFloor) or no start converges.
+std::optional<MultilaterationResult> multilaterateOnFloorWithDelays(
+    const std::vector<MultilaterationSample>& samples, const AnchorTable& anchors, const Vec3& b_t_tag,
+    const std::vector<Vec3>& initial_guesses, double floor_z_m, const std::vector<unsigned char>& floor_level,
+    double huber_k_m = 0.3, int max_iterations = 30);
 
 /// (F16b) The same robust solve for a body that moves at an unknown constant velocity on top of the known displacements:
 /// the body was at p0 + v0 (t_i − t_ref) + d_i. Unknowns p0 and v0 (6), so a start in the air with unknown velocity

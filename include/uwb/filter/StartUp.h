@@ -21,6 +21,8 @@ struct StartFix {
   Vec3 w_p0 = Vec3::Zero();    ///< body origin at the window's start [m]
   double rms_residual_m = 0.0;
   bool with_velocity = false;
+  /// (F16f) a fix on the floor: the range delay of each floor-level anchor, by anchor id (NaN: none found) [m]
+  std::vector<double> anchor_delay_m;
 };
 
 struct StartUpParams {
@@ -44,6 +46,8 @@ class StartUp {
   /// TDoA can disagree by metres, and the fix is revised in the air).
   void begin(double t_s, const NavState& x_ref, bool moving, bool reacquisition = false);
   bool active() const { return active_; }
+  /// (F16f) By anchor id, 1 for a floor-level anchor: a fix on the floor solves a range delay for each of them.
+  void setFloorLevelAnchors(const std::vector<unsigned char>& floor_level) { floor_level_ = floor_level; }
   void cancel() { active_ = false; samples_.clear(); }
   /// Adds a TDoA taken while the filter's predicted state is x_now; returns the fix when a solve succeeds (the
   /// collection then ends). floor_z_m: the body sits on the floor now (ground evidence, F18) at this height of its
@@ -58,6 +62,7 @@ class StartUp {
   std::vector<Vec3> guesses_;
   Vec3 box_min_, box_max_;
   std::vector<MultilaterationSample> samples_;
+  std::vector<unsigned char> floor_level_;
   bool active_ = false;
   bool moving_ = false;
   bool reacquisition_ = false;

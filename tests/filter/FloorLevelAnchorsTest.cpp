@@ -1,0 +1,65 @@
+/** @file FloorLevelAnchorsTest.cpp
+ *  @brief Floor-level anchors and their delays on the floor (docs/math/filter.md F16f).
+ */
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "uwb/filter/FloorLevelAnchors.h"
+
+namespace uwb {
+namespace {
+
+AnchorTable mixedRoom() {
+  AnchorTable t;
+  t.set(0, Vec3(-3, -4, 0.2));
+  t.set(1, Vec3(-3, 4, 2.9));
+  t.set(2, Vec3(3, 4, 0.17));
+  t.set(3, Vec3(4, -4, 3.2));
+  t.set(5, Vec3(4, -3, 1.05));  // just above the default 1 m
+  return t;
+}
+
+TEST(FloorLevelAnchors, GivenAnchorHeightsWhenClassifiedThenOnlyThoseBelowTheHeightAboveTheFloorAreFloorLevel) {
+  const FloorLevelAnchors f(mixedRoom(), 0.0, 1.0);
+  EXPECT_TRUE(f.any());
+  EXPECT_TRUE(f.isFloorLevel(0));
+  EXPECT_FALSE(f.isFloorLevel(1));
+  EXPECT_TRUE(f.isFloorLevel(2));
+  EXPECT_FALSE(f.isFloorLevel(3));
+  EXPECT_FALSE(f.isFloorLevel(4));  // unknown id
+  EXPECT_FALSE(f.isFloorLevel(5));
+  EXPECT_FALSE(f.isFloorLevel(-1));
+  // the height counts from the floor: with the floor at 0.1 m, 1.05 m is 0.95 m above it
+  EXPECT_TRUE(FloorLevelAnchors(mixedRoom(), 0.1, 1.0).isFloorLevel(5));
+  // 0 turns it off
+  EXPECT_FALSE(FloorLevelAnchors(mixedRoom(), 0.0, 0.0).any());
+}
+
+TEST(FloorLevelAnchors, GivenDelaysWhenAPairIsCorrectedThenItIsTheDelayOfBMinusTheDelayOfA) {
+  FloorLevelAnchors f(mixedRoom(), 0.0, 1.0);
+  EXPECT_FALSE(f.hasDelays());
+  EXPECT_EQ(f.pairDelay(0, 1), 0.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  // anchor 0 late by 2.9 m, anchor 2 not found (NaN), an entry for the high anchor 1 that must be ignored
+  f.setDelays({2.9, 5.0, nan});
+  EXPECT_TRUE(f.hasDelays());
+  EXPECT_DOUBLE_EQ(f.delay(0), 2.9);
+  EXPECT_EQ(f.delay(1), 0.0);
+  EXPECT_EQ(f.delay(2), 0.0);
+  // z = ‖p − a_B‖ − ‖p − a_A‖: a late A shortens the TDoA, a late B lengthens it
+  EXPECT_DOUBLE_EQ(f.pairDelay(0, 1), -2.9);
+  EXPECT_DOUBLE_EQ(f.pairDelay(1, 0), 2.9);
+  EXPECT_EQ(f.pairDelay(1, 3), 0.0);
+  EXPECT_EQ(f.pairDelay(7, 9), 0.0);  // unknown ids
+  // a later fix replaces the delays; one without any finite delay clears them
+  f.setDelays({nan, nan, 3.1});
+  EXPECT_EQ(f.delay(0), 0.0);
+  EXPECT_DOUBLE_EQ(f.pairDelay(2, 0), -3.1);
+  f.setDelays({});
+  EXPECT_FALSE(f.hasDelays());
+}
+
+}  // namespace
+}  // namespace uwb
