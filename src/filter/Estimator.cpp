@@ -69,6 +69,7 @@ constexpr double kGroundHeightSigma_m = 0.1;
 /// Ground contact (F18): shaking within this long counts [s]; only below this estimated height above the floor [m];
 /// after leaving the ground, shaking counts again only after this long [s] (the take-off's own transient).
 constexpr double kContactHold_s = 0.3;
+constexpr double kFromRest_s = 0.05;     // (F16f) the ground was left from rest: at rest this recently
 constexpr double kContactMaxHeight_m = 0.8;
 /// The contact height test uses the lowest estimate of the last 1.5 s, sampled every 50 ms (F18).
 constexpr double kLowZPeriod_s = 0.05;
@@ -191,6 +192,7 @@ void Estimator::initialize(double t_s, const Vec3& acc_mean_b, bool moving) {
 void Estimator::startAcquisition(double t_s, bool reacquisition) {
   phase_ = FlightPhase::kAcquisition;
   descent_.clear();
+  climb_.clear();
   if (reacquisition) {
     ++summary_.n_reacquisitions;
     if (summary_.reacquisition_t_s.size() < 100) summary_.reacquisition_t_s.push_back(t_s);
@@ -267,6 +269,7 @@ void Estimator::handleTimeJump(double t_s, double gap_s) {
   // (F17) nothing is integrated across a gap or a backward jump: the covariance grows by what a body could do in it
   ++summary_.n_time_jumps;
   descent_.clear();
+  climb_.clear();
   propagate(true);
   acc_sum_.setZero();
   gyro_sum_.setZero();
@@ -283,6 +286,11 @@ void Estimator::handleTimeJump(double t_s, double gap_s) {
 void Estimator::leaveGround(double t_s, bool climbing) {
   on_ground_ = false;
   descent_.clear();  // (F26) the climb is not dead-reckoned from the floor: the detector's climb speed lags
+  // (F16f) leaving rest (motors off) without a detected climb, the body still sits on the floor (rotors spun up
+  // without floor shaking, or lifted by hand): its height is dead-reckoned from there for the fade of the floor-level
+  // delays. Leaving floor contact (shaking with the motors running) or with a detected climb, it has already risen.
+  const bool from_rest = t_s - t_last_rest_ < kFromRest_s && t_s - t_last_shake_ >= kContactHold_s;
+  if (floor_anchors_.hasDelays() && !climbing && from_rest) climb_.start(t_s);
   t_left_ground_ = t_s;
   t_last_shake_ = -1e300;
   if (std::isnan(summary_.takeoff_t_s)) summary_.takeoff_t_s = t_s;
@@ -309,6 +317,7 @@ void Estimator::leaveGround(double t_s, bool climbing) {
 void Estimator::enterGround(double t_s) {
   on_ground_ = true;
   descent_.clear();
+  climb_.clear();
   n_low_z_ = 0;
   v_climb_ = 0.0;
   ++summary_.n_rest_periods;
@@ -404,9 +413,13 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
   // (F18) ground evidence is re-decided at every sample: at rest (motors off), or shaking as on the floor with the
   // motors running while the estimate is near the floor; a climb seen by the accelerometer contradicts both (F15)
   rest_.update(t_s, imu, dt_imu);
+  if (rest_.atRest()) t_last_rest_ = t_s;
   // (F26) the vertical motion from the accelerometer alone, for the descent bound
-  if (!on_ground_ && descent_.running())
-    descent_.integrate(worldVertical(ekf_.state().w_q_b, imu.b_acc_mps2) - g_ref_, dt_imu);
+  if (!on_ground_ && (descent_.running() || climb_.running())) {
+    const double a_up = worldVertical(ekf_.state().w_q_b, imu.b_acc_mps2) - g_ref_;
+    if (descent_.running()) descent_.integrate(a_up, dt_imu);
+    climb_.integrate(t_s, a_up, dt_imu);  // (F16f)
+  }
   if (params_.ground_phase == GroundPhase::kDetectTakeoff) {
     bool climbing = false;
     if (on_ground_) {
@@ -586,8 +599,12 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   // (F14) TDoA near the floor carry the large floor-level bias: down-weighted on the ground and just above it
   const bool near_floor = on_ground_ || ekf_.state().w_p_b.z() - params_.ground_z_m < kLowFlight_m;
   const TdoaUpdateOptions& opt = acquiring ? acq_opt_ : (near_floor ? rest_opt_ : track_opt_);
-  // (F16f) on the ground the floor-level anchors are seen with the delays the start on the floor found
-  if (on_ground_ && floor_anchors_.hasDelays()) zc.tdoa_m -= floor_anchors_.pairDelay(z.id_a, z.id_b);
+  // (F16f) on the ground the floor-level anchors are seen with the delays the start on the floor found; after the
+  // ground evidence ended without a climb, they fade with the height dead-reckoned from the floor
+  if (floor_anchors_.hasDelays() && (on_ground_ || climb_.running())) {
+    const double f = on_ground_ ? 1.0 : FloorLevelAnchors::remainingFraction(climb_.height());
+    zc.tdoa_m -= f * floor_anchors_.pairDelay(z.id_a, z.id_b);
+  }
   if (antenna_) {
     antenna_->advance(t);
     antenna_predicted_ = false;

@@ -3,6 +3,7 @@
  */
 #include "uwb/filter/FloorLevelAnchors.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace uwb {
@@ -34,6 +35,24 @@ void FloorLevelAnchors::setDelays(const std::vector<double>& delay_m) {
 
 double FloorLevelAnchors::delay(int id) const {
   return id >= 0 && static_cast<std::size_t>(id) < delay_m_.size() ? delay_m_[static_cast<std::size_t>(id)] : 0.0;
+}
+
+double FloorLevelAnchors::remainingFraction(double h_m) {
+  const double x = std::clamp(h_m / kFadeHeight_m, 0.0, 1.0);
+  return 1.0 - x * x * (3.0 - 2.0 * x);
+}
+
+void ClimbFromFloor::start(double t_s) {
+  running_ = true;
+  t_start_s_ = t_s;
+  h_m_ = v_mps_ = 0.0;
+}
+
+void ClimbFromFloor::integrate(double t_s, double a_up_mps2, double dt_s) {
+  if (!running_ || !(dt_s > 0.0)) return;
+  h_m_ = std::max(0.0, h_m_ + v_mps_ * dt_s + 0.5 * a_up_mps2 * dt_s * dt_s);
+  v_mps_ = h_m_ > 0.0 ? v_mps_ + a_up_mps2 * dt_s : std::max(0.0, v_mps_ + a_up_mps2 * dt_s);  // the floor holds it
+  if (t_s - t_start_s_ > kMaxDuration_s || h_m_ > FloorLevelAnchors::kFadeHeight_m) running_ = false;
 }
 
 }  // namespace uwb

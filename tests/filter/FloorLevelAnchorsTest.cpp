@@ -61,5 +61,52 @@ TEST(FloorLevelAnchors, GivenDelaysWhenAPairIsCorrectedThenItIsTheDelayOfBMinusT
   EXPECT_FALSE(f.hasDelays());
 }
 
+TEST(FloorLevelAnchors, GivenAHeightThenTheRemainingFractionFadesSmoothlyOverTheFadeHeight) {
+  const double h = FloorLevelAnchors::kFadeHeight_m;
+  EXPECT_EQ(FloorLevelAnchors::remainingFraction(0.0), 1.0);
+  EXPECT_EQ(FloorLevelAnchors::remainingFraction(-0.05), 1.0);  // below the resting height: all of it
+  EXPECT_NEAR(FloorLevelAnchors::remainingFraction(0.5 * h), 0.5, 1e-15);
+  EXPECT_NEAR(FloorLevelAnchors::remainingFraction(0.25 * h), 1.0 - (3.0 * 0.0625 - 2.0 * 0.015625), 1e-15);
+  EXPECT_EQ(FloorLevelAnchors::remainingFraction(h), 0.0);
+  EXPECT_EQ(FloorLevelAnchors::remainingFraction(2.0), 0.0);
+}
+
+TEST(ClimbFromFloor, GivenAConstantUpwardAccelerationThenTheHeightIsHalfATSquaredUntilTheFadeHeight) {
+  // GIVEN a body leaving the floor at t = 10 s with a_up = 1 m/s², IMU at 1 kHz
+  ClimbFromFloor c;
+  c.start(10.0);
+  const double dt = 1e-3;
+  double t = 10.0;
+  // WHEN integrating 0.3 s, THEN h = ½ a t² (exact for constant a), still below the fade height
+  for (int k = 0; k < 300; ++k) c.integrate(t += dt, 1.0, dt);
+  EXPECT_TRUE(c.running());
+  EXPECT_NEAR(c.height(), 0.5 * 0.3 * 0.3, 1e-9);
+  // and it ends once above the fade height (h = 0.12 m at t ≈ 0.49 s)
+  for (int k = 0; k < 300 && c.running(); ++k) c.integrate(t += dt, 1.0, dt);
+  EXPECT_FALSE(c.running());
+  EXPECT_GT(c.height(), FloorLevelAnchors::kFadeHeight_m);
+  EXPECT_LT(t - 10.0, 0.5);
+}
+
+TEST(ClimbFromFloor, GivenADownwardPushOnTheFloorThenItStaysOnTheFloorAndEndsAfterItsMaximumDuration) {
+  // GIVEN a body on the floor whose vertical specific force reads below gravity (a_up < 0: bias, spin-up)
+  ClimbFromFloor c;
+  c.start(0.0);
+  const double dt = 1e-3;
+  double t = 0.0;
+  for (int k = 0; k < 500; ++k) c.integrate(t += dt, -0.5, dt);
+  // THEN the floor holds it (height 0, no downward velocity stored), and a later upward push starts from rest
+  EXPECT_EQ(c.height(), 0.0);
+  for (int k = 0; k < 100; ++k) c.integrate(t += dt, 1.0, dt);
+  EXPECT_NEAR(c.height(), 0.5 * 0.1 * 0.1, 1e-9);
+  // and it gives up after kMaxDuration_s: beyond that the accelerometer alone is not trusted
+  while (t < ClimbFromFloor::kMaxDuration_s + 0.01) c.integrate(t += dt, 0.0, dt);
+  EXPECT_FALSE(c.running());
+  // clear() stops it at once
+  c.start(t);
+  c.clear();
+  EXPECT_FALSE(c.running());
+}
+
 }  // namespace
 }  // namespace uwb

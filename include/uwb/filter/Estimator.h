@@ -181,6 +181,7 @@ class Estimator {
   RestDetector rest_;
   StartUp start_;
   FloorLevelAnchors floor_anchors_;  ///< floor-level anchors and their delays on the floor (F16f)
+  ClimbFromFloor climb_;             ///< height since leaving the ground without a detected climb (F16f)
   TdoaUpdateOptions track_opt_, acq_opt_, rest_opt_;
   TofUpdateOptions tof_opt_;
   LocalizerSummary summary_;
@@ -192,6 +193,7 @@ class Estimator {
   double v_climb_ = 0.0;         ///< take-off detector's vertical velocity (F15) [m/s]
   double g_ref_ = kGravity_mps2; ///< vertical specific force on the ground [m/s²]
   double t_last_shake_ = -1e300, t_shake_since_ = 0.0, t_left_ground_ = -1e300;
+  double t_last_rest_ = -1e300;  ///< last IMU sample at rest (F18)
   std::array<double, 30> low_z_{};  ///< recent heights, one per 50 ms (F18)
   std::size_t i_low_z_ = 0, n_low_z_ = 0;
   double t_low_z_sample_ = -1e300;

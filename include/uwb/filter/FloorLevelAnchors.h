@@ -35,12 +35,35 @@ class FloorLevelAnchors {
   double delay(int id) const;
   /// (F16f) What the floor adds to a TDoA of pair (A, B), z = ‖p − a_B‖ − ‖p − a_A‖: g_B − g_A [m].
   double pairDelay(int id_a, int id_b) const { return delay(id_b) - delay(id_a); }
+  /// (F16f) The fraction of the delays left at a height h above the resting height: 1 − S(h / h_f), S(x) = 3x² − 2x³
+  /// on [0, 1], h_f = kFadeHeight_m (the real take-offs lose the floor-level bias over the first 12 cm, S18).
+  static double remainingFraction(double h_m);
+  static constexpr double kFadeHeight_m = 0.12;
 
  private:
   std::vector<unsigned char> floor_level_;
   std::vector<double> delay_m_;  ///< by id, 0 where unknown
   int n_floor_level_ = 0;
   bool has_delays_ = false;
+};
+
+/// (F16f) The height above the floor of a body that left the ground without a detected climb (the ground evidence
+/// ended while it still sat on the floor: rotors spun up without floor shaking), dead-reckoned from the accelerometer
+/// alone from rest on the floor (h = 0, v = 0): the floor-level delays fade with the true height, which the estimate,
+/// pulled by those very TDoA, does not know. It runs for at most kMaxDuration_s and ends above the fade height.
+class ClimbFromFloor {
+ public:
+  static constexpr double kMaxDuration_s = 1.0;
+  void start(double t_s);
+  void clear() { running_ = false; }
+  /// One IMU step: a_up = (R f)_z − g_ref [m/s²] over dt_s, at t_s.
+  void integrate(double t_s, double a_up_mps2, double dt_s);
+  bool running() const { return running_; }
+  double height() const { return h_m_; }
+
+ private:
+  bool running_ = false;
+  double t_start_s_ = 0.0, h_m_ = 0.0, v_mps_ = 0.0;
 };
 
 }  // namespace uwb
