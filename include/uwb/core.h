@@ -5,4 +5,5 @@
 #pragma once
 
 #include "uwb/core/Error.h"
+#include "uwb/core/Smoothstep.h"
 #include "uwb/core/Types.h"

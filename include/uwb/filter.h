@@ -7,6 +7,7 @@
 #include "uwb/filter/CooperativeRange.h"
 #include "uwb/filter/Ekf.h"
 #include "uwb/filter/EkfParams.h"
+#include "uwb/filter/FloorLevelAnchors.h"
 #include "uwb/filter/Multilateration.h"
 #include "uwb/filter/NavState.h"
 #include "uwb/filter/OutlierGate.h"

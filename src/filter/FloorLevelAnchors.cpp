@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "uwb/core/Smoothstep.h"
+
 namespace uwb {
 
 FloorLevelAnchors::FloorLevelAnchors(const AnchorTable& anchors, double floor_z_m, double max_height_m) {
@@ -37,10 +39,7 @@ double FloorLevelAnchors::delay(int id) const {
   return id >= 0 && static_cast<std::size_t>(id) < delay_m_.size() ? delay_m_[static_cast<std::size_t>(id)] : 0.0;
 }
 
-double FloorLevelAnchors::remainingFraction(double h_m) {
-  const double x = std::clamp(h_m / kFadeHeight_m, 0.0, 1.0);
-  return 1.0 - x * x * (3.0 - 2.0 * x);
-}
+double FloorLevelAnchors::remainingFraction(double h_m) { return 1.0 - smoothstep3(h_m / kFadeHeight_m); }
 
 void ClimbFromFloor::start(double t_s) {
   running_ = true;

@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "uwb/core/Smoothstep.h"
+
 namespace uwb::sim {
 
 namespace {
@@ -18,11 +20,6 @@ void require(bool ok, const std::string& what) {
 
 bool finiteNonNegative(double v) { return std::isfinite(v) && v >= 0.0; }
 
-/// Cubic smoothstep 3x² − 2x³ on [0, 1] (clamped).
-double smoothstep3(double x) {
-  x = std::clamp(x, 0.0, 1.0);
-  return x * x * (3.0 - 2.0 * x);
-}
 
 /// Spherical-harmonic coefficients for degrees 1..degree (index 0, the constant, stays 0), drawn with
 /// variance 1/l per degree and scaled so that the pattern's RMS over the sphere is exactly rms_m (S13):

@@ -4,8 +4,8 @@
  *
  *  A tag on the floor sees an anchor that is also near the floor along a grazing direct path that the floor, the
  *  body and clutter block; the first path to arrive is longer by metres (util-pilot, both sessions: the TDoA of a
- *  pair of one floor-level and one high anchor are off by 2.5–4 m on the floor, pairs of two high or two
- *  floor-level anchors by at most about 0.5 m; the simulator's S18 has the same form). The start on the floor solves
+ *  pair of one floor-level and one high anchor are off by 2.5–4.1 m on the floor, pairs of two high or two
+ *  floor-level anchors by at most about 0.7 m; the simulator's S18 has the same form). The start on the floor solves
  *  one delay per floor-level anchor with the position (multilaterateOnFloorWithDelays); on the ground the TDoA are
  *  corrected by the delays found. The delays are nuisance parameters of the floor, never used in the air.
  */
