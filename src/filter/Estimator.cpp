@@ -71,8 +71,11 @@ constexpr double kGroundHeightSigma_m = 0.1;
 constexpr double kContactHold_s = 0.3;
 constexpr double kFromRest_s = 0.05;     // (F16f) the ground was left from rest: at rest this recently
 constexpr double kContactMaxHeight_m = 0.8;
-/// The contact height test uses the lowest estimate of the last 1.5 s, sampled every 50 ms (F18).
+/// The contact height test uses the lowest estimate of the last 1.5 s, sampled every 50 ms; the rest test that of the
+/// last 3 s (F18).
 constexpr double kLowZPeriod_s = 0.05;
+constexpr std::size_t kContactLowZSamples = 30;
+constexpr std::size_t kRestLowZSamples = 60;
 constexpr double kContactRearm_s = 0.5;
 constexpr double kContactSustained_s = 1.5;
 /// Below this estimated height above the floor TDoA are down-weighted as on the ground (F14) [m].
@@ -442,16 +445,24 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
       n_low_z_ = std::min(n_low_z_ + 1, low_z_.size());
       t_low_z_sample_ = t_s;
     }
-    // shaking near the floor, or shaking for long wherever the estimate is (flight shakes only briefly)
-    const auto lowestRecentZ = [&] {
+    // the lowest estimate of the last n samples (and the current one)
+    const auto lowestRecentZ = [&](std::size_t n) {
       double z_low = ekf_.state().w_p_b.z();
-      for (std::size_t k = 0; k < n_low_z_; ++k) z_low = std::min(z_low, low_z_[k]);
+      const std::size_t size = low_z_.size();
+      for (std::size_t k = 0; k < std::min(n, n_low_z_); ++k) z_low = std::min(z_low, low_z_[(i_low_z_ + size - 1 - k) % size]);
       return z_low;
     };
+    // shaking near the floor, or shaking for long wherever the estimate is (flight shakes only briefly)
     const bool contact = t_s - t_last_shake_ < kContactHold_s &&
                          (!ready_ || t_s - t_shake_since_ >= kContactSustained_s ||
-                          lowestRecentZ() - params_.ground_z_m < kContactMaxHeight_m);
-    const bool ground_now = (rest_.atRest() || contact) && !climbing;
+                          lowestRecentZ(kContactLowZSamples) - params_.ground_z_m < kContactMaxHeight_m);
+    // rest enters the ground near the floor only: an IMU logged at a low rate or filtered reads as quiet in a still
+    // hover as with the motors off, and a still hover high above the floor is not on the ground (the floor height, the
+    // ZUPT and the ground's TDoA weight would pull it down); the window spans the climb of the estimate after a
+    // touchdown (F26). Once on the ground, rest holds it wherever the estimate is.
+    const bool rest = rest_.atRest() && (on_ground_ || !ready_ ||
+                                         lowestRecentZ(kRestLowZSamples) - params_.ground_z_m < kContactMaxHeight_m);
+    const bool ground_now = (rest || contact) && !climbing;
     if (ground_now && !on_ground_) {
       predictTo(t_s);
       propagate(true);
