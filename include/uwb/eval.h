@@ -4,10 +4,15 @@
  */
 #pragma once
 
+#include "uwb/eval/BiasCalibration.h"
 #include "uwb/eval/BiasDataset.h"
 #include "uwb/eval/BiasModel.h"
+#include "uwb/eval/EstimateChecks.h"
 #include "uwb/eval/Evaluation.h"
 #include "uwb/eval/EvaluationTable.h"
+#include "uwb/eval/FaultInjection.h"
 #include "uwb/eval/Localization.h"
+#include "uwb/eval/ProtocolScenarios.h"
+#include "uwb/eval/RunDiagnostics.h"
 #include "uwb/eval/SwarmLocalization.h"
 #include "uwb/eval/TrajectoryMetrics.h"

@@ -4,15 +4,23 @@
  */
 #pragma once
 
+#include "uwb/filter/AntennaBias.h"
+#include "uwb/filter/BiasGuard.h"
 #include "uwb/filter/CooperativeRange.h"
+#include "uwb/filter/DescentBound.h"
 #include "uwb/filter/Ekf.h"
+#include "uwb/filter/EkfParamRegistry.h"
 #include "uwb/filter/EkfParams.h"
+#include "uwb/filter/Estimator.h"
 #include "uwb/filter/FloorLevelAnchors.h"
 #include "uwb/filter/Multilateration.h"
 #include "uwb/filter/NavState.h"
 #include "uwb/filter/OutlierGate.h"
 #include "uwb/filter/QuadImuProcess.h"
+#include "uwb/filter/RestDetector.h"
 #include "uwb/filter/SensorEvents.h"
+#include "uwb/filter/StartUp.h"
 #include "uwb/filter/StateIndex.h"
 #include "uwb/filter/TdoaLocalizer.h"
 #include "uwb/filter/TdoaUpdate.h"
+#include "uwb/filter/TofUpdate.h"

@@ -5,5 +5,6 @@
 #pragma once
 
 #include "uwb/gp/Kernel.h"
+#include "uwb/gp/PredictTile.h"
 #include "uwb/gp/Svgp.h"
 #include "uwb/gp/SvgpTrainer.h"

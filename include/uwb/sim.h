@@ -4,11 +4,11 @@
  */
 #pragma once
 
-#include "uwb/sim/SimulatedBias.h"
 #include "uwb/sim/FlightSimulator.h"
 #include "uwb/sim/Kinematics.h"
 #include "uwb/sim/ResidualProfile.h"
 #include "uwb/sim/Scenario.h"
 #include "uwb/sim/SimParams.h"
+#include "uwb/sim/SimulatedBias.h"
 #include "uwb/sim/Swarm.h"
 #include "uwb/sim/Trajectory.h"

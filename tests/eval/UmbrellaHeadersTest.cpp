@@ -1,10 +1,15 @@
 /** @file UmbrellaHeadersTest.cpp
- *  @brief The eight module umbrella headers compile together in one translation unit and give each module's API.
+ *  @brief The eight module umbrella headers compile together in one translation unit, give each module's API, and
+ *         list every public header of their module.
  */
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include "uwb/core.h"
 #include "uwb/eval.h"
@@ -33,6 +38,28 @@ TEST(UmbrellaHeaders, GiveEachModuleTogether) {
   bias_params.min_z_m = std::nan("");
   EXPECT_THROW(bias_params.validate(), std::invalid_argument);
   EXPECT_GT(sim::SimParams{}.imu.rate_hz, 0.0);                                          // sim
+}
+
+TEST(UmbrellaHeaders, ListEveryPublicHeaderOfTheirModule) {
+  // GIVEN each module's umbrella header and the headers in its folder
+  namespace fs = std::filesystem;
+  const fs::path include_dir = fs::path(UWB_SOURCE_DIR) / "include" / "uwb";
+  ASSERT_TRUE(fs::is_directory(include_dir)) << include_dir;
+  for (const char* module : {"core", "eval", "filter", "gp", "graph", "io", "model", "sim"}) {
+    std::ifstream in(include_dir / (std::string(module) + ".h"));
+    ASSERT_TRUE(in) << module;
+    std::stringstream umbrella;
+    umbrella << in.rdbuf();
+    // THEN every header of the folder is included by the umbrella
+    int n = 0;
+    for (const fs::directory_entry& e : fs::directory_iterator(include_dir / module)) {
+      if (e.path().extension() != ".h") continue;
+      ++n;
+      const std::string line = "#include \"uwb/" + std::string(module) + "/" + e.path().filename().string() + "\"";
+      EXPECT_NE(umbrella.str().find(line), std::string::npos) << module << ".h misses " << e.path().filename();
+    }
+    EXPECT_GT(n, 0) << module;
+  }
 }
 
 }  // namespace
