@@ -261,8 +261,13 @@ std::optional<MultilaterationResult> multilaterateOnFloorWithDelays(
     res.covariance.setZero();
     res.covariance.topLeftCorner<2, 2>() = Ainv.topLeftCorner<2, 2>();
     res.anchor_delay_m.assign(column.size(), std::numeric_limits<double>::quiet_NaN());
-    for (std::size_t id = 0; id < column.size(); ++id)
-      if (column[id] >= 0) res.anchor_delay_m[id] = run.x(column[id]);
+    bool plausible = true;
+    for (std::size_t id = 0; id < column.size(); ++id) {
+      if (column[id] < 0) continue;
+      res.anchor_delay_m[id] = run.x(column[id]);
+      plausible = plausible && res.anchor_delay_m[id] >= kMinFloorDelay_m && res.anchor_delay_m[id] <= kMaxFloorDelay_m;
+    }
+    if (!plausible) continue;  // not a longer first path: a poor geometry fitted the delays to something else
     best = res;
   }
   return best;

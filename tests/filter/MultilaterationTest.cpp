@@ -187,6 +187,25 @@ TEST(MultilaterateOnFloorWithDelays, GivenNoDelaysWhenSolvedThenAgreesWithThePla
   for (int k = 0; k < 4; ++k) EXPECT_NEAR(with->anchor_delay_m[2 * k], 0.0, 1e-4);
 }
 
+TEST(MultilaterateOnFloorWithDelays, GivenDelaysOutsideTheirPlausibleRangeThenNoSolution) {
+  // GIVEN TDoA whose fitted delays would be 8 m (longer than the room: not a floor path) or −3 m (a shorter path)
+  for (const double g : {8.0, -3.0}) {
+    const FloorRoom room = floorRoom(Vec3(1.5, 0.2, 0.0), {g, g, g, g});
+    // WHEN solving with the delays
+    const auto with = multilaterateOnFloorWithDelays(room.samples, room.anchors, Vec3::Zero(), {Vec3(0, 0, 1)}, 0.0,
+                                                     room.floor_level);
+    // THEN there is no solution (the caller falls back to the plain solve), while 6 m and −1 m are still accepted
+    EXPECT_FALSE(with) << g;
+  }
+  for (const double g : {kMaxFloorDelay_m - 0.01, kMinFloorDelay_m + 0.01}) {
+    const FloorRoom room = floorRoom(Vec3(1.5, 0.2, 0.0), {g, g, g, g});
+    const auto with = multilaterateOnFloorWithDelays(room.samples, room.anchors, Vec3::Zero(), {Vec3(0, 0, 1)}, 0.0,
+                                                     room.floor_level);
+    ASSERT_TRUE(with) << g;
+    EXPECT_NEAR(with->anchor_delay_m[0], g, 0.01);
+  }
+}
+
 TEST(MultilaterateOnFloorWithDelays, GivenFewerThanThreeOtherAnchorsThenNoSolution) {
   // GIVEN only pairs among the floor-level anchors and two high ones: x and y are not determined by the others
   const FloorRoom room = floorRoom(Vec3(1, 1, 0), {3.0, 3.0, 3.0, 3.0});

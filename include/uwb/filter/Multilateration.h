@@ -50,7 +50,10 @@ std::optional<MultilaterationResult> multilaterateOnFloor(const std::vector<Mult
 /// a path longer than the direct one: each such anchor's range carries its own unknown delay g_i, solved for with
 /// x and y (the body at p0 + d_i as above; model z = h(p) + g_B − g_A, delays with a weak N(0, (5 m)²) prior). The
 /// position then rests on the other anchors. nullopt when fewer than 3 other anchors are seen in the batch (x and y
-/// are not determined by them; use multilaterateOnFloor) or no start converges.
+/// are not determined by them; use multilaterateOnFloor), no start converges, or a delay falls outside
+/// [kMinFloorDelay_m, kMaxFloorDelay_m].
+constexpr double kMinFloorDelay_m = -1.0;  ///< a delay is a longer path: ≥ 0 up to the estimation error
+constexpr double kMaxFloorDelay_m = 6.0;   ///< at most a room's size (util-pilot floors: 0.6–4.1 m)
 std::optional<MultilaterationResult> multilaterateOnFloorWithDelays(
     const std::vector<MultilaterationSample>& samples, const AnchorTable& anchors, const Vec3& b_t_tag,
     const std::vector<Vec3>& initial_guesses, double floor_z_m, const std::vector<unsigned char>& floor_level,
