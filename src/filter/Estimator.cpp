@@ -74,8 +74,8 @@ constexpr double kContactMaxHeight_m = 0.8;
 /// The contact height test uses the lowest estimate of the last 1.5 s, sampled every 50 ms; the rest test that of the
 /// last 3 s (F18).
 constexpr double kLowZPeriod_s = 0.05;
-constexpr std::size_t kContactLowZSamples = 30;
-constexpr std::size_t kRestLowZSamples = 60;
+constexpr std::size_t kContactLowZSamples = 30;  // 1.5 s / kLowZPeriod_s
+constexpr std::size_t kRestLowZSamples = 60;     // 3 s / kLowZPeriod_s: the whole ring (Estimator::low_z_)
 constexpr double kContactRearm_s = 0.5;
 constexpr double kContactSustained_s = 1.5;
 /// Below this estimated height above the floor TDoA are down-weighted as on the ground (F14) [m].
@@ -449,7 +449,8 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
     const auto lowestRecentZ = [&](std::size_t n) {
       double z_low = ekf_.state().w_p_b.z();
       const std::size_t size = low_z_.size();
-      for (std::size_t k = 0; k < std::min(n, n_low_z_); ++k) z_low = std::min(z_low, low_z_[(i_low_z_ + size - 1 - k) % size]);
+      for (std::size_t k = 0; k < std::min(n, n_low_z_); ++k)
+        z_low = std::min(z_low, low_z_[(i_low_z_ + size - 1 - k) % size]);
       return z_low;
     };
     // shaking near the floor, or shaking for long wherever the estimate is (flight shakes only briefly)

@@ -212,8 +212,8 @@ std::optional<MultilaterationResult> multilaterateOnFloorWithDelays(
   constexpr std::size_t kMinUsed = 4;
   using MatU = Eigen::Matrix<double, kMaxDelays + 2, kMaxDelays + 2>;
   using VecU = Eigen::Matrix<double, kMaxDelays + 2, 1>;
-  const auto position = [&](const VecU& u, const MultilaterationSample& s) {
-    return Vec3(Vec3(u(0), u(1), floor_z_m) + s.w_d_b);
+  const auto position = [&](const VecU& u, const MultilaterationSample& s) -> Vec3 {
+    return Vec3(u(0), u(1), floor_z_m) + s.w_d_b;
   };
   const auto row = [&](const VecU& u, const MultilaterationSample& s, const TdoaJacobians& J, VecU* out) {
     // (F16f) z = h(p) + g_B − g_A: the delay of B lengthens d_B, the delay of A lengthens d_A
@@ -253,6 +253,9 @@ std::optional<MultilaterationResult> multilaterateOnFloorWithDelays(
     GaussNewtonRun<VecU, MatU> run = huberGaussNewton<VecU, MatU>(
         u0, samples, anchors, b_t_tag, huber_k_m, max_iterations, kMinUsed, position, row, regularize, limit);
     if (run.res.n_used < kMinUsed || !run.x.allFinite() || !(run.cost < best_cost)) continue;
+    // a delay outside its range is not a longer first path: a poor geometry fitted the delays to something else
+    const auto implausible = [](double g) { return g < kMinFloorDelay_m || g > kMaxFloorDelay_m; };
+    if (std::any_of(run.x.data() + 2, run.x.data() + n_cols, implausible)) continue;
     best_cost = run.cost;
     MultilaterationResult& res = run.res;
     res.w_p0 = Vec3(run.x(0), run.x(1), floor_z_m);
@@ -261,13 +264,8 @@ std::optional<MultilaterationResult> multilaterateOnFloorWithDelays(
     res.covariance.setZero();
     res.covariance.topLeftCorner<2, 2>() = Ainv.topLeftCorner<2, 2>();
     res.anchor_delay_m.assign(column.size(), std::numeric_limits<double>::quiet_NaN());
-    bool plausible = true;
-    for (std::size_t id = 0; id < column.size(); ++id) {
-      if (column[id] < 0) continue;
-      res.anchor_delay_m[id] = run.x(column[id]);
-      plausible = plausible && res.anchor_delay_m[id] >= kMinFloorDelay_m && res.anchor_delay_m[id] <= kMaxFloorDelay_m;
-    }
-    if (!plausible) continue;  // not a longer first path: a poor geometry fitted the delays to something else
+    for (std::size_t id = 0; id < column.size(); ++id)
+      if (column[id] >= 0) res.anchor_delay_m[id] = run.x(column[id]);
     best = res;
   }
   return best;

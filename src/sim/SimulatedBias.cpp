@@ -20,7 +20,6 @@ void require(bool ok, const std::string& what) {
 
 bool finiteNonNegative(double v) { return std::isfinite(v) && v >= 0.0; }
 
-
 /// Spherical-harmonic coefficients for degrees 1..degree (index 0, the constant, stays 0), drawn with
 /// variance 1/l per degree and scaled so that the pattern's RMS over the sphere is exactly rms_m (S13):
 /// for orthonormal Y_lm, (1/4π) ∫ (Σ k Y)² dΩ = Σ k² / 4π.
