@@ -77,6 +77,12 @@ constexpr double kLowZPeriod_s = 0.05;
 constexpr std::size_t kContactLowZSamples = 30;  // 1.5 s / kLowZPeriod_s
 constexpr std::size_t kRestLowZSamples = 60;     // 3 s / kLowZPeriod_s: the whole ring (Estimator::low_z_)
 constexpr double kContactRearm_s = 0.5;
+/// Rest enters the ground from the air only while the estimate is near the floor and does not climb faster than
+/// kRestMaxClimb_mps [m/s], or within kLandingWindow_s [s] of a descent faster than kRestDescent_mps [m/s] (a landing:
+/// the estimate may climb after the touchdown, F26) (F18).
+constexpr double kRestMaxClimb_mps = 0.3;
+constexpr double kRestDescent_mps = 0.2;
+constexpr double kLandingWindow_s = 3.0;
 constexpr double kContactSustained_s = 1.5;
 /// Below this estimated height above the floor TDoA are down-weighted as on the ground (F14) [m].
 constexpr double kLowFlight_m = 0.25;
@@ -461,8 +467,17 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
     // hover as with the motors off, and a still hover high above the floor is not on the ground (the floor height, the
     // ZUPT and the ground's TDoA weight would pull it down); the window spans the climb of the estimate after a
     // touchdown (F26). Once on the ground, rest holds it wherever the estimate is.
-    const bool rest = rest_.atRest() && (on_ground_ || !ready_ ||
-                                         lowestRecentZ(kRestLowZSamples) - params_.ground_z_m < kContactMaxHeight_m);
+    // Nor does it enter while the estimate climbs or after a climb from the floor: after a take-off a steady climb or
+    // hover reads as quiet as rest too, and the ZUPT would take the climb for accelerometer bias. Only a descent
+    // opens the window (the touchdown: the estimate may climb after it, F26).
+    const NavState& x = ekf_.state();
+    if (ready_ && x.w_v_b.z() < -kRestDescent_mps) t_last_descent_ = t_s;
+    const bool rest =
+        rest_.atRest() &&
+        (on_ground_ || !ready_ ||
+         (x.w_p_b.z() - params_.ground_z_m < kContactMaxHeight_m && x.w_v_b.z() < kRestMaxClimb_mps) ||
+         (t_s - t_last_descent_ < kLandingWindow_s &&
+          lowestRecentZ(kRestLowZSamples) - params_.ground_z_m < kContactMaxHeight_m));
     const bool ground_now = (rest || contact) && !climbing;
     if (ground_now && !on_ground_) {
       predictTo(t_s);
