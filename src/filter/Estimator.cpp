@@ -391,6 +391,7 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
     // (F15) levelling window: mean specific force for the attitude, its spread tells rest from motion
     if (std::isnan(t_first_imu_)) t_first_imu_ = t_s;
     init_acc_sum_ += imu.b_acc_mps2;
+    init_gyro_sum_ += imu.b_gyro_radps;
     init_acc_sq_sum_ += imu.b_acc_mps2.squaredNorm();
     ++n_init_;
     last_imu_ = imu;
@@ -400,6 +401,8 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
       const double var = std::max(init_acc_sq_sum_ / n_init_ - mean.squaredNorm(), 0.0);
       const bool moving = var > kLevelRestAccStd_mps2 * kLevelRestAccStd_mps2;
       rest_.reset(imu);
+      // (F18) a still levelling window shows the gyro's own bias: the rest test reads against it too
+      if (!moving) rest_.setGyroReference(init_gyro_sum_ / n_init_);
       g_ref_ = mean.norm();
       initialize(t_s, mean, moving);
     }

@@ -24,16 +24,28 @@ RestDetector::RestDetector(const RestDetectorParams& params)
       hp_rate_per_s_(1.0 / params.hp_tau_s),
       contact_ms_min_(params.contact_gyro_hp_rms_radps * params.contact_gyro_hp_rms_radps) {
   if (!(params.acc_std_mps2 > 0.0 && params.gyro_rms_radps > 0.0 && params.tau_s > 0.0 && params.min_hold_s >= 0.0 &&
-        params.contact_gyro_hp_rms_radps > 0.0 && params.hp_tau_s > 0.0))
-    throw std::invalid_argument("RestDetectorParams: thresholds and tau_s must be > 0, min_hold_s >= 0");
+        params.contact_gyro_hp_rms_radps > 0.0 && params.hp_tau_s > 0.0 && params.max_gyro_reference_radps >= 0.0))
+    throw std::invalid_argument(
+        "RestDetectorParams: thresholds and tau_s must be > 0, min_hold_s and max_gyro_reference_radps >= 0");
 }
 
-bool RestDetector::stillNow() const { return acc_var_ < acc_var_max_ && gyro_ms_ < gyro_ms_max_; }
+bool RestDetector::stillNow() const {
+  return acc_var_ < acc_var_max_ && (gyro_ms_ < gyro_ms_max_ || (has_gyro_ref_ && gyro_ref_ms_ < gyro_ms_max_));
+}
+
+bool RestDetector::setGyroReference(const Vec3& b_gyro_radps) {
+  if (!b_gyro_radps.allFinite() || b_gyro_radps.norm() > params_.max_gyro_reference_radps) return false;
+  gyro_ref_ = b_gyro_radps;
+  gyro_ref_ms_ = gyro_ms_;
+  has_gyro_ref_ = true;
+  return true;
+}
 
 void RestDetector::reset(const ImuReading& imu) {
   acc_mean_ = imu.b_acc_mps2.norm();
   acc_var_ = 1.0;
   gyro_ms_ = 1.0;
+  gyro_ref_ms_ = 1.0;
   gyro_hp_ms_ = 0.0;
   gyro_mean_ = imu.b_gyro_radps;
   still_ = at_rest_ = false;
@@ -52,6 +64,7 @@ void RestDetector::update(double t_s, const ImuReading& imu, double dt_s) {
     acc_mean_ = a * acc_mean_ + (1 - a) * an;
     acc_var_ = a * acc_var_ + (1 - a) * (an - acc_mean_) * (an - acc_mean_);
     gyro_ms_ = a * gyro_ms_ + (1 - a) * imu.b_gyro_radps.squaredNorm();
+    if (has_gyro_ref_) gyro_ref_ms_ = a * gyro_ref_ms_ + (1 - a) * (imu.b_gyro_radps - gyro_ref_).squaredNorm();
     // high-passed gyro: deviation from its own short moving mean (rotor-frame shaking, not turning)
     const double a_hp = a_hp_cached_;
     gyro_mean_ = a_hp * gyro_mean_ + (1 - a_hp) * imu.b_gyro_radps;

@@ -307,6 +307,45 @@ TEST(RestDetector, RestIsDecidedAndRevisedFromTheImu) {
   EXPECT_TRUE(d.shaking());
 }
 
+TEST(RestDetector, AnUncalibratedGyroReadsAsRestAgainstItsReference) {
+  // GIVEN a body at rest whose gyro carries a bias of 0.03 rad/s per axis (0.052 rad/s in norm, above the 0.03 rad/s
+  // rms of the rest test; a raw MEMS gyro without the Crazyflie's start-up calibration)
+  std::mt19937 rng(2);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const Vec3 bias(0.03, -0.03, 0.03);
+  const auto still = [&](const Vec3& b) {
+    ImuReading m;
+    m.b_acc_mps2 += 0.01 * Vec3(n(rng), n(rng), n(rng));
+    m.b_gyro_radps = b + 0.001 * Vec3(n(rng), n(rng), n(rng));
+    return m;
+  };
+  const auto feed = [&](RestDetector& d, const Vec3& b, double seconds) {
+    for (double t = 0.0; t < seconds; t += 0.001) d.update(t, still(b), 0.001);
+  };
+  RestDetector raw, referenced, wrong;
+  for (RestDetector* d : {&raw, &referenced, &wrong}) d->reset(still(bias));
+  // WHEN one detector has no reference, one the mean of a still window as its reference
+  Vec3 mean = Vec3::Zero();
+  for (int k = 0; k < 100; ++k) mean += still(bias).b_gyro_radps / 100.0;
+  EXPECT_TRUE(referenced.setGyroReference(mean));
+  feed(raw, bias, 1.0);
+  feed(referenced, bias, 1.0);
+  // THEN only the referenced one reads rest; the test on the raw rate alone is the same as without a reference
+  EXPECT_FALSE(raw.atRest());
+  EXPECT_TRUE(referenced.atRest());
+  EXPECT_TRUE(referenced.hasGyroReference());
+  // AND a reference of a turning body (0.5 rad/s) is refused, and a wrong one costs nothing: a calibrated gyro at
+  // rest still reads rest on its raw rate
+  EXPECT_FALSE(wrong.setGyroReference(Vec3(0.0, 0.0, 0.5)));
+  EXPECT_FALSE(wrong.hasGyroReference());
+  EXPECT_TRUE(wrong.setGyroReference(Vec3(0.05, 0.0, 0.0)));
+  feed(wrong, Vec3::Zero(), 1.0);
+  EXPECT_TRUE(wrong.atRest());
+  // AND turning at 0.2 rad/s is not rest against either
+  feed(referenced, Vec3(0.0, 0.0, 0.2), 1.0);
+  EXPECT_FALSE(referenced.atRest());
+}
+
 TEST(RestDetector, StatisticsAreTheExponentialAveragesForAnyStepSequence) {
   // GIVEN IMU samples at a jittered period (steps repeat and change, as logged stamps do)
   RestDetector d;

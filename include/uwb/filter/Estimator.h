@@ -222,6 +222,7 @@ class Estimator {
   int n_imu_acc_ = 0;
   ImuReading last_imu_;
   Vec3 init_acc_sum_ = Vec3::Zero();
+  Vec3 init_gyro_sum_ = Vec3::Zero();
   double init_acc_sq_sum_ = 0.0;
   int n_init_ = 0;
   double t_first_imu_ = std::numeric_limits<double>::quiet_NaN();

@@ -25,6 +25,9 @@ struct RestDetectorParams {
   /// 0.217, the lower quartile 0.153 and 0.122 (docs/math/filter.md F18).
   double contact_gyro_hp_rms_radps = 0.15;
   double hp_tau_s = 0.02;
+  /// A gyro reference (the reading at rest: the gyro's own bias) is accepted only up to this norm [rad/s]; larger
+  /// means the body was turning (F18).
+  double max_gyro_reference_radps = 0.1;
 };
 
 class RestDetector {
@@ -40,13 +43,21 @@ class RestDetector {
   double gyroMeanSquare() const { return gyro_ms_; }
   /// The shaking of ground contact with the motors running: high-passed gyro rms above its threshold (F18).
   bool shaking() const { return gyro_hp_ms_ > contact_ms_min_; }
-  /// Restarts the statistics from a sample (moving, not at rest).
+  /// Restarts the statistics from a sample (moving, not at rest); a gyro reference is kept.
   void reset(const ImuReading& imu);
+  /// (F18) The gyro's reading at rest (its bias, e.g. the mean of a still levelling window): the gyro test then passes
+  /// when either the raw rate or its deviation from this reference is small, so that an uncalibrated gyro still reads
+  /// as at rest and a wrong reference costs nothing. Returns false (and keeps none) above max_gyro_reference_radps.
+  bool setGyroReference(const Vec3& b_gyro_radps);
+  bool hasGyroReference() const { return has_gyro_ref_; }
 
  private:
   RestDetectorParams params_;
   double acc_var_max_, gyro_ms_max_, rate_per_s_, hp_rate_per_s_, contact_ms_min_;
   double acc_mean_ = 9.81, acc_var_ = 1.0, gyro_ms_ = 1.0, gyro_hp_ms_ = 0.0;
+  double gyro_ref_ms_ = 1.0;  ///< mean square of the gyro's deviation from the reference
+  Vec3 gyro_ref_ = Vec3::Zero();
+  bool has_gyro_ref_ = false;
   Vec3 gyro_mean_ = Vec3::Zero();
   /// The decay factors of the last Δt: the IMU period repeats, so they are recomputed only when it changes.
   double dt_cached_s_ = -1.0, a_cached_ = 0.0, a_hp_cached_ = 0.0;
