@@ -276,6 +276,40 @@ TEST(Estimator, ReportedCovarianceAddsTheBiasFloor) {
   EXPECT_DOUBLE_EQ(std::sqrt(ea.cov_pose(2, 2)), ea.sigma_p_m.z());
 }
 
+TEST(Estimator, OnTheFloorTheReportedCovarianceCarriesTheFloorLevelBias) {
+  // GIVEN a take-off log (on the floor for 2 s, then a climb), localized with the bias floor of F23 and without it
+  const SensorLog log = filtertest::takeoffLog(filtertest::TakeoffLogSpec{});
+  EkfParams with;
+  EkfParams without = with;
+  without.output_bias_sigma_m = 0.0;
+  const LocalizerResult a = TdoaLocalizer(with, arenaAnchors()).run(log, 0.05);
+  const LocalizerResult b = TdoaLocalizer(without, arenaAnchors()).run(log, 0.05);
+  ASSERT_EQ(a.estimates.size(), b.estimates.size());
+  // THEN the states are the same; on the floor the added variance is the floor-level bias's, horizontal only and at
+  // least that of the flight's σ_b, with the body's height on the floor (0.1 m) for z (F23); in flight the flight's
+  // σ_b² (HᵀH)⁻¹, which holds z too
+  int n_floor = 0, n_air = 0;
+  double min_floor_xy = 1e9, max_air_xy = 0.0;
+  for (std::size_t i = 0; i < a.estimates.size(); ++i) {
+    const LocalizerEstimate& ea = a.estimates[i];
+    const LocalizerEstimate& eb = b.estimates[i];
+    ASSERT_EQ(ea.x.w_p_b, eb.x.w_p_b);
+    const Vec3 added = ea.sigma_p_m.cwiseAbs2() - eb.sigma_p_m.cwiseAbs2();
+    if (ea.phase == FlightPhase::kGround && ea.t_s > 1.0) {
+      ++n_floor;
+      EXPECT_NEAR(added.z(), 0.1 * 0.1, 1e-9) << "t = " << ea.t_s;
+      min_floor_xy = std::min(min_floor_xy, added.head<2>().minCoeff());
+    } else if (ea.phase == FlightPhase::kTracking && ea.x.w_p_b.z() > 0.5) {
+      ++n_air;
+      EXPECT_GT(added.z(), 0.0);
+      max_air_xy = std::max(max_air_xy, added.head<2>().maxCoeff());
+    }
+  }
+  ASSERT_GT(n_floor, 5);
+  ASSERT_GT(n_air, 5);
+  EXPECT_GT(min_floor_xy, 4.0 * max_air_xy);  // σ_b on the floor 1.0 m (rest_tdoa_sigma_m) against 0.2 m in flight
+}
+
 TEST(RestDetector, RestIsDecidedAndRevisedFromTheImu) {
   RestDetector d;
   std::mt19937 rng(1);
