@@ -768,16 +768,16 @@ Mat3 Estimator::biasFloor() const {
   }
   // on the floor the height is known (F22) and the TDoA carry the floor-level bias, for which the filter's own TDoA σ
   // on the ground stands (F14): the bias moves the horizontal position only, by σ_b,ground² (H_xyᵀH_xy)⁻¹
-  const bool on_floor = on_ground_ && params_.floor_constraint;
-  const double s = on_floor ? std::max(params_.rest_tdoa_sigma_m, params_.output_bias_sigma_m) : params_.output_bias_sigma_m;
-  const double s2 = s * s;
-  if (n < 3) return Mat3::Identity() * s2;
-  if (on_floor) {
+  if (on_ground_ && params_.floor_constraint) {
+    const double s = std::max(params_.rest_tdoa_sigma_m, params_.output_bias_sigma_m);
+    const Eigen::Matrix2d HtH_xy = HtH.topLeftCorner<2, 2>() + 1e-6 * Eigen::Matrix2d::Identity();
     Mat3 C = Mat3::Zero();
-    C.topLeftCorner<2, 2>() = s2 * (HtH.topLeftCorner<2, 2>() + 1e-6 * Eigen::Matrix2d::Identity()).inverse();
+    C.topLeftCorner<2, 2>() = s * s * (n < 3 ? Eigen::Matrix2d::Identity() : Eigen::Matrix2d(HtH_xy.inverse()));
     C(2, 2) = kGroundHeightSigma_m * kGroundHeightSigma_m;  // the body's height on the floor, not the repeated updates'
     return C;
   }
+  const double s2 = params_.output_bias_sigma_m * params_.output_bias_sigma_m;
+  if (n < 3) return Mat3::Identity() * s2;
   const Eigen::LDLT<Mat3> ldlt(HtH + 1e-6 * Mat3::Identity());
   return s2 * ldlt.solve(Mat3::Identity());
 }

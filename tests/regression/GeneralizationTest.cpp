@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 
 #include "support/TestSupport.h"
 #include "uwb/eval/EstimateChecks.h"
@@ -32,6 +33,13 @@ const SimScenarioRun& scenario(const std::vector<SimScenarioRun>& runs, const st
   for (const SimScenarioRun& r : runs)
     if (r.name == name) return r;
   throw std::runtime_error("no scenario " + name);
+}
+
+/// A 40 s simulated flight of the given shape at the paper's anchors with the given sensors, localized with the
+/// defaults.
+LocalizationRun localizeSimulated(sim::TrajectoryShape shape, const sim::SimParams& sp, std::uint64_t seed) {
+  const sim::SimResult s = sim::simulateFlight(sim::makeScenario(sim::paperAnchors(), shape, 40.0), sp, seed);
+  return localizeFlight(s.flight, s.survey);
 }
 
 TEST(Generalization, RealFlightLoggedFromMidAir) {
@@ -174,10 +182,8 @@ TEST(Generalization, SimulatedImuLoggedAt100HzWithAStillHover) {
   sim::SimParams sp;
   sp.imu.rate_hz = 100.0;
   sp.tdoa.rate_hz = 100.0;
-  const sim::SimResult s =
-      sim::simulateFlight(sim::makeScenario(sim::paperAnchors(), sim::TrajectoryShape::kZigzag, 40.0), sp, 5);
   // WHEN localizing with the defaults
-  const LocalizationRun run = localizeFlight(s.flight, s.survey);
+  const LocalizationRun run = localizeSimulated(sim::TrajectoryShape::kZigzag, sp, 5);
   // THEN the hover is not taken for the ground (at 2 m the floor height pulled the estimate 2 m down: airborne RMSE
   // 0.37 m, largest error 2.0 m), and the flight is as accurate as at 1 kHz (0.23 m)
   ASSERT_TRUE(run.metrics);
@@ -192,10 +198,8 @@ TEST(Generalization, SimulatedQuietAccelerometerDuringTheClimb) {
   // filtered IMU): the steady climb after the take-off and the hover before the circle read as quiet as the motors off
   sim::SimParams sp;
   sp.imu.acc_noise_std_mps2 = 0.04;
-  const sim::SimResult s =
-      sim::simulateFlight(sim::makeScenario(sim::paperAnchors(), sim::TrajectoryShape::kCircle, 40.0), sp, 3);
   // WHEN localizing with the defaults
-  const LocalizationRun run = localizeFlight(s.flight, s.survey);
+  const LocalizationRun run = localizeSimulated(sim::TrajectoryShape::kCircle, sp, 3);
   // THEN the climb is not taken for the ground (rest put the climbing body back on the floor and the ZUPT took the
   // climb for accelerometer bias: airborne RMSE 0.73 m, largest error 2.1 m, six rest periods), and the flight is as
   // accurate as with the noisier accelerometer (0.31 m, 0.84 m; this seed's bias field is the hard one)
@@ -211,10 +215,8 @@ TEST(Generalization, SimulatedUncalibratedGyro) {
   // the Crazyflie's start-up calibration): at rest on the floor it reads above the rest test's 0.03 rad/s rms
   sim::SimParams sp;
   sp.imu.gyro_bias_std_rps = 0.03;
-  const sim::SimResult s =
-      sim::simulateFlight(sim::makeScenario(sim::paperAnchors(), sim::TrajectoryShape::kCircle, 40.0), sp, 5);
   // WHEN localizing with the defaults
-  const LocalizationRun run = localizeFlight(s.flight, s.survey);
+  const LocalizationRun run = localizeSimulated(sim::TrajectoryShape::kCircle, sp, 5);
   // THEN rest is found against the gyro's reading in the still levelling window: the start and the landing are on
   // the ground (without the reference: no rest period, the position lost after the landing, 78 % of the TDoA used)
   ASSERT_TRUE(run.metrics);
