@@ -51,6 +51,9 @@ std::vector<RealFlight> realFlights(const std::string& data_dir) {
   for (int i = 1; i <= 12; ++i)
     out.push_back({"0425-traj" + std::to_string(i), "0425", pilot + "/0425/0425-traj" + std::to_string(i) + ".csv",
                    pilot + "/survey/anchor_0425_survey.txt"});
+  // TDoA3 (the LPS mode of current firmware: random anchor pairs at a lower rate per pair), its own session so that
+  // the TDoA2 development medians compare across versions
+  out.push_back({"0425-traj13", "0425-tdoa3", pilot + "/0425/0425-traj13.csv", pilot + "/survey/anchor_0425_survey.txt"});
   for (int i : {1, 2, 11, 12})
     out.push_back({"0426-traj" + std::to_string(i), "0426", pilot + "/0426/0426-traj" + std::to_string(i) + ".csv",
                    pilot + "/survey/anchor_0426_survey.txt"});
@@ -68,6 +71,9 @@ void applySet(const std::string& kv, uwb::EkfParams& p) {
   if (eq == std::string::npos) throw std::invalid_argument("--set: expected name=value, got '" + kv + "'");
   uwb::setEkfParamFromText(p, uwb::ekfParamInfo(kv.substr(0, eq)), kv.substr(eq + 1), "--set");
 }
+
+/// The development flights: the util-pilot TDoA2 sessions with IMU.
+bool isDevSession(const std::string& session) { return session == "0425" || session == "0426"; }
 
 double median(std::vector<double> v) {
   v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
@@ -206,7 +212,7 @@ json summarize(const std::vector<Row>& rows, const std::string& label, bool prin
     by_session[r.session].push_back(&r);
     by_session["all"].push_back(&r);
     // the development flights: the util-pilot TDoA2 sessions with IMU
-    if (r.session == "0425" || r.session == "0426") by_session["dev (0425+0426)"].push_back(&r);
+    if (isDevSession(r.session)) by_session["dev (0425+0426)"].push_back(&r);
   }
   json out = json::object();
   if (print)
@@ -536,14 +542,16 @@ void runProtocol(const ProtocolArgs& a) {
     }
     if (!cut_rows.empty()) {
       printTable("Real flights cut to start in the air and end before landing", cut_rows, true);
-      for (double t0 : a.cuts) {
-        std::vector<Row> sel;
-        for (const Row& r : cut_rows)
-          if (r.t0 == t0) sel.push_back(r);
-        if (sel.empty()) continue;
-        std::cout << "\ncut at " << t0 << " s: ";
-        printCutSummary(sel);
-      }
+      // the development flights (TDoA2) apart from the TDoA3 flight, whose session has a mode of its own
+      for (const bool tdoa2 : {true, false})
+        for (double t0 : a.cuts) {
+          std::vector<Row> sel;
+          for (const Row& r : cut_rows)
+            if (r.t0 == t0 && isDevSession(r.session) == tdoa2) sel.push_back(r);
+          if (sel.empty()) continue;
+          std::cout << "\n" << (tdoa2 ? "" : "TDoA3, ") << "cut at " << t0 << " s: ";
+          printCutSummary(sel);
+        }
     }
     if (!sim_rows.empty()) {
       printTable("Simulated flights, whole", sim_rows, false);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "uwb/filter/AntennaBias.h"
+#include "uwb/filter/BiasFloor.h"
 #include "uwb/filter/BiasGuard.h"
 #include "uwb/filter/CooperativeRange.h"
 #include "uwb/filter/DescentBound.h"

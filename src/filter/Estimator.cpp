@@ -8,6 +8,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "uwb/filter/BiasFloor.h"
+
 namespace uwb {
 namespace {
 
@@ -749,37 +751,26 @@ Mat3 Estimator::reportedPositionCovariance() const {
 }
 
 Mat3 Estimator::biasFloor() const {
-  // (F23) a slowly varying TDoA bias of std σ_b per pair, common over the pairs in view, moves the position by
-  // (HᵀH)⁻¹Hᵀ b: covariance σ_b² (HᵀH)⁻¹ with H the rows ∂z/∂p of the pairs seen recently
+  // (F23) a slowly varying range bias per anchor of the pairs seen recently, pair std σ_b, moves the least-squares
+  // position; its covariance is added to the reported one
   const NavState& x = ekf_.state();
-  const Vec3 w_p_tag = x.w_p_b + x.w_q_b * params_.b_t_tag;
-  Mat3 HtH = Mat3::Zero();
-  int n = 0;
+  BiasFloorGeometry g(x.w_p_b + x.w_q_b * params_.b_t_tag);
   for (const RecentPair& rp : recent_pairs_) {
     if (t_last_event_ - rp.t_s > kRecentPairWindow_s) continue;
     const Moments3* a = anchors_.find(rp.id_a);
     const Moments3* b = anchors_.find(rp.id_b);
-    if (!a || !b) continue;
-    const Vec3 da = w_p_tag - a->m, db = w_p_tag - b->m;
-    if (da.norm() < 1e-6 || db.norm() < 1e-6) continue;
-    const Vec3 h = db.normalized() - da.normalized();
-    HtH += h * h.transpose();
-    ++n;
+    if (a && b) g.addPair(rp.id_a, a->m, rp.id_b, b->m);
   }
   // on the floor the height is known (F22) and the TDoA carry the floor-level bias, for which the filter's own TDoA σ
-  // on the ground stands (F14): the bias moves the horizontal position only, by σ_b,ground² (H_xyᵀH_xy)⁻¹
+  // on the ground stands (F14): the bias moves the horizontal position only (F23′)
   if (on_ground_ && params_.floor_constraint) {
     const double s = std::max(params_.rest_tdoa_sigma_m, params_.output_bias_sigma_m);
-    const Eigen::Matrix2d HtH_xy = HtH.topLeftCorner<2, 2>() + 1e-6 * Eigen::Matrix2d::Identity();
     Mat3 C = Mat3::Zero();
-    C.topLeftCorner<2, 2>() = s * s * (n < 3 ? Eigen::Matrix2d::Identity() : Eigen::Matrix2d(HtH_xy.inverse()));
+    C.topLeftCorner<2, 2>() = g.horizontalCovariance(s);
     C(2, 2) = kGroundHeightSigma_m * kGroundHeightSigma_m;  // the body's height on the floor, not the repeated updates'
     return C;
   }
-  const double s2 = params_.output_bias_sigma_m * params_.output_bias_sigma_m;
-  if (n < 3) return Mat3::Identity() * s2;
-  const Eigen::LDLT<Mat3> ldlt(HtH + 1e-6 * Mat3::Identity());
-  return s2 * ldlt.solve(Mat3::Identity());
+  return g.covariance(params_.output_bias_sigma_m);
 }
 
 LocalizerEstimate Estimator::estimate() const {

@@ -286,8 +286,8 @@ TEST(Estimator, OnTheFloorTheReportedCovarianceCarriesTheFloorLevelBias) {
   const LocalizerResult b = TdoaLocalizer(without, arenaAnchors()).run(log, 0.05);
   ASSERT_EQ(a.estimates.size(), b.estimates.size());
   // THEN the states are the same; on the floor the added variance is the floor-level bias's, horizontal only and at
-  // least that of the flight's σ_b, with the body's height on the floor (0.1 m) for z (F23); in flight the flight's
-  // σ_b² (HᵀH)⁻¹, which holds z too
+  // least that of the flight's σ_b, with the body's height on the floor (0.1 m) for z (F23′); in flight the anchor
+  // biases' term of F23, which holds z too
   int n_floor = 0, n_air = 0;
   double min_floor_xy = 1e9, max_air_xy = 0.0;
   for (std::size_t i = 0; i < a.estimates.size(); ++i) {

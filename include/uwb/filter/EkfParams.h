@@ -159,8 +159,8 @@ struct EkfParams {
   double moving_start_vel_sigma_mps = 1.0;  ///< velocity std when the IMU starts while moving (in the air) [m/s]
   double moving_start_att_sigma_rad = 0.1;  ///< roll/pitch std when the IMU starts while moving [rad]
   double moving_start_yaw_sigma_rad = 0.02; ///< yaw std when the IMU starts while moving [rad] (yaw 0 assumed)
-  /// Std of the slowly varying TDoA bias as seen in the position (F23): the reported position covariance is the
-  /// filter's plus this bias term mapped through the current anchor geometry. 0 reports the filter's P alone.
+  /// Std of one pair's slowly varying TDoA bias (F23; each anchor's range bias σ_b/√2): the reported position
+  /// covariance is the filter's plus this bias mapped through the anchors in view. 0 reports the filter's P alone.
   double output_bias_sigma_m = 0.2;
 
   // --- downward ToF range (Flow deck VL53L1x), docs/math/filter.md F21 ---

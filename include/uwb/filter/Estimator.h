@@ -165,7 +165,7 @@ class Estimator {
   bool diverged() const;
   /// Reported position covariance: the filter's plus the bias floor (F23).
   Mat3 reportedPositionCovariance() const;
-  /// σ_b² (HᵀH)⁻¹ of the pairs in view (F23).
+  /// The covariance of the anchors' range biases seen through the pairs in view (F23, BiasFloor.h).
   Mat3 biasFloor() const;
 
   EkfParams params_;
