@@ -75,6 +75,7 @@ Setters<SimParams> simSetters() {
   sub("tdoa.", &SimParams::tdoa,
       std::vector<std::pair<std::string, double T::*>>{{"rate_hz", &T::rate_hz},
                                                        {"jitter_fraction", &T::jitter_fraction}});
+  sub("tdoa.", &SimParams::tdoa, std::vector<std::pair<std::string, bool T::*>>{{"tdoa3", &T::tdoa3}});
   using B = BiasParams;
   sub("bias.", &SimParams::bias,
       std::vector<std::pair<std::string, double B::*>>{
@@ -179,7 +180,7 @@ void bindSim(py::module_& m) {
       py::arg("shape") = "circle", py::arg("duration_s") = 60.0, py::arg("anchors") = py::none(),
       py::arg("seed") = 1, py::arg("trajectory") = py::dict(), py::arg("params") = py::dict(),
       py::arg("noise_free") = false, py::arg("data_dir") = "",
-      "Simulates a Crazyflie flight (IMU, Vicon pose, TDoA2 with a pose-dependent bias) in the UTIL layout.\n"
+      "Simulates a Crazyflie flight (IMU, Vicon pose, TDoA2 or TDoA3 with a pose-dependent bias) in the UTIL layout.\n"
       "shape: 'zigzag' | 'circle' | 'circle-sine' | 'figure8'; anchors: None ('paper'), a preset name or an\n"
       "AnchorSurvey; trajectory: overrides of TrajectoryParams fields (e.g. {'radius_m': 1.2}); params: overrides\n"
       "of SimParams as 'imu.rate_hz', 'bias.noise_std_m', ... Deterministic per seed. Returns a dict: flight,\n"

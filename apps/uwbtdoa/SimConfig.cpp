@@ -77,7 +77,7 @@ void applySimConfig(const nlohmann::json& j, SimParams* sp, TrajectoryParams* tp
                    {"quat_quantum", &p.quat_quantum}});
     } else if (key == "tdoa") {
       auto& p = sp->tdoa;
-      applyObject(value, key, {{"rate_hz", &p.rate_hz}, {"jitter_fraction", &p.jitter_fraction}});
+      applyObject(value, key, {{"rate_hz", &p.rate_hz}, {"jitter_fraction", &p.jitter_fraction}, {"tdoa3", &p.tdoa3}});
     } else if (key == "bias") {
       auto& p = sp->bias;
       applyObject(value, key,

@@ -207,6 +207,6 @@ void setup(CLI::App& sub) {
 }
 
 const bool kRegistered = uwb::app::registerCommand(
-    {"simulate", "Simulate a Crazyflie flight (IMU, Vicon pose, TDoA2) with a realistic TDoA bias", setup});
+    {"simulate", "Simulate a Crazyflie flight (IMU, Vicon pose, TDoA2 or TDoA3) with a realistic TDoA bias", setup});
 
 }  // namespace

@@ -92,3 +92,18 @@ def test_pose_track_interpolates_and_flags_missing_truth(sim):
     np.testing.assert_allclose(np.linalg.norm(q["q"][1:], axis=1), 1.0, atol=1e-12)
     with pytest.raises(ValueError, match="unknown PoseTrack parameter"):
         u.PoseTrack(sim["flight"], params={"gap": 1.0})
+
+
+def test_tdoa3_schedule_pairs_every_anchor_with_every_other():
+    # TDoA2: the eight neighbour pairs in round robin; TDoA3 (S19b): random pairs of distinct anchors, at its own rate
+    tdoa2 = u.simulate_flight("circle", 25.0, seed=2)["flight"].tdoa
+    sim3 = u.simulate_flight("circle", 25.0, seed=2, params={"tdoa.tdoa3": True, "tdoa.rate_hz": 200.0})
+    tdoa3, truth = sim3["flight"].tdoa, sim3["tdoa_truth"]
+    unordered = lambda t: {tuple(sorted(p)) for p in zip(t["id_a"].tolist(), t["id_b"].tolist())}
+    assert len(unordered(tdoa2)) == 8
+    assert len(unordered(tdoa3)) == 28
+    assert np.all(tdoa3["id_a"] != tdoa3["id_b"])
+    assert 0.45 < tdoa3["t"].size / tdoa2["t"].size < 0.55
+    np.testing.assert_allclose(tdoa3["tdoa"], truth["tdoa_true"] + truth["error"], atol=1e-9)
+    with pytest.raises(ValueError, match="'tdoa.tdoa3': wrong type"):
+        u.simulate_flight(params={"tdoa.tdoa3": "yes"})

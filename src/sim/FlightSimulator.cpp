@@ -118,7 +118,7 @@ SimResult simulateFlight(const Scenario& scenario, const SimParams& params, std:
     }
   }
 
-  // --- TDoA2 (S19), (S20): neighbour pairs in round robin at a jittered rate.
+  // --- TDoA2 (S19), (S20): neighbour pairs in round robin at a jittered rate; TDoA3 (S19b): random pairs.
   {
     const TdoaScheduleParams& tp = params.tdoa;
     const double dt = 1.0 / tp.rate_hz;
@@ -130,9 +130,17 @@ SimResult simulateFlight(const Scenario& scenario, const SimParams& params, std:
     out.tdoa_truth.reserve(n_expected);
     std::size_t slot = static_cast<std::size_t>(phase(rng.schedule) * static_cast<double>(n_anchors)) % n_anchors;
     double t = dt * phase(rng.schedule);
+    if (tp.tdoa3 && n_anchors < 2) throw std::invalid_argument("simulateFlight: TDoA3 needs at least two anchors");
+    std::uniform_int_distribution<std::size_t> any_anchor(0, n_anchors - 1), other_anchor(1, n_anchors - 1);
     while (t <= duration) {
-      const Anchor& anchor_a = survey.anchors[slot];
-      const Anchor& anchor_b = survey.anchors[(slot + 1) % n_anchors];
+      std::size_t i_a = slot, i_b = (slot + 1) % n_anchors;
+      if (tp.tdoa3) {
+        // (S19b) the anchor just heard against a random other one heard before it
+        i_b = any_anchor(rng.schedule);
+        i_a = (i_b + other_anchor(rng.schedule)) % n_anchors;
+      }
+      const Anchor& anchor_a = survey.anchors[i_a];
+      const Anchor& anchor_b = survey.anchors[i_b];
       const KinematicState s = kinematicState(trajectory, t);
       const Vec3 w_p_tag = tagPosition(s.w_p, s.w_q_b, params.b_t_tag);
       TdoaTruth truth;

@@ -37,10 +37,12 @@ struct PoseParams {
   void validate() const;
 };
 
-/// TDoA2 schedule: neighbour pairs (id_0,id_1), (id_1,id_2), …, (id_{n−1},id_0) in round robin (S19).
+/// TDoA2 schedule: neighbour pairs (id_0,id_1), (id_1,id_2), …, (id_{n−1},id_0) in round robin (S19); or TDoA3:
+/// each measurement a random pair of distinct anchors (S19b; util-pilot 0425-traj13: about 200 Hz).
 struct TdoaScheduleParams {
-  double rate_hz = 400.0;       ///< all pairs together (util-pilot: 370–430 Hz)
+  double rate_hz = 400.0;       ///< all pairs together (util-pilot: 370–430 Hz TDoA2, about 200 Hz TDoA3)
   double jitter_fraction = 0.3; ///< each interval is (1 + U(−j, j)) / rate
+  bool tdoa3 = false;           ///< random pairs (TDoA3) instead of the neighbour round robin (TDoA2)
   void validate() const;
 };
 
