@@ -108,6 +108,16 @@ std::vector<SimScenarioRun> protocolSimulations(const std::string& data_dir, con
         const sim::SimResult r = sim::simulateFlight(sc, sp, seed);
         out.push_back({"fast-" + tag, "fast", "full", r.flight, r.survey, false});
       }
+      if (want("tdoa3")) {
+        // TDoA3 (S19b): random anchor pairs at 200 Hz instead of the neighbour round robin, a circle with a vertical
+        // sine from the ground to the ground
+        sim::SimParams sp3 = sp;
+        sp3.tdoa.tdoa3 = true;
+        sp3.tdoa.rate_hz = 200.0;
+        const sim::SimResult r =
+            sim::simulateFlight(sim::makeScenario(layout.survey, sim::TrajectoryShape::kCircleSine, 40.0), sp3, seed);
+        out.push_back({"tdoa3-" + tag, "tdoa3", "full", r.flight, r.survey, false});
+      }
       // a yawing figure eight started in the air (unknown yaw at the log's start)
       if (want("yawing-start")) cutInAir("yawing-start", sim::TrajectoryShape::kFigureEight, 50.0, 6.0);
       if (want("hand-carried")) {
