@@ -66,7 +66,10 @@ void TrajectoryParams::validate() const {
   require(sine_omega_ratio > 0.0, "sine_omega_ratio must be positive");
   require(figure8_half_length_m > 0.0 && figure8_half_width_m > 0.0, "figure-eight extents must be positive");
   require(zigzag_half_x_m > 0.0 && zigzag_half_y_m > 0.0, "zigzag extents must be positive");
-  require(zigzag_z_min_m > ground_z_m && zigzag_z_max_m >= zigzag_z_min_m, "zigzag height band invalid");
+  require(zigzag_z_min_m > ground_z_m && zigzag_z_max_m >= zigzag_z_min_m,
+          "zigzag height band invalid: need ground_z_m < zigzag_z_min_m <= zigzag_z_max_m, got " +
+              std::to_string(ground_z_m) + ", " + std::to_string(zigzag_z_min_m) + ", " +
+              std::to_string(zigzag_z_max_m) + " m (checked for every shape)");
   require(zigzag_speed_mps > 0.0 && zigzag_sweep_ratio > 1.0, "zigzag speed > 0 and sweep ratio > 1 required");
   require(std::isfinite(yaw0_rad) && std::isfinite(yaw_rate_rps), "yaw must be finite");
   require(std::abs(yaw_rate_rps) <= 6.0, "yaw_rate_rps must be within ±6 rad/s");

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include "support/DerivativeChecker.h"
 #include "uwb/sim/Trajectory.h"
@@ -118,6 +119,20 @@ TEST(Trajectory, RejectsADurationTooShortForTheGroundAndRampPhases) {
   p.duration_s = 10.0;
   EXPECT_THROW(p.validate(), std::invalid_argument);
   EXPECT_THROW(Trajectory{p}, std::invalid_argument);
+}
+
+TEST(Trajectory, AFloorAboveTheZigzagBandNamesTheFields) {
+  // GIVEN a floor (a start from a box) above the zigzag's lowest height THEN the error names the fields and values
+  TrajectoryParams p;
+  p.ground_z_m = 0.8;
+  try {
+    p.validate();
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("ground_z_m < zigzag_z_min_m"), std::string::npos) << what;
+    EXPECT_NE(what.find("0.800000"), std::string::npos) << what;
+  }
 }
 
 TEST(Trajectory, ParsesShapeNames) {
