@@ -4,6 +4,7 @@
  */
 #pragma once
 
+#include "uwb/filter/AnchorRangeBias.h"
 #include "uwb/filter/AntennaBias.h"
 #include "uwb/filter/BiasFloor.h"
 #include "uwb/filter/BiasGuard.h"

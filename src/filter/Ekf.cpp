@@ -114,6 +114,7 @@ ErrMat AccumulatedTransition::rightMultiplyTransposed(const ErrMat& M) const {
 Ekf::Ekf(const EkfParams& params) : params_(params) {
   params_.validate();
   P_ = initialCovariance(params_);
+  if (params_.range_bias_sigma_m > 0.0) range_bias_.emplace(params_.range_bias_sigma_m, params_.range_bias_tau_s);
 }
 
 ErrMat initialCovariance(const EkfParams& p) {
@@ -135,6 +136,7 @@ void Ekf::initialize(const NavState& x0, const ErrMat& P0) {
   P_ = 0.5 * (P0 + P0.transpose());
   phi_ = AccumulatedTransition{};
   pending_cv_dt_s_ = 0.0;
+  if (params_.range_bias_sigma_m > 0.0) range_bias_.emplace(params_.range_bias_sigma_m, params_.range_bias_tau_s);
 }
 
 void Ekf::predict(const ImuReading& imu, double dt_s) {
@@ -161,18 +163,30 @@ void Ekf::predictTdoaOnly(double dt_s) {
   pending_cv_dt_s_ += dt_s;
 }
 
+namespace {
+
+/// (F9) M ← F(T) M for the TDoA-only transition, on the rows of any 15-row M (the position row uses the old velocity
+/// row, so it goes first).
+template <typename Derived>
+void tdoaOnlyTransitionRows(Eigen::MatrixBase<Derived>& M, double T, bool ca) {
+  M.template middleRows<3>(kPos) += T * M.template middleRows<3>(kVel);
+  if (ca) {
+    M.template middleRows<3>(kPos) += (0.5 * T * T) * M.template middleRows<3>(kAccBias);
+    M.template middleRows<3>(kVel) += T * M.template middleRows<3>(kAccBias);
+  }
+}
+
+}  // namespace
+
 void Ekf::propagateTdoaOnlyCovariance() {
   // docs/math/filter.md (F9, F7): P ← F(T) P F(T)ᵀ + Q(T) using the structure of F(T) = I + T E_pv
   // (+ ½T² E_pa + T E_va for constant acceleration), per axis: O(15·3) instead of dense 15×15 products.
   const double T = pending_cv_dt_s_;
   const double T2 = T * T, T3 = T2 * T;
   const bool ca = params_.process_model == ProcessModel::kConstantAcceleration;
-  // rows: P ← F P (the position row uses the old velocity row, so it goes first)
-  P_.middleRows<3>(kPos) += T * P_.middleRows<3>(kVel);
-  if (ca) {
-    P_.middleRows<3>(kPos) += (0.5 * T2) * P_.middleRows<3>(kAccBias);
-    P_.middleRows<3>(kVel) += T * P_.middleRows<3>(kAccBias);
-  }
+  // rows: P ← F P; the range-bias cross-covariance's rows alike, P_xβ ← F P_xβ (F27b)
+  tdoaOnlyTransitionRows(P_, T, ca);
+  if (range_bias_) tdoaOnlyTransitionRows(range_bias_->cross(), T, ca);
   // columns: P ← (F P) Fᵀ
   P_.middleCols<3>(kPos) += T * P_.middleCols<3>(kVel);
   if (ca) {
@@ -204,8 +218,17 @@ void Ekf::propagateTdoaOnlyCovariance() {
 }
 
 void Ekf::propagateCovariance() {
+  // (F27b) the range biases' Ornstein–Uhlenbeck transition over the same time
+  const double T_pending = pendingDt();
   if (pending_cv_dt_s_ > 0.0) propagateTdoaOnlyCovariance();
-  if (phi_.empty()) return;
+  if (phi_.empty()) {
+    if (range_bias_) range_bias_->decay(T_pending);
+    return;
+  }
+  if (range_bias_) {
+    range_bias_->cross() = phi_.dense() * range_bias_->cross();  // P_xβ ← Φ P_xβ
+    range_bias_->decay(T_pending);
+  }
   // docs/math/filter.md (F7): P ← Φ P Φᵀ + Q(T). With A = (δp, δv, δθ) (rows 0..8) and B = the biases (rows 9..14),
   // the bias rows of Φ are identity rows, so for Y = P Φᵀ (column operations, vectorised along the columns):
   //   (Φ P Φᵀ)_{B,:} = Y_{B,:},   (Φ P Φᵀ)_{A,B} = Y_{B,A}ᵀ (symmetry),   (Φ P Φᵀ)_{A,A} = (Y_{:,A})ᵀ_{A-rows} Φᵀ.
@@ -227,10 +250,105 @@ void Ekf::propagateCovariance() {
 }
 
 InnovationStats Ekf::innovation(const ScalarLinearMessage<kDim>& message) const {
+  if (range_bias_) return augmentedInnovation(augmentedMessage(message, -1, -1));
   return innovationOf<kDim>(message, ErrVec::Zero(), P_);
 }
 
+double Ekf::rangeBiasDifference(int id_a, int id_b) const {
+  return range_bias_ ? range_bias_->mean(id_b) - range_bias_->mean(id_a) : 0.0;
+}
+
+ScalarLinearMessage<kAugDim> Ekf::augmentedMessage(const ScalarLinearMessage<kDim>& message, int slot_a,
+                                                   int slot_b) const {
+  // (F27c) z − ẑ − (β̂_B − β̂_A) = a δx + δβ_B − δβ_A + e
+  ScalarLinearMessage<kAugDim> m;
+  m.a.setZero();
+  m.a.head<kDim>() = message.a;
+  if (slot_a >= 0) m.a(kDim + slot_a) -= 1.0;
+  if (slot_b >= 0) m.a(kDim + slot_b) += 1.0;
+  m.y = message.y;
+  m.var = message.var;
+  return m;
+}
+
+namespace {
+
+/// u = J hᵀ for the joint covariance J = [[P, P_xβ], [P_xβᵀ, P_ββ]] and a row h = [a, e], from the blocks and the
+/// non-zero entries of h (a TDoA row has 6 in a and 2 in e): the same u as J hᵀ up to summation order.
+void jointGain(const ErrMat& P, const AnchorRangeBias& b, const ScalarLinearMessage<kAugDim>& m, ErrVec& u_x,
+               BiasVec& u_b) {
+  u_x.setZero();
+  u_b.setZero();
+  for (int c = 0; c < kDim; ++c) {
+    const double a_c = m.a(c);
+    if (a_c == 0.0) continue;
+    u_x.noalias() += P.col(c) * a_c;
+    u_b.noalias() += b.cross().row(c).transpose() * a_c;
+  }
+  for (int k = 0; k < kMaxBiasAnchors; ++k) {
+    const double e_k = m.a(kDim + k);
+    if (e_k == 0.0) continue;
+    u_x.noalias() += b.cross().col(k) * e_k;
+    u_b.noalias() += b.covariance().col(k) * e_k;
+  }
+}
+
+}  // namespace
+
+InnovationStats Ekf::augmentedInnovation(const ScalarLinearMessage<kAugDim>& message) const {
+  ErrVec u_x;
+  BiasVec u_b;
+  jointGain(P_, *range_bias_, message, u_x, u_b);
+  InnovationStats st;
+  st.innovation_m = message.y;  // the prior error state [δx, δβ] is zero
+  st.innovation_var_m2 = message.a.head<kDim>().dot(u_x.transpose()) +
+                         message.a.tail<kMaxBiasAnchors>().dot(u_b.transpose()) + message.var;
+  st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
+  return st;
+}
+
+std::optional<InnovationStats> Ekf::correctAugmented(const ScalarLinearMessage<kAugDim>& message) {
+  // (G18) the equality node on [δx, δβ] with the joint prior N(0, [[P, P_xβ], [P_xβᵀ, P_ββ]]) (F27c), by blocks:
+  // u = J hᵀ, S = h u + var, [δx, δβ] = u r/S, J ← J − w wᵀ with w = u/√S (detail::applyRankOneGain on the joint J).
+  ErrVec u_x;
+  BiasVec u_b;
+  jointGain(P_, *range_bias_, message, u_x, u_b);
+  InnovationStats st;
+  st.innovation_m = message.y;
+  st.innovation_var_m2 = message.a.head<kDim>().dot(u_x.transpose()) +
+                         message.a.tail<kMaxBiasAnchors>().dot(u_b.transpose()) + message.var;
+  if (!(st.innovation_var_m2 > 0.0) || !std::isfinite(st.innovation_var_m2) || !std::isfinite(st.innovation_m))
+    return std::nullopt;
+  st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
+  const double S = st.innovation_var_m2;
+  const ErrVec w_x = u_x * (1.0 / std::sqrt(S));
+  const BiasVec w_b = u_b * (1.0 / std::sqrt(S));
+  detail::rankOneDowndate<kDim>(P_, w_x);
+  range_bias_->downdate(w_x, w_b, u_b * (st.innovation_m / S));
+  inject(u_x * (st.innovation_m / S));  // (F8)
+  return st;
+}
+
+InnovationStats Ekf::innovationWithRangeBias(const ScalarLinearMessage<kDim>& message, int id_a, int id_b) {
+  if (!range_bias_) return innovation(message);
+  const int slot_a = range_bias_->slot(id_a), slot_b = range_bias_->slot(id_b);
+  return augmentedInnovation(augmentedMessage(message, slot_a, slot_b));
+}
+
+std::optional<InnovationStats> Ekf::correctWithRangeBias(const ScalarLinearMessage<kDim>& message, int id_a,
+                                                         int id_b) {
+  if (!range_bias_) return correct(message);
+  const int slot_a = range_bias_->slot(id_a), slot_b = range_bias_->slot(id_b);
+  return correctAugmented(augmentedMessage(message, slot_a, slot_b));
+}
+
+void Ekf::scaleCovariance(double factor) {
+  P_ *= factor;
+  if (range_bias_) range_bias_->scale(factor);
+}
+
 std::optional<InnovationStats> Ekf::correct(const ScalarLinearMessage<kDim>& message) {
+  if (range_bias_) return correctAugmented(augmentedMessage(message, -1, -1));
   // Paper Fig. 3: equality node between the predicted error state N(0, P) and the TDoA message (G18).
   ErrVec dx = ErrVec::Zero();
   const std::optional<InnovationStats> st = equalityRankOneInPlace<kDim>(dx, P_, message);
@@ -240,6 +358,7 @@ std::optional<InnovationStats> Ekf::correct(const ScalarLinearMessage<kDim>& mes
 }
 
 std::optional<InnovationStats> Ekf::correctPositionAttitude(const ScalarLinearMessage<kDim>& message) {
+  if (range_bias_) return correct(message);
   // As correct(); the equality node (G18) skips the velocity and bias columns, where the TDoA row is zero (G16).
   ErrVec dx = ErrVec::Zero();
   const std::optional<InnovationStats> st = equalityRankOneTwoBlocksInPlace<kDim>(dx, P_, message, kPos, kAtt);
@@ -250,6 +369,7 @@ std::optional<InnovationStats> Ekf::correctPositionAttitude(const ScalarLinearMe
 
 std::optional<InnovationStats> Ekf::correctPositionAttitude(const ScalarLinearMessage<kDim>& message,
                                                             const ErrVec& P_a, double a_P_a) {
+  if (range_bias_) return correct(message);  // P_a and a_P_a do not hold the cross terms
   // The equality node (G18) from u = P aᵀ and a u; a m = 0 since the prior error state m is zero.
   ErrVec dx = ErrVec::Zero();
   const std::optional<InnovationStats> st = detail::applyRankOneGain<kDim>(dx, P_, message, P_a, 0.0, a_P_a);
@@ -267,6 +387,10 @@ void Ekf::zeroVelocityUpdate(double sigma_mps) {
     m.a(kVel + i) = 1.0;
     m.y = -x_.w_v_b(i);
     m.var = sigma_mps * sigma_mps;
+    if (range_bias_) {
+      correct(m);
+      continue;
+    }
     ErrVec dx = ErrVec::Zero();
     const ErrVec u = P_.col(kVel + i);
     if (detail::applyRankOneGain<kDim>(dx, P_, m, u, 0.0, u(kVel + i))) inject(dx);  // (F8)
@@ -299,6 +423,7 @@ void Ekf::resetPosition(const Vec3& w_p_b, double sigma_m) {
   P_.middleRows<3>(kPos).setZero();
   P_.middleCols<3>(kPos).setZero();
   P_.block<3, 3>(kPos, kPos).diagonal().setConstant(sigma_m * sigma_m);
+  if (range_bias_) range_bias_->cross().middleRows<3>(kPos).setZero();
 }
 
 void Ekf::resetPositionVelocity(const Vec3& w_p_b, const Vec3& w_v_b, const Eigen::Matrix<double, 6, 6>& cov) {
@@ -308,6 +433,7 @@ void Ekf::resetPositionVelocity(const Vec3& w_p_b, const Vec3& w_v_b, const Eige
   P_.middleRows<6>(kPos).setZero();
   P_.middleCols<6>(kPos).setZero();
   P_.block<6, 6>(kPos, kPos) = 0.5 * (cov + cov.transpose());
+  if (range_bias_) range_bias_->cross().middleRows<6>(kPos).setZero();
 }
 
 void Ekf::inflateThrustBias(double sigma_mps2) { P_(kAccBias + 2, kAccBias + 2) += sigma_mps2 * sigma_mps2; }

@@ -114,7 +114,9 @@ std::vector<EkfParamInfo> makeRegistry() {
       // --- TDoA measurement ---
       vec3("b_t_tag", &P::b_t_tag, "m", "Tag (antenna) position in the body frame x,y,z", "tag-offset"),
       real("tdoa_sigma_m", &P::tdoa_sigma_m, "m", kPositive,
-           "TDoA noise std used by the filter (inflated for correlation, F12)", "tdoa-sigma"),
+           "TDoA noise std used by the filter: the white part beside the range-bias states (F27); without them 0.35 "
+           "(F12)",
+           "tdoa-sigma"),
       real("anchor_sigma_m", &P::anchor_sigma_m, "m", kNonNegative, "Std of each surveyed anchor coordinate"),
       real("gate_sigma", &P::gate_sigma, "", kPositive, "Mahalanobis gate on the normalised innovation (sigmas)",
            "gate"),
@@ -124,6 +126,11 @@ std::vector<EkfParamInfo> makeRegistry() {
       integer("robust_iterations", &P::robust_iterations, EkfParamRange{1, 20}, "IRLS iterations per TDoA update"),
       real("pair_bias_tau_s", &P::pair_bias_tau_s, "s", kNonNegative,
            "Per-pair TDoA offset learned from innovations with this time constant; 0 off (F19)"),
+      real("range_bias_sigma_m", &P::range_bias_sigma_m, "m", kNonNegative,
+           "Per-anchor range bias as filter states (Ornstein-Uhlenbeck, with cross-covariance): stationary std; "
+           "0 off (F27)"),
+      real("range_bias_tau_s", &P::range_bias_tau_s, "s", kPositive,
+           "Correlation time of each anchor's range bias state (F27)"),
       integer("antenna_bias_degree", &P::antenna_bias_degree, EkfParamRange{0, 4},
               "Learn the tag antenna-pattern TDoA bias in flight from the innovations: spherical harmonics of degrees "
               "2..this of the anchor's body-frame direction; 0 off, 1 invalid (F25)"),

@@ -44,6 +44,8 @@ void EkfParams::validate() const {
   if (!(max_rejection_rate > 0.0 && max_rejection_rate <= 1.0))
     throw std::invalid_argument("EkfParams.max_rejection_rate must be in (0, 1]");
   requireNonNegative(pair_bias_tau_s, "pair_bias_tau_s");
+  requireNonNegative(range_bias_sigma_m, "range_bias_sigma_m");
+  requirePositive(range_bias_tau_s, "range_bias_tau_s");
   if (antenna_bias_degree != 0 && (antenna_bias_degree < 2 || antenna_bias_degree > 4))
     throw std::invalid_argument("EkfParams.antenna_bias_degree must be 0 (off) or in [2, 4]");
   requirePositive(antenna_bias_sigma_m, "antenna_bias_sigma_m");

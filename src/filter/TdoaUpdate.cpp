@@ -175,6 +175,9 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
       bias_row.setZero();
     }
   }
+  // (F27) the anchors' range biases the filter carries as states: β̂_B − β̂_A
+  const bool range_bias = ekf.rangeBias() != nullptr;
+  if (range_bias) z_corr -= ekf.rangeBiasDifference(z.id_a, z.id_b);
   std::optional<ScalarLinearMessage<kDim>> msg =
       tdoaMessageFromAnchors(x, anchor_a, anchor_b, z_corr, var, options.b_t_tag);
   if (!msg) {
@@ -189,17 +192,23 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
   // (F11) χ² gate on the unweighted innovation
   // The message row a = B12 C is non-zero only in the position and attitude blocks, so u = P aᵀ needs only those
   // 6 columns of P (G17). u is formed once, in full, for both the gate (a u) and the equality node (G18).
-  const ErrMat& P = ekf.covariance();
-  const Vec3 a_p = msg->a.segment<3>(kPos).transpose();
-  const Vec3 a_att = msg->a.segment<3>(kAtt).transpose();
-  ErrVec P_a;
-  P_a.noalias() = P.middleCols<3>(kPos) * a_p;
-  P_a.noalias() += P.middleCols<3>(kAtt) * a_att;
-  const double a_P_a = a_p.dot(P_a.segment<3>(kPos)) + a_att.dot(P_a.segment<3>(kAtt));
+  // With range-bias states the row also reaches δβ_A and δβ_B, and S the cross terms (F27c).
+  ErrVec P_a = ErrVec::Zero();
+  double a_P_a = 0.0;
   InnovationStats st;
-  st.innovation_m = msg->y;  // prior error state is zero
-  st.innovation_var_m2 = a_P_a + msg->var;
-  st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
+  if (range_bias) {
+    st = ekf.innovationWithRangeBias(*msg, z.id_a, z.id_b);
+  } else {
+    const ErrMat& P = ekf.covariance();
+    const Vec3 a_p = msg->a.segment<3>(kPos).transpose();
+    const Vec3 a_att = msg->a.segment<3>(kAtt).transpose();
+    P_a.noalias() = P.middleCols<3>(kPos) * a_p;
+    P_a.noalias() += P.middleCols<3>(kAtt) * a_att;
+    a_P_a = a_p.dot(P_a.segment<3>(kPos)) + a_att.dot(P_a.segment<3>(kAtt));
+    st.innovation_m = msg->y;  // prior error state is zero
+    st.innovation_var_m2 = a_P_a + msg->var;
+    st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
+  }
   res.innovation_m = st.innovation_m;
   res.nis = st.nis;
   res.innovation_var_m2 = st.innovation_var_m2;
@@ -212,7 +221,9 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
   res.weight = robustUpdateWeight(options.loss, options.robust_k, st.innovation_m, hph, msg->var,
                                   options.robust_iterations);
   msg->var /= res.weight;
-  if (!ekf.correctPositionAttitude(*msg, P_a, a_P_a)) {  // the TDoA row touches only δp and δθ (G16)
+  const bool corrected = range_bias ? ekf.correctWithRangeBias(*msg, z.id_a, z.id_b).has_value()
+                                    : ekf.correctPositionAttitude(*msg, P_a, a_P_a).has_value();  // δp, δθ only (G16)
+  if (!corrected) {
     res.outcome = UpdateOutcome::kDegenerate;
     return res;
   }

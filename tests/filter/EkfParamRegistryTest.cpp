@@ -155,7 +155,7 @@ TEST(EkfParamRegistry, BadValuesNameTheParameterTheSourceAndTheValue) {
 }
 
 TEST(EkfParamRegistry, HelpAndMarkdownShowUnitDefaultAndRange) {
-  EXPECT_EQ(ekfParamHelpSuffix(ekfParamInfo("tdoa_sigma_m")), "[m] (default 0.35, > 0)");
+  EXPECT_EQ(ekfParamHelpSuffix(ekfParamInfo("tdoa_sigma_m")), "[m] (default 0.2, > 0)");
   EXPECT_EQ(ekfParamHelpSuffix(ekfParamInfo("robust_loss")), "(default huber; one of none, huber, cauchy)");
   EXPECT_EQ(ekfParamInfo("tdoa_sigma_m").flag(), "--tdoa-sigma-m");
   const std::string table = ekfParamMarkdownTable();

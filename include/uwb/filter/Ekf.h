@@ -11,6 +11,7 @@
 
 #include <optional>
 
+#include "uwb/filter/AnchorRangeBias.h"
 #include "uwb/filter/EkfParams.h"
 #include "uwb/filter/NavState.h"
 #include "uwb/filter/QuadImuProcess.h"
@@ -81,6 +82,19 @@ class Ekf {
   /// Innovation statistics of a message without applying it (G17).
   InnovationStats innovation(const ScalarLinearMessage<kDim>& message) const;
 
+  /// The per-anchor range-bias states (F27), or nullptr when off (EkfParams::range_bias_sigma_m = 0). With them on,
+  /// every correction is the equality node (G18) on the augmented state [δx, δβ], whatever its row: a message on δx
+  /// alone still moves β̂ through the cross-covariance.
+  const AnchorRangeBias* rangeBias() const { return range_bias_ ? &*range_bias_ : nullptr; }
+  /// β̂_B − β̂_A: the TDoA bias of pair (A, B) the states predict [m]; 0 when off.
+  double rangeBiasDifference(int id_a, int id_b) const;
+  /// (F27c) Innovation statistics of a TDoA message of pair (A, B) on the augmented state: its row gains −1 at δβ_A and
+  /// +1 at δβ_B (the anchors get a state on first sight). message.y must already exclude β̂_B − β̂_A. Without range-bias
+  /// states: innovation(message).
+  InnovationStats innovationWithRangeBias(const ScalarLinearMessage<kDim>& message, int id_a, int id_b);
+  /// (F27c) The correction with that augmented row, followed by the reset (F8); correct(message) when off.
+  std::optional<InnovationStats> correctWithRangeBias(const ScalarLinearMessage<kDim>& message, int id_a, int id_b);
+
   /// Zero-velocity update v = 0 with std sigma_mps per axis (F14), three scalar corrections.
   void zeroVelocityUpdate(double sigma_mps);
   /// Scalar pseudo-measurement of the position along world axis `axis` (0..2): p_axis = value ± sigma.
@@ -88,7 +102,7 @@ class Ekf {
   /// Adds sigma² to the position (and optionally velocity) variances: used on re-acquisition.
   void inflatePosition(double sigma_m, double vel_sigma_mps);
   /// P ← factor · P (factor > 0): the prior of a covariance-intersection update, P/ω (message-passing.md G21).
-  void scaleCovariance(double factor) { P_ *= factor; }
+  void scaleCovariance(double factor);
   /// Adds sigma² to the x and y position variances and vel_sigma² to the velocity variances.
   void inflateHorizontalPosition(double sigma_m, double vel_sigma_mps);
   /// Overwrites the position; keeps other state; sets the position block of P to sigma² I, clears its correlations.
@@ -114,7 +128,15 @@ class Ekf {
   AccumulatedTransition phi_;
   /// TDoA-only models (F9): the pending transition F(T) and noise Q(T) are determined by T alone.
   double pending_cv_dt_s_ = 0.0;
+  std::optional<AnchorRangeBias> range_bias_;  ///< F27, with range_bias_sigma_m > 0
   void propagateTdoaOnlyCovariance();
+  /// The message on [δx, δβ]: its δx row, −1 at slot_a and +1 at slot_b (a slot < 0: no entry).
+  ScalarLinearMessage<kAugDim> augmentedMessage(const ScalarLinearMessage<kDim>& message, int slot_a,
+                                                int slot_b) const;
+  /// (G17) innovation statistics of a message on the augmented state.
+  InnovationStats augmentedInnovation(const ScalarLinearMessage<kAugDim>& message) const;
+  /// (G18) on the augmented state, then the reset (F8) of δx and β̂ += δβ.
+  std::optional<InnovationStats> correctAugmented(const ScalarLinearMessage<kAugDim>& message);
 };
 
 /// The initial covariance from the params' init_* sigmas (F1).

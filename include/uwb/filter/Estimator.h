@@ -135,6 +135,8 @@ class Estimator {
   /// Time of the latest event folded in [s].
   double time() const { return t_last_event_; }
   const NavState& state() const { return ekf_.state(); }
+  /// The filter (its range-bias states, F27, among others).
+  const Ekf& ekf() const { return ekf_; }
   /// Covariance at the last propagation (Ekf::covariance).
   const ErrMat& covariance() const { return ekf_.covariance(); }
   FlightPhase phase() const { return phase_; }

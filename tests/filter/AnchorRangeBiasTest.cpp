@@ -1,0 +1,285 @@
+/** @file AnchorRangeBiasTest.cpp
+ *  @brief Per-anchor range-bias states (docs/math/filter.md F27): the Ornstein–Uhlenbeck transition, the augmented
+ *         correction and propagation against dense references, and what the states learn on synthetic flights.
+ */
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "FilterTestUtil.h"
+#include "uwb/filter/AnchorRangeBias.h"
+#include "uwb/filter/Ekf.h"
+#include "uwb/filter/QuadImuProcess.h"
+#include "uwb/filter/Estimator.h"
+#include "uwb/filter/SensorEvents.h"
+#include "uwb/filter/TdoaUpdate.h"
+
+namespace uwb {
+namespace {
+
+EkfParams rangeBiasParams(double sigma_m = 0.2, double tau_s = 2.0) {
+  EkfParams p;
+  p.range_bias_sigma_m = sigma_m;
+  p.range_bias_tau_s = tau_s;
+  return p;
+}
+
+/// A random symmetric positive-definite 15 × 15 covariance of a plausible scale.
+ErrMat randomCovariance(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  ErrMat A;
+  for (int i = 0; i < kDim; ++i)
+    for (int j = 0; j < kDim; ++j) A(i, j) = 0.1 * n(rng);
+  return A * A.transpose() + 0.01 * ErrMat::Identity();
+}
+
+NavState hoverState() {
+  NavState x;
+  x.w_p_b = Vec3(0.4, -0.2, 1.3);
+  x.w_v_b = Vec3(0.3, 0.1, 0.0);
+  x.w_q_b = expQuat(Vec3(0.02, -0.01, 0.3));
+  return x;
+}
+
+TEST(AnchorRangeBias, SlotsAreGivenOnFirstSightUntilFull) {
+  AnchorRangeBias b(0.2, 2.0);
+  EXPECT_EQ(b.findSlot(7), -1);
+  EXPECT_EQ(b.slot(7), 0);
+  EXPECT_EQ(b.slot(3), 1);
+  EXPECT_EQ(b.slot(7), 0);
+  for (int id = 100; id < 100 + kMaxBiasAnchors - 2; ++id) EXPECT_GE(b.slot(id), 0);
+  EXPECT_EQ(b.slot(999), -1);  // full: this anchor has no state
+  EXPECT_DOUBLE_EQ(b.mean(999), 0.0);
+  EXPECT_DOUBLE_EQ(b.stddev(999), 0.2);
+  EXPECT_THROW(AnchorRangeBias(0.0, 1.0), std::invalid_argument);
+  EXPECT_THROW(AnchorRangeBias(0.1, -1.0), std::invalid_argument);
+}
+
+TEST(AnchorRangeBias, DecayIsTheOrnsteinUhlenbeckTransitionAndComposes) {
+  // GIVEN a state with a mean, a cross-covariance and a correlated bias block (from a correction)
+  Ekf ekf(rangeBiasParams(0.2, 2.0));
+  ekf.initialize(hoverState(), randomCovariance(1));
+  const AnchorTable anchors = filtertest::arenaAnchors();
+  TdoaUpdateOptions opt;
+  opt.gate_sigma = 0.0;
+  updateTdoa(ekf, anchors, {0.0, 0, 1, 0.7}, opt);
+  AnchorRangeBias once = *ekf.rangeBias(), twice = *ekf.rangeBias();
+  // WHEN decaying over 0.3 s at once, or over 0.1 s and then 0.2 s
+  once.decay(0.3);
+  twice.decay(0.1);
+  twice.decay(0.2);
+  // THEN both are the same, the mean and the cross terms shrink by e^{−T/τ} and the variance relaxes towards σ²
+  const double f = std::exp(-0.3 / 2.0);
+  const AnchorRangeBias& before = *ekf.rangeBias();
+  EXPECT_LT((once.means() - twice.means()).norm(), 1e-14);
+  EXPECT_LT((once.covariance() - twice.covariance()).norm(), 1e-14);
+  EXPECT_LT((once.cross() - twice.cross()).norm(), 1e-14);
+  EXPECT_LT((once.means() - f * before.means()).norm(), 1e-14);
+  EXPECT_LT((once.cross() - f * before.cross()).norm(), 1e-14);
+  const BiasMat expected = f * f * before.covariance() + (1.0 - f * f) * 0.04 * BiasMat::Identity();
+  EXPECT_LT((once.covariance() - expected).norm(), 1e-14);
+  EXPECT_NE(before.means()(0), 0.0);  // the correction did move the biases
+}
+
+TEST(EkfRangeBias, TdoaCorrectionIsTheKalmanUpdateOfTheAugmentedState) {
+  // GIVEN a filter with range-bias states correlated with δx by earlier corrections
+  Ekf ekf(rangeBiasParams());
+  ekf.initialize(hoverState(), randomCovariance(2));
+  const AnchorTable anchors = filtertest::arenaAnchors();
+  TdoaUpdateOptions opt;
+  opt.gate_sigma = 0.0;
+  opt.loss = RobustLoss::kNone;
+  const TdoaObservation warmup[] = {{0.0, 0, 1, 0.4}, {0.0, 1, 2, -0.9}, {0.0, 2, 3, 1.3}, {0.0, 7, 0, 0.2}};
+  for (const TdoaObservation& z : warmup) updateTdoa(ekf, anchors, z, opt);
+  const AugMat J0 = ekf.rangeBias()->joint(ekf.covariance());
+  const BiasVec beta0 = ekf.rangeBias()->means();
+  const NavState x0 = ekf.state();
+  // WHEN one more TDoA of pair (1, 2) is applied
+  const TdoaObservation z{0.0, 1, 2, -0.75};
+  const TdoaUpdateResult r = updateTdoa(ekf, anchors, z, opt);
+  ASSERT_EQ(r.outcome, UpdateOutcome::kApplied);
+  // THEN it equals the dense Kalman update on [δx, δβ] with the row [∂h/∂δx, −e_A + e_B] (F27c)
+  const std::optional<ScalarLinearMessage<kDim>> m =
+      tdoaMessage(x0, anchors, z, z.tdoa_m - (beta0(2) - beta0(1)), opt.sigma_m * opt.sigma_m, opt.b_t_tag);
+  ASSERT_TRUE(m.has_value());
+  Eigen::Matrix<double, 1, kAugDim> h = Eigen::Matrix<double, 1, kAugDim>::Zero();
+  h.head<kDim>() = m->a;
+  h(kDim + 1) = -1.0;  // anchor 1 (slot 1) is A
+  h(kDim + 2) = 1.0;   // anchor 2 (slot 2) is B
+  const double S = (h * J0 * h.transpose())(0, 0) + m->var;
+  const AugVec K = J0 * h.transpose() / S;
+  const AugVec dx = K * m->y;
+  const AugMat J1 = J0 - K * S * K.transpose();
+  EXPECT_NEAR(r.innovation_var_m2, S, 1e-12);
+  EXPECT_LT((ekf.state().w_p_b - (x0.w_p_b + dx.segment<3>(kPos))).norm(), 1e-12);
+  EXPECT_LT((ekf.rangeBias()->means() - (beta0 + dx.tail<kMaxBiasAnchors>())).norm(), 1e-12);
+  EXPECT_LT((ekf.rangeBias()->joint(ekf.covariance()) - J1).norm(), 1e-12);
+  // and the graph's equality node (G18) on the 31-dimensional joint state, the plain reference of the block update
+  ScalarLinearMessage<kAugDim> m_aug;
+  m_aug.a = h;
+  m_aug.y = m->y;
+  m_aug.var = m->var;
+  AugMat J_node = J0;
+  AugVec dx_node = AugVec::Zero();
+  ASSERT_TRUE(equalityRankOneInPlace<kAugDim>(dx_node, J_node, m_aug).has_value());
+  EXPECT_LT((ekf.rangeBias()->joint(ekf.covariance()) - J_node).norm(), 1e-12);
+  EXPECT_LT((dx_node - dx).norm(), 1e-12);
+}
+
+TEST(EkfRangeBias, ImuPropagationIsTheAugmentedTransition) {
+  // GIVEN a filter with cross-covariances, and the same IMU steps accumulated by hand
+  EkfParams params = rangeBiasParams(0.25, 1.5);
+  Ekf ekf(params);
+  ekf.initialize(hoverState(), randomCovariance(3));
+  const AnchorTable anchors = filtertest::arenaAnchors();
+  TdoaUpdateOptions opt;
+  opt.gate_sigma = 0.0;
+  updateTdoa(ekf, anchors, {0.0, 3, 4, 0.5}, opt);
+  updateTdoa(ekf, anchors, {0.0, 5, 6, -0.2}, opt);
+  const CrossMat cross0 = ekf.rangeBias()->cross();
+  const BiasMat Pbb0 = ekf.rangeBias()->covariance();
+  Ekf plain(EkfParams{});  // the same filter without range-bias states gives the δx block
+  plain.initialize(ekf.state(), ekf.covariance());
+  AccumulatedTransition phi;
+  NavState x = ekf.state();
+  ImuReading imu;
+  imu.b_acc_mps2 = Vec3(0.3, -0.2, kGravity_mps2 + 0.4);
+  imu.b_gyro_radps = Vec3(0.05, -0.02, 0.3);
+  const int steps = 20;
+  const double dt = 0.001;
+  for (int k = 0; k < steps; ++k) {
+    ekf.predict(imu, dt);
+    plain.predict(imu, dt);
+    const ProcessStep s = quadImuProcess(x, imu, dt, params.accel_model);
+    x = s.next;
+    phi.accumulate(s.J);
+  }
+  // WHEN the covariance is propagated
+  ekf.propagateCovariance();
+  plain.propagateCovariance();
+  // THEN P_xx is the plain filter's, P_xβ = Φ P_xβ f and P_ββ = f² P_ββ + (1 − f²) σ² I (F27b)
+  const double f = std::exp(-steps * dt / 1.5);
+  EXPECT_LT((ekf.covariance() - plain.covariance()).norm(), 1e-12);
+  EXPECT_LT((ekf.rangeBias()->cross() - phi.dense() * cross0 * f).norm(), 1e-12);
+  const BiasMat expected = f * f * Pbb0 + (1.0 - f * f) * 0.0625 * BiasMat::Identity();
+  EXPECT_LT((ekf.rangeBias()->covariance() - expected).norm(), 1e-12);
+}
+
+TEST(EkfRangeBias, TdoaOnlyPropagationIsTheAugmentedTransition) {
+  // GIVEN a TDoA-only (constant-velocity) filter with cross-covariances
+  EkfParams params = rangeBiasParams(0.2, 3.0);
+  params.process_model = ProcessModel::kConstantVelocity;
+  Ekf ekf(params);
+  ekf.initialize(hoverState(), randomCovariance(4));
+  const AnchorTable anchors = filtertest::arenaAnchors();
+  TdoaUpdateOptions opt;
+  opt.gate_sigma = 0.0;
+  updateTdoa(ekf, anchors, {0.0, 2, 3, 0.1}, opt);
+  const CrossMat cross0 = ekf.rangeBias()->cross();
+  // WHEN 0.05 s pass
+  const double T = 0.05;
+  ekf.predictTdoaOnly(T);
+  ekf.propagateCovariance();
+  // THEN P_xβ = F(T) P_xβ e^{−T/τ} with F(T) = I + T E_pv (F9)
+  ErrMat F = ErrMat::Identity();
+  F.block<3, 3>(kPos, kVel) = T * Mat3::Identity();
+  EXPECT_LT((ekf.rangeBias()->cross() - F * cross0 * std::exp(-T / 3.0)).norm(), 1e-12);
+}
+
+TEST(EkfRangeBias, ResetsClearTheCrossCovarianceOfWhatTheyReset) {
+  Ekf ekf(rangeBiasParams());
+  ekf.initialize(hoverState(), randomCovariance(5));
+  const AnchorTable anchors = filtertest::arenaAnchors();
+  TdoaUpdateOptions opt;
+  opt.gate_sigma = 0.0;
+  updateTdoa(ekf, anchors, {0.0, 0, 1, 0.3}, opt);
+  ASSERT_GT(ekf.rangeBias()->cross().middleRows<3>(kPos).norm(), 0.0);
+  ekf.resetPosition(Vec3(1, 2, 1), 0.5);
+  EXPECT_EQ(ekf.rangeBias()->cross().middleRows<3>(kPos).norm(), 0.0);
+  EXPECT_GT(ekf.rangeBias()->cross().middleRows<3>(kAtt).norm(), 0.0);
+  // a covariance intersection's P/ω scales the whole joint covariance
+  const AugMat J = ekf.rangeBias()->joint(ekf.covariance());
+  ekf.scaleCovariance(2.0);
+  EXPECT_LT((ekf.rangeBias()->joint(ekf.covariance()) - 2.0 * J).norm(), 1e-12);
+}
+
+/// Circle of radius 1.2 m at 1.4 m height, 0.6 rad/s.
+filtertest::Truth circle(double t) {
+  const double w = 0.6, r = 1.2;
+  return {Vec3(r * std::cos(w * t), r * std::sin(w * t), 1.4), Vec3(-r * w * std::sin(w * t), r * w * std::cos(w * t), 0),
+          Vec3(-r * w * w * std::cos(w * t), -r * w * w * std::sin(w * t), 0)};
+}
+
+/// Runs an Estimator over the log one event at a time; RMSE of the position against circle() after t0_s.
+double runCircle(Estimator& est, const SensorLog& log, double t0_s) {
+  double s = 0.0;
+  int n = 0;
+  SensorEventCursor cursor(log);
+  for (SensorEvent ev; cursor.next(ev);) {
+    if (ev.kind == SensorEvent::Kind::kImu) {
+      est.addImu(ev.t_s, log.imu[ev.index].imu);
+      continue;
+    }
+    if (ev.kind != SensorEvent::Kind::kTdoa) continue;
+    est.addTdoa(log.tdoa[ev.index]);
+    if (ev.t_s < t0_s || !est.ready()) continue;
+    s += (est.state().w_p_b - circle(ev.t_s).p).squaredNorm();
+    ++n;
+  }
+  return std::sqrt(s / std::max(n, 1));
+}
+
+TEST(EkfRangeBias, LearnsAnAnchorRangeBiasThatMovedThePosition) {
+  // GIVEN a circle flight whose anchor 3 reads every range 0.4 m long (pairs (2, 3) and (3, 4) carry ±0.4 m)
+  const AnchorTable anchors = filtertest::arenaAnchors();
+  constexpr double kBias_m = 0.4;
+  const auto offset = [](double, int a) { return a == 2 ? kBias_m : (a == 3 ? -kBias_m : 0.0); };
+  const SensorLog log = filtertest::flightLog(anchors, circle, 0.0, 60.0, 0.05, true, 11, offset);
+  EkfParams off;
+  off.ground_phase = GroundPhase::kNone;
+  off.range_bias_sigma_m = 0.0;  // the filter without range-bias states
+  off.tdoa_sigma_m = 0.35;
+  EkfParams on = off;
+  on.tdoa_sigma_m = 0.2;
+  on.range_bias_sigma_m = 0.3;
+  on.range_bias_tau_s = 1000.0;  // a constant bias
+  // WHEN localizing without and with range-bias states
+  Estimator est_off(off, anchors), est_on(on, anchors);
+  const double e_off = runCircle(est_off, log, 30.0), e_on = runCircle(est_on, log, 30.0);
+  // THEN the states find the anchor's bias (up to the common range offset that no TDoA sees) and its position error
+  EXPECT_EQ(est_off.ekf().rangeBias(), nullptr);
+  ASSERT_NE(est_on.ekf().rangeBias(), nullptr);
+  const AnchorRangeBias& b = *est_on.ekf().rangeBias();
+  double others = 0.0;
+  for (int id = 0; id < 8; ++id)
+    if (id != 3) others += b.mean(id) / 7.0;
+  EXPECT_NEAR(b.mean(3) - others, kBias_m, 0.1);
+  EXPECT_GT(e_off, 0.08);  // the bias does move the plain filter
+  EXPECT_LT(e_on, 0.5 * e_off);
+}
+
+TEST(EkfRangeBias, ABiasFreeFlightStaysAsGood) {
+  // GIVEN the same flight without bias
+  const AnchorTable anchors = filtertest::arenaAnchors();
+  const SensorLog log = filtertest::flightLog(anchors, circle, 0.0, 40.0, 0.05, true, 12);
+  EkfParams off;
+  off.ground_phase = GroundPhase::kNone;
+  off.range_bias_sigma_m = 0.0;
+  off.tdoa_sigma_m = 0.35;
+  const EkfParams on = [] {
+    EkfParams p;  // the defaults: range-bias states on
+    p.ground_phase = GroundPhase::kNone;
+    return p;
+  }();
+  // WHEN localizing without and with range-bias states
+  Estimator est_off(off, anchors), est_on(on, anchors);
+  const double e_off = runCircle(est_off, log, 10.0), e_on = runCircle(est_on, log, 10.0);
+  // THEN the states cost little accuracy (they only add freedom the TDoA do not ask for)
+  EXPECT_LT(e_off, 0.05);
+  EXPECT_LT(e_on, 0.05);
+}
+
+}  // namespace
+}  // namespace uwb
