@@ -106,11 +106,14 @@ void BM_CovariancePropagation(benchmark::State& state) {
 BENCHMARK(BM_CovariancePropagation);
 
 void BM_TdoaUpdate(benchmark::State& state) {
+  // arg 0: defaults (with the range-bias states, F27: the equality node on [δx, δβ]); 1: without them
   const AnchorTable anchors = benchAnchors();
-  Ekf ekf(EkfParams{});
+  EkfParams params;
+  if (state.range(0) == 1) params.range_bias_sigma_m = 0.0;
+  Ekf ekf(params);
   NavState x;
   x.w_p_b = Vec3(0.3, -0.2, 1.5);
-  ekf.initialize(x, initialCovariance(EkfParams{}));
+  ekf.initialize(x, initialCovariance(params));
   TdoaUpdateOptions opt;
   opt.gate_sigma = 0.0;
   const Vec3 tag = tagPosition(x.w_p_b, x.w_q_b, kUtilTagOffset_b);
@@ -122,7 +125,7 @@ void BM_TdoaUpdate(benchmark::State& state) {
     benchmark::DoNotOptimize(updateTdoa(ekf, anchors, {0.0, 0, 1, z + 0.05}, opt));  // graph TDoA node + equality
   }
 }
-BENCHMARK(BM_TdoaUpdate);
+BENCHMARK(BM_TdoaUpdate)->Arg(0)->Arg(1);
 
 /// One online Estimator event at steady state: the estimator has run 5 s of the synthetic flight; the timed loop feeds
 /// the next events of the same kind (IMU or TDoA) from the following 30 s, wrapping the log's time forward.
@@ -189,10 +192,14 @@ void BM_WholeFlightReal0425Traj2(benchmark::State& state) {
   const Flight f = readFlightCsv(flight.string());
   const SensorLog log = sensorLogFromFlight(f);
   // arg 0: defaults; 1: the tag antenna pattern learned in flight (F25, degree 3); 2: the bias guard (F24) with a
-  // zero-mean bias model, i.e. two filters side by side
+  // zero-mean bias model, i.e. two filters side by side; 3: without the range-bias states (F27)
   EkfParams p;
   BiasPredictor bias;
   if (state.range(0) == 1) p.antenna_bias_degree = 3;
+  if (state.range(0) == 3) {
+    p.range_bias_sigma_m = 0.0;
+    p.tdoa_sigma_m = 0.35;
+  }
   if (state.range(0) == 2) {
     p.bias_guard = true;
     bias = [](const TdoaFeature&) { return BiasPrediction{}; };
@@ -201,7 +208,7 @@ void BM_WholeFlightReal0425Traj2(benchmark::State& state) {
   const double duration = f.timeSpan().second - f.timeSpan().first;
   runFlightBenchmark(state, localizer, log, duration);
 }
-BENCHMARK(BM_WholeFlightReal0425Traj2)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WholeFlightReal0425Traj2)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace uwb

@@ -1,13 +1,16 @@
 #!/usr/bin/env python3
-"""Airborne RMSE of the whole flight and of its second half, without and with the online antenna-bias learning
-(docs/math/filter.md F25).
+"""Airborne RMSE of the whole flight and of its second half, without and with a bias learned online (the antenna
+pattern, docs/math/filter.md F25; the range-bias states, F27).
 
 For each flight: `uwbtdoa localize FLIGHT --anchors SURVEY --json --out TRAJ [extra flags]` twice (the baseline flags,
 then the same flags plus --antenna-bias-degree DEGREE); the estimate is interpolated linearly at the ground-truth
 times (no comparison across estimate gaps over 0.1 s, as eval/TrajectoryMetrics), airborne = ground-truth z > 0.3 m
 (io/Airborne.h), and the second half is the airborne samples after the middle of the first and last airborne time.
 
-Usage: scripts/online_bias_eval.py BUILD_DIR SURVEY FLIGHT.csv... [-- extra localize flags for the learning run]
+Usage: scripts/online_bias_eval.py BUILD_DIR SURVEY FLIGHT.csv... [-- flags of the learning run [-- flags of the
+baseline run]]
+e.g. the range-bias states (on by default) against the filter without them:
+  scripts/online_bias_eval.py build SURVEY FLIGHTS -- -- --range-bias-sigma-m 0 --tdoa-sigma-m 0.35
 """
 import json
 import os
@@ -65,10 +68,13 @@ def run(build, survey, flight, flags, tmpdir):
 
 def main():
     args = sys.argv[1:]
-    extra = []
+    extra, base = [], []
     if "--" in args:
         i = args.index("--")
         args, extra = args[:i], args[i + 1:]
+    if "--" in extra:
+        i = extra.index("--")
+        extra, base = extra[:i], extra[i + 1:]
     build, survey, flights = args[0], args[1], args[2:]
     print(f"{'flight':14s} {'tool_air':>8s} {'air_u':>7s} {'air_l':>7s} {'chg%':>6s} {'2nd_u':>7s} {'2nd_l':>7s} "
           f"{'chg%':>6s} {'cpu_u':>6s} {'cpu_l':>6s}")
@@ -76,7 +82,7 @@ def main():
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for f in flights:
-            tool_u, wu, su, cu = run(build, survey, f, [], tmp)
+            tool_u, wu, su, cu = run(build, survey, f, base, tmp)
             _, wl, sl, cl = run(build, survey, f, extra, tmp)
             cw, cs = 100 * (wl / wu - 1), 100 * (sl / su - 1)
             ch_whole.append(cw)

@@ -44,13 +44,13 @@ void AnchorRangeBias::decay(double dt_s) {
   // (F27b) exact discretisation of dβ = −β/τ dt + σ √(2/τ) dW
   const double f = std::exp(-dt_s / tau_s_);
   beta_ *= f;
-  P_xb_ *= f;
+  P_bx_ *= f;
   P_bb_ *= f * f;
   P_bb_.diagonal().array() += (1.0 - f * f) * sigma_m_ * sigma_m_;
 }
 
 void AnchorRangeBias::downdate(const ErrVec& w_x, const BiasVec& w_b, const BiasVec& dbeta) {
-  P_xb_.noalias() -= w_x * w_b.transpose();
+  P_bx_.noalias() -= w_b * w_x.transpose();
   detail::rankOneDowndate<kMaxBiasAnchors>(P_bb_, w_b);
   beta_ += dbeta;
 }
@@ -58,8 +58,8 @@ void AnchorRangeBias::downdate(const ErrVec& w_x, const BiasVec& w_b, const Bias
 AugMat AnchorRangeBias::joint(const ErrMat& P) const {
   AugMat J;
   J.topLeftCorner<kDim, kDim>() = P;
-  J.topRightCorner<kDim, kMaxBiasAnchors>() = P_xb_;
-  J.bottomLeftCorner<kMaxBiasAnchors, kDim>() = P_xb_.transpose();
+  J.topRightCorner<kDim, kMaxBiasAnchors>() = P_bx_.transpose();
+  J.bottomLeftCorner<kMaxBiasAnchors, kDim>() = P_bx_;
   J.bottomRightCorner<kMaxBiasAnchors, kMaxBiasAnchors>() = P_bb_;
   return J;
 }

@@ -186,7 +186,10 @@ void Ekf::propagateTdoaOnlyCovariance() {
   const bool ca = params_.process_model == ProcessModel::kConstantAcceleration;
   // rows: P ← F P; the range-bias cross-covariance's rows alike, P_xβ ← F P_xβ (F27b)
   tdoaOnlyTransitionRows(P_, T, ca);
-  if (range_bias_) tdoaOnlyTransitionRows(range_bias_->cross(), T, ca);
+  if (range_bias_) {
+    auto P_xb = range_bias_->biasRows().transpose();  // a writable view: P_xβ ← F P_xβ
+    tdoaOnlyTransitionRows(P_xb, T, ca);
+  }
   // columns: P ← (F P) Fᵀ
   P_.middleCols<3>(kPos) += T * P_.middleCols<3>(kVel);
   if (ca) {
@@ -226,7 +229,7 @@ void Ekf::propagateCovariance() {
     return;
   }
   if (range_bias_) {
-    range_bias_->cross() = phi_.dense() * range_bias_->cross();  // P_xβ ← Φ P_xβ
+    range_bias_->biasRows() = range_bias_->biasRows() * phi_.dense().transpose();  // P_βx ← P_βx Φᵀ
     range_bias_->decay(T_pending);
   }
   // docs/math/filter.md (F7): P ← Φ P Φᵀ + Q(T). With A = (δp, δv, δθ) (rows 0..8) and B = the biases (rows 9..14),
@@ -250,7 +253,15 @@ void Ekf::propagateCovariance() {
 }
 
 InnovationStats Ekf::innovation(const ScalarLinearMessage<kDim>& message) const {
-  if (range_bias_) return augmentedInnovation(augmentedMessage(message, -1, -1));
+  if (range_bias_) {
+    const ScalarLinearMessage<kAugDim> m = augmentedMessage(message, -1, -1);
+    const RangeBiasGain g = augmentedGain(m);
+    InnovationStats st;
+    st.innovation_m = message.y;
+    st.innovation_var_m2 = g.h_u + message.var;
+    st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
+    return st;
+  }
   return innovationOf<kDim>(message, ErrVec::Zero(), P_);
 }
 
@@ -273,73 +284,72 @@ ScalarLinearMessage<kAugDim> Ekf::augmentedMessage(const ScalarLinearMessage<kDi
 
 namespace {
 
-/// u = J hᵀ for the joint covariance J = [[P, P_xβ], [P_xβᵀ, P_ββ]] and a row h = [a, e], from the blocks and the
-/// non-zero entries of h (a TDoA row has 6 in a and 2 in e): the same u as J hᵀ up to summation order.
+/// u = J hᵀ for the joint covariance J = [[P, P_xβ], [P_βx, P_ββ]] and a row h = [a, e], from the blocks and the
+/// non-zero entries of h: the same u as J hᵀ up to summation order. A TDoA row (G16) is non-zero only in δp and δθ
+/// and at two anchors: those are read as 3-column blocks (as equalityRankOneTwoBlocksInPlace); other rows by entry.
 void jointGain(const ErrMat& P, const AnchorRangeBias& b, const ScalarLinearMessage<kAugDim>& m, ErrVec& u_x,
                BiasVec& u_b) {
-  u_x.setZero();
-  u_b.setZero();
-  for (int c = 0; c < kDim; ++c) {
-    const double a_c = m.a(c);
-    if (a_c == 0.0) continue;
-    u_x.noalias() += P.col(c) * a_c;
-    u_b.noalias() += b.cross().row(c).transpose() * a_c;
+  const BiasRowsMat& P_bx = b.biasRows();
+  const bool two_blocks = m.a.segment<3>(kVel).isZero() && m.a.segment<6>(kAccBias).isZero();
+  if (two_blocks) {
+    const Vec3 a_p = m.a.segment<3>(kPos).transpose(), a_att = m.a.segment<3>(kAtt).transpose();
+    u_x.noalias() = P.middleCols<3>(kPos) * a_p;
+    u_x.noalias() += P.middleCols<3>(kAtt) * a_att;
+    u_b.noalias() = P_bx.middleCols<3>(kPos) * a_p;
+    u_b.noalias() += P_bx.middleCols<3>(kAtt) * a_att;
+  } else {
+    u_x.setZero();
+    u_b.setZero();
+    for (int c = 0; c < kDim; ++c) {
+      const double a_c = m.a(c);
+      if (a_c == 0.0) continue;
+      u_x.noalias() += P.col(c) * a_c;
+      u_b.noalias() += P_bx.col(c) * a_c;
+    }
   }
   for (int k = 0; k < kMaxBiasAnchors; ++k) {
     const double e_k = m.a(kDim + k);
     if (e_k == 0.0) continue;
-    u_x.noalias() += b.cross().col(k) * e_k;
+    u_x.noalias() += P_bx.row(k).transpose() * e_k;
     u_b.noalias() += b.covariance().col(k) * e_k;
   }
 }
 
 }  // namespace
 
-InnovationStats Ekf::augmentedInnovation(const ScalarLinearMessage<kAugDim>& message) const {
-  ErrVec u_x;
-  BiasVec u_b;
-  jointGain(P_, *range_bias_, message, u_x, u_b);
-  InnovationStats st;
-  st.innovation_m = message.y;  // the prior error state [δx, δβ] is zero
-  st.innovation_var_m2 = message.a.head<kDim>().dot(u_x.transpose()) +
-                         message.a.tail<kMaxBiasAnchors>().dot(u_b.transpose()) + message.var;
-  st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
-  return st;
+Ekf::RangeBiasGain Ekf::augmentedGain(const ScalarLinearMessage<kAugDim>& message) const {
+  RangeBiasGain g;
+  jointGain(P_, *range_bias_, message, g.u_x, g.u_b);
+  g.h_u = message.a.head<kDim>().dot(g.u_x.transpose()) + message.a.tail<kMaxBiasAnchors>().dot(g.u_b.transpose());
+  return g;
 }
 
-std::optional<InnovationStats> Ekf::correctAugmented(const ScalarLinearMessage<kAugDim>& message) {
-  // (G18) the equality node on [δx, δβ] with the joint prior N(0, [[P, P_xβ], [P_xβᵀ, P_ββ]]) (F27c), by blocks:
-  // u = J hᵀ, S = h u + var, [δx, δβ] = u r/S, J ← J − w wᵀ with w = u/√S (detail::applyRankOneGain on the joint J).
-  ErrVec u_x;
-  BiasVec u_b;
-  jointGain(P_, *range_bias_, message, u_x, u_b);
+std::optional<InnovationStats> Ekf::correctAugmented(double y, double var, const RangeBiasGain& g) {
+  // (G18) the equality node on [δx, δβ] with the joint prior N(0, [[P, P_xβ], [P_βx, P_ββ]]) (F27c), by blocks:
+  // S = h u + var, [δx, δβ] = u r/S, J ← J − w wᵀ with w = u/√S (detail::applyRankOneGain on the joint J).
   InnovationStats st;
-  st.innovation_m = message.y;
-  st.innovation_var_m2 = message.a.head<kDim>().dot(u_x.transpose()) +
-                         message.a.tail<kMaxBiasAnchors>().dot(u_b.transpose()) + message.var;
+  st.innovation_m = y;  // the prior error state [δx, δβ] is zero
+  st.innovation_var_m2 = g.h_u + var;
   if (!(st.innovation_var_m2 > 0.0) || !std::isfinite(st.innovation_var_m2) || !std::isfinite(st.innovation_m))
     return std::nullopt;
   st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
   const double S = st.innovation_var_m2;
-  const ErrVec w_x = u_x * (1.0 / std::sqrt(S));
-  const BiasVec w_b = u_b * (1.0 / std::sqrt(S));
+  const double inv_sqrt_S = 1.0 / std::sqrt(S);
+  const ErrVec w_x = g.u_x * inv_sqrt_S;
   detail::rankOneDowndate<kDim>(P_, w_x);
-  range_bias_->downdate(w_x, w_b, u_b * (st.innovation_m / S));
-  inject(u_x * (st.innovation_m / S));  // (F8)
+  range_bias_->downdate(w_x, g.u_b * inv_sqrt_S, g.u_b * (st.innovation_m / S));
+  inject(g.u_x * (st.innovation_m / S));  // (F8)
   return st;
 }
 
-InnovationStats Ekf::innovationWithRangeBias(const ScalarLinearMessage<kDim>& message, int id_a, int id_b) {
-  if (!range_bias_) return innovation(message);
+Ekf::RangeBiasGain Ekf::rangeBiasGain(const ScalarLinearMessage<kDim>& message, int id_a, int id_b) {
   const int slot_a = range_bias_->slot(id_a), slot_b = range_bias_->slot(id_b);
-  return augmentedInnovation(augmentedMessage(message, slot_a, slot_b));
+  return augmentedGain(augmentedMessage(message, slot_a, slot_b));
 }
 
-std::optional<InnovationStats> Ekf::correctWithRangeBias(const ScalarLinearMessage<kDim>& message, int id_a,
-                                                         int id_b) {
-  if (!range_bias_) return correct(message);
-  const int slot_a = range_bias_->slot(id_a), slot_b = range_bias_->slot(id_b);
-  return correctAugmented(augmentedMessage(message, slot_a, slot_b));
+std::optional<InnovationStats> Ekf::correctWithRangeBias(const ScalarLinearMessage<kDim>& message,
+                                                         const RangeBiasGain& gain) {
+  return correctAugmented(message.y, message.var, gain);
 }
 
 void Ekf::scaleCovariance(double factor) {
@@ -348,7 +358,7 @@ void Ekf::scaleCovariance(double factor) {
 }
 
 std::optional<InnovationStats> Ekf::correct(const ScalarLinearMessage<kDim>& message) {
-  if (range_bias_) return correctAugmented(augmentedMessage(message, -1, -1));
+  if (range_bias_) return correctAugmented(message.y, message.var, augmentedGain(augmentedMessage(message, -1, -1)));
   // Paper Fig. 3: equality node between the predicted error state N(0, P) and the TDoA message (G18).
   ErrVec dx = ErrVec::Zero();
   const std::optional<InnovationStats> st = equalityRankOneInPlace<kDim>(dx, P_, message);
@@ -423,7 +433,7 @@ void Ekf::resetPosition(const Vec3& w_p_b, double sigma_m) {
   P_.middleRows<3>(kPos).setZero();
   P_.middleCols<3>(kPos).setZero();
   P_.block<3, 3>(kPos, kPos).diagonal().setConstant(sigma_m * sigma_m);
-  if (range_bias_) range_bias_->cross().middleRows<3>(kPos).setZero();
+  if (range_bias_) range_bias_->biasRows().middleCols<3>(kPos).setZero();
 }
 
 void Ekf::resetPositionVelocity(const Vec3& w_p_b, const Vec3& w_v_b, const Eigen::Matrix<double, 6, 6>& cov) {
@@ -433,7 +443,7 @@ void Ekf::resetPositionVelocity(const Vec3& w_p_b, const Vec3& w_v_b, const Eige
   P_.middleRows<6>(kPos).setZero();
   P_.middleCols<6>(kPos).setZero();
   P_.block<6, 6>(kPos, kPos) = 0.5 * (cov + cov.transpose());
-  if (range_bias_) range_bias_->cross().middleRows<6>(kPos).setZero();
+  if (range_bias_) range_bias_->biasRows().middleCols<6>(kPos).setZero();
 }
 
 void Ekf::inflateThrustBias(double sigma_mps2) { P_(kAccBias + 2, kAccBias + 2) += sigma_mps2 * sigma_mps2; }

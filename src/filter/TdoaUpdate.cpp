@@ -196,8 +196,12 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
   ErrVec P_a = ErrVec::Zero();
   double a_P_a = 0.0;
   InnovationStats st;
+  Ekf::RangeBiasGain gain;
   if (range_bias) {
-    st = ekf.innovationWithRangeBias(*msg, z.id_a, z.id_b);
+    gain = ekf.rangeBiasGain(*msg, z.id_a, z.id_b);
+    st.innovation_m = msg->y;
+    st.innovation_var_m2 = gain.h_u + msg->var;
+    st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
   } else {
     const ErrMat& P = ekf.covariance();
     const Vec3 a_p = msg->a.segment<3>(kPos).transpose();
@@ -221,7 +225,7 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
   res.weight = robustUpdateWeight(options.loss, options.robust_k, st.innovation_m, hph, msg->var,
                                   options.robust_iterations);
   msg->var /= res.weight;
-  const bool corrected = range_bias ? ekf.correctWithRangeBias(*msg, z.id_a, z.id_b).has_value()
+  const bool corrected = range_bias ? ekf.correctWithRangeBias(*msg, gain).has_value()
                                     : ekf.correctPositionAttitude(*msg, P_a, a_P_a).has_value();  // δp, δθ only (G16)
   if (!corrected) {
     res.outcome = UpdateOutcome::kDegenerate;

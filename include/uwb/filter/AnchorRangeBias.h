@@ -28,6 +28,8 @@ using AugMat = Eigen::Matrix<double, kAugDim, kAugDim>;
 using BiasVec = Eigen::Matrix<double, kMaxBiasAnchors, 1>;
 using BiasMat = Eigen::Matrix<double, kMaxBiasAnchors, kMaxBiasAnchors>;
 using CrossMat = Eigen::Matrix<double, kDim, kMaxBiasAnchors>;
+/// P_βx = P_xβᵀ, stored by bias rows: the TDoA update reads its δp and δθ columns (contiguous).
+using BiasRowsMat = Eigen::Matrix<double, kMaxBiasAnchors, kDim>;
 
 class AnchorRangeBias {
  public:
@@ -45,16 +47,16 @@ class AnchorRangeBias {
   double stddev(int id) const;
 
   /// (F27b) The Ornstein–Uhlenbeck transition over dt_s ≥ 0 with f = e^{−dt/τ}: β̂ ← f β̂, P_ββ ← f² P_ββ + (1 − f²) σ² I,
-  /// and the cross-covariance's β columns P_xβ ← P_xβ f (its δx rows are the Ekf's business, propagateCross).
+  /// and the cross-covariance P_βx ← f P_βx (its δx side is the Ekf's business: P_βx ← P_βx Φᵀ).
   void decay(double dt_s);
 
   /// The joint covariance's cross and bias blocks times factor (a covariance intersection's P/ω, G21).
   void scale(double factor) {
-    P_xb_ *= factor;
+    P_bx_ *= factor;
     P_bb_ *= factor;
   }
 
-  /// The bias part of a rank-one correction of the joint covariance (G18): P_xβ ← P_xβ − w_x w_βᵀ,
+  /// The bias part of a rank-one correction of the joint covariance (G18): P_βx ← P_βx − w_β w_xᵀ,
   /// P_ββ ← P_ββ − w_β w_βᵀ, β̂ ← β̂ + dbeta (the Ekf downdates P by w_x w_xᵀ).
   void downdate(const ErrVec& w_x, const BiasVec& w_b, const BiasVec& dbeta);
 
@@ -62,8 +64,11 @@ class AnchorRangeBias {
   AugMat joint(const ErrMat& P) const;
 
   const BiasVec& means() const { return beta_; }
-  CrossMat& cross() { return P_xb_; }
-  const CrossMat& cross() const { return P_xb_; }
+  /// P_βx = Cov(δβ, δx) (kMaxBiasAnchors × 15).
+  BiasRowsMat& biasRows() { return P_bx_; }
+  const BiasRowsMat& biasRows() const { return P_bx_; }
+  /// P_xβ = P_βxᵀ (15 × kMaxBiasAnchors).
+  CrossMat cross() const { return P_bx_.transpose(); }
   const BiasMat& covariance() const { return P_bb_; }
   double sigma() const { return sigma_m_; }
   double tau() const { return tau_s_; }
@@ -74,7 +79,7 @@ class AnchorRangeBias {
   std::array<int, kMaxBiasAnchors> ids_{};
   int n_ = 0;
   BiasVec beta_ = BiasVec::Zero();
-  CrossMat P_xb_ = CrossMat::Zero();
+  BiasRowsMat P_bx_ = BiasRowsMat::Zero();
   BiasMat P_bb_;
 };
 

@@ -88,12 +88,19 @@ class Ekf {
   const AnchorRangeBias* rangeBias() const { return range_bias_ ? &*range_bias_ : nullptr; }
   /// β̂_B − β̂_A: the TDoA bias of pair (A, B) the states predict [m]; 0 when off.
   double rangeBiasDifference(int id_a, int id_b) const;
-  /// (F27c) Innovation statistics of a TDoA message of pair (A, B) on the augmented state: its row gains −1 at δβ_A and
-  /// +1 at δβ_B (the anchors get a state on first sight). message.y must already exclude β̂_B − β̂_A. Without range-bias
-  /// states: innovation(message).
-  InnovationStats innovationWithRangeBias(const ScalarLinearMessage<kDim>& message, int id_a, int id_b);
-  /// (F27c) The correction with that augmented row, followed by the reset (F8); correct(message) when off.
-  std::optional<InnovationStats> correctWithRangeBias(const ScalarLinearMessage<kDim>& message, int id_a, int id_b);
+  /// u = J hᵀ of a message on the augmented state [δx, δβ] with joint covariance J (G18), and h u.
+  struct RangeBiasGain {
+    ErrVec u_x = ErrVec::Zero();
+    BiasVec u_b = BiasVec::Zero();
+    double h_u = 0.0;  ///< h J hᵀ: the innovation variance is h_u + the message's var (G17)
+  };
+  /// (F27c) The gain of a TDoA message of pair (A, B) on the augmented state: its row gains −1 at δβ_A and +1 at δβ_B
+  /// (the anchors get a state on first sight). message.y must already exclude β̂_B − β̂_A. Requires rangeBias().
+  RangeBiasGain rangeBiasGain(const ScalarLinearMessage<kDim>& message, int id_a, int id_b);
+  /// (F27c) The correction with that gain (u does not depend on the message's var, which the caller may have changed
+  /// since, e.g. by a robust weight), followed by the reset (F8) of δx and β̂ += δβ. Requires rangeBias().
+  std::optional<InnovationStats> correctWithRangeBias(const ScalarLinearMessage<kDim>& message,
+                                                      const RangeBiasGain& gain);
 
   /// Zero-velocity update v = 0 with std sigma_mps per axis (F14), three scalar corrections.
   void zeroVelocityUpdate(double sigma_mps);
@@ -133,10 +140,10 @@ class Ekf {
   /// The message on [δx, δβ]: its δx row, −1 at slot_a and +1 at slot_b (a slot < 0: no entry).
   ScalarLinearMessage<kAugDim> augmentedMessage(const ScalarLinearMessage<kDim>& message, int slot_a,
                                                 int slot_b) const;
-  /// (G17) innovation statistics of a message on the augmented state.
-  InnovationStats augmentedInnovation(const ScalarLinearMessage<kAugDim>& message) const;
-  /// (G18) on the augmented state, then the reset (F8) of δx and β̂ += δβ.
-  std::optional<InnovationStats> correctAugmented(const ScalarLinearMessage<kAugDim>& message);
+  /// The gain of a message on the augmented state (jointGain).
+  RangeBiasGain augmentedGain(const ScalarLinearMessage<kAugDim>& message) const;
+  /// (G18) on the augmented state with its gain, then the reset (F8) of δx and β̂ += δβ.
+  std::optional<InnovationStats> correctAugmented(double y, double var, const RangeBiasGain& gain);
 };
 
 /// The initial covariance from the params' init_* sigmas (F1).

@@ -1,0 +1,95 @@
+#!/usr/bin/env python3
+"""The bias-correction splits of docs/math/filter.md F24 and F27: does a GP model of other flights help the filter on a
+flight it was not trained on, with and without the range-bias states learned online (F27)?
+
+Splits (util-pilot TDoA2 flights; a model is `uwbtdoa train TRAIN... --kernel tdoa --inducing 30`):
+  0426 1->1   a model of one 0426 flight on each other 0426 flight (12 pairs)
+  0426 LOO    each 0426 flight with a model of the three others (4)
+  0425->0426  a model of the 12 TDoA2 flights of 0425 on each 0426 flight (4)
+  0425 1->1   models of 0425-traj1, 6 and 11 on each other 0425 flight (33)
+  0425 LOO    each 0425 flight with a model of the 11 others (12)
+  0426->0425  a model of the four 0426 flights on each 0425 flight (12)
+For each test flight `uwbtdoa localize FLIGHT --json` gives the airborne RMSE for four filters: without the range-bias
+states (--range-bias-sigma-m 0 --tdoa-sigma-m 0.35), uncorrected and with the model ("offline"); with them (the
+defaults), uncorrected ("online") and with the model ("offline + online"). Change = 100 (RMSE / reference - 1).
+
+Usage: scripts/bias_splits.py [BUILD_DIR]   (data: $UWBTDOA_DATA or ../shared/data)
+"""
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+
+BUILD = sys.argv[1] if len(sys.argv) > 1 else "build"
+CLI = os.path.join(BUILD, "uwbtdoa")
+DATA = os.environ.get("UWBTDOA_DATA", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared",
+                                                   "data"))
+PILOT = os.path.join(DATA, "real", "util-pilot")
+PLAIN = ["--range-bias-sigma-m", "0", "--tdoa-sigma-m", "0.35"]
+FLIGHTS = {"0425": [f"0425-traj{i}" for i in range(1, 13)], "0426": [f"0426-traj{i}" for i in (1, 2, 11, 12)]}
+
+
+def path(name):
+    return os.path.join(PILOT, name[:4], name + ".csv")
+
+
+def survey(session):
+    return os.path.join(PILOT, "survey", f"anchor_{session}_survey.txt")
+
+
+def train(names, out):
+    session = names[0][:4]
+    subprocess.run([CLI, "train", *map(path, names), "--anchors", survey(session), "--kernel", "tdoa", "--inducing",
+                    "30", "--out", out], check=True, capture_output=True)
+
+
+def rmse(name, flags):
+    cmd = [CLI, "localize", path(name), "--anchors", survey(name[:4]), "--json", *flags]
+    return json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)["rmse_airborne_m"]
+
+
+def splits():
+    s = []
+    for session in ("0426", "0425"):
+        f = FLIGHTS[session]
+        models = f if session == "0426" else ["0425-traj1", "0425-traj6", "0425-traj11"]
+        s.append((f"{session} 1->1", [([m], t) for m in models for t in f if t != m]))
+        s.append((f"{session} LOO", [([o for o in f if o != t], t) for t in f]))
+        other = "0425" if session == "0426" else "0426"
+        s.append((f"{other}->{session}", [(FLIGHTS[other], t) for t in f]))
+    return s
+
+
+def main():
+    cache, base = {}, {}
+    print(f"{'split':11s} {'n':>3s} | {'offline vs plain':>22s} | {'online vs plain':>22s} | "
+          f"{'off+on vs plain':>22s} | {'off+on vs online':>22s}")
+    with tempfile.TemporaryDirectory() as tmp:
+        for label, pairs in splits():
+            ch = {k: [] for k in ("offline", "online", "both", "both_vs_online")}
+            for train_set, test in pairs:
+                key = tuple(train_set)
+                if key not in cache:
+                    cache[key] = os.path.join(tmp, f"model{len(cache)}.json")
+                    train(train_set, cache[key])
+                if test not in base:
+                    base[test] = (rmse(test, PLAIN), rmse(test, []))
+                plain, online = base[test]
+                offline = rmse(test, PLAIN + ["--bias-model", cache[key]])
+                both = rmse(test, ["--bias-model", cache[key]])
+                ch["offline"].append(100 * (offline / plain - 1))
+                ch["online"].append(100 * (online / plain - 1))
+                ch["both"].append(100 * (both / plain - 1))
+                ch["both_vs_online"].append(100 * (both / online - 1))
+
+            def cell(v):
+                return f"{statistics.mean(v):+6.1f} {max(v):+6.1f} {sum(x > 1 for x in v):3d}"
+            print(f"{label:11s} {len(pairs):3d} | {cell(ch['offline']):>22s} | {cell(ch['online']):>22s} | "
+                  f"{cell(ch['both']):>22s} | {cell(ch['both_vs_online']):>22s}", flush=True)
+    print("cells: mean change [%], worst change [%], flights above +1 %")
+
+
+if __name__ == "__main__":
+    main()
