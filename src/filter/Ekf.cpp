@@ -65,8 +65,8 @@ namespace {
 /// last packet covers the last 4 rows and overlaps the one before; both give the overlapping rows the same value
 /// (the same additions from the same loaded values), so no row is updated twice. `cols` must not overlap the written
 /// columns.
-template <int Rows, class Columns>
-void addColumnBlockTimesTransposed(ErrMat& out, int j, const Columns& cols, const Mat3& B) {
+template <int Rows, class Matrix, class Columns>
+void addColumnBlockTimesTransposed(Matrix& out, int j, const Columns& cols, const Mat3& B) {
   static_assert(Rows >= 4);
   constexpr int kPackets = (Rows + 3) / 4;
   constexpr auto start = [](int p) { return std::min(4 * p, Rows - 4); };
@@ -79,9 +79,10 @@ void addColumnBlockTimesTransposed(ErrMat& out, int j, const Columns& cols, cons
   }
 }
 
-/// The first Rows rows of M ← M Φᵀ in place, using the block structure of Φ (F7).
-template <int Rows>
-void rightMultiplyTransposedTopRows(const AccumulatedTransition& phi, ErrMat& M) {
+/// The first Rows rows of M ← M Φᵀ in place, using the block structure of Φ (F7); M has the 15 columns of δx (P, or the
+/// range-bias rows P_βx of F27b).
+template <int Rows, class Matrix>
+void rightMultiplyTransposedTopRows(const AccumulatedTransition& phi, Matrix& M) {
   // Column blocks of M Φᵀ = (Φ Mᵀ)ᵀ: column block j of the result is Σ_k M_{:,k} Φ_jkᵀ; bias columns are unchanged.
   // Written in the order position, velocity, attitude: each block reads only blocks that are still unchanged, except
   // the attitude block, which reads its own old value (kept in a copy).
@@ -229,7 +230,7 @@ void Ekf::propagateCovariance() {
     return;
   }
   if (range_bias_) {
-    range_bias_->biasRows() = range_bias_->biasRows() * phi_.dense().transpose();  // P_βx ← P_βx Φᵀ
+    rightMultiplyTransposedTopRows<kMaxBiasAnchors>(phi_, range_bias_->biasRows());  // P_βx ← P_βx Φᵀ
     range_bias_->decay(T_pending);
   }
   // docs/math/filter.md (F7): P ← Φ P Φᵀ + Q(T). With A = (δp, δv, δθ) (rows 0..8) and B = the biases (rows 9..14),
