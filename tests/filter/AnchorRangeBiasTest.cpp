@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <initializer_list>
 #include <random>
 
 #include "FilterTestUtil.h"
@@ -43,6 +44,19 @@ NavState hoverState() {
   return x;
 }
 
+/// A filter with range-bias states whose blocks are correlated with δx by the TDoA corrections `warmup` (no gate, no
+/// robust weight), from a random covariance; the TDoA options used are returned in `opt`.
+Ekf correlatedFilter(const EkfParams& params, unsigned seed, std::initializer_list<TdoaObservation> warmup,
+                     TdoaUpdateOptions* opt) {
+  Ekf ekf(params);
+  ekf.initialize(hoverState(), randomCovariance(seed));
+  opt->gate_sigma = 0.0;
+  opt->loss = RobustLoss::kNone;
+  const AnchorTable anchors = filtertest::arenaAnchors();
+  for (const TdoaObservation& z : warmup) updateTdoa(ekf, anchors, z, *opt);
+  return ekf;
+}
+
 TEST(AnchorRangeBias, SlotsAreGivenOnFirstSightUntilFull) {
   AnchorRangeBias b(0.2, 2.0);
   EXPECT_EQ(b.findSlot(7), -1);
@@ -59,12 +73,8 @@ TEST(AnchorRangeBias, SlotsAreGivenOnFirstSightUntilFull) {
 
 TEST(AnchorRangeBias, DecayIsTheOrnsteinUhlenbeckTransitionAndComposes) {
   // GIVEN a state with a mean, a cross-covariance and a correlated bias block (from a correction)
-  Ekf ekf(rangeBiasParams(0.2, 2.0));
-  ekf.initialize(hoverState(), randomCovariance(1));
-  const AnchorTable anchors = filtertest::arenaAnchors();
   TdoaUpdateOptions opt;
-  opt.gate_sigma = 0.0;
-  updateTdoa(ekf, anchors, {0.0, 0, 1, 0.7}, opt);
+  const Ekf ekf = correlatedFilter(rangeBiasParams(0.2, 2.0), 1, {{0.0, 0, 1, 0.7}}, &opt);
   AnchorRangeBias once = *ekf.rangeBias(), twice = *ekf.rangeBias();
   // WHEN decaying over 0.3 s at once, or over 0.1 s and then 0.2 s
   once.decay(0.3);
@@ -85,14 +95,10 @@ TEST(AnchorRangeBias, DecayIsTheOrnsteinUhlenbeckTransitionAndComposes) {
 
 TEST(EkfRangeBias, TdoaCorrectionIsTheKalmanUpdateOfTheAugmentedState) {
   // GIVEN a filter with range-bias states correlated with δx by earlier corrections
-  Ekf ekf(rangeBiasParams());
-  ekf.initialize(hoverState(), randomCovariance(2));
-  const AnchorTable anchors = filtertest::arenaAnchors();
   TdoaUpdateOptions opt;
-  opt.gate_sigma = 0.0;
-  opt.loss = RobustLoss::kNone;
-  const TdoaObservation warmup[] = {{0.0, 0, 1, 0.4}, {0.0, 1, 2, -0.9}, {0.0, 2, 3, 1.3}, {0.0, 7, 0, 0.2}};
-  for (const TdoaObservation& z : warmup) updateTdoa(ekf, anchors, z, opt);
+  Ekf ekf = correlatedFilter(rangeBiasParams(), 2,
+                             {{0.0, 0, 1, 0.4}, {0.0, 1, 2, -0.9}, {0.0, 2, 3, 1.3}, {0.0, 7, 0, 0.2}}, &opt);
+  const AnchorTable anchors = filtertest::arenaAnchors();
   const AugMat J0 = ekf.rangeBias()->joint(ekf.covariance());
   const BiasVec beta0 = ekf.rangeBias()->means();
   const NavState x0 = ekf.state();
@@ -131,13 +137,8 @@ TEST(EkfRangeBias, TdoaCorrectionIsTheKalmanUpdateOfTheAugmentedState) {
 TEST(EkfRangeBias, ImuPropagationIsTheAugmentedTransition) {
   // GIVEN a filter with cross-covariances, and the same IMU steps accumulated by hand
   EkfParams params = rangeBiasParams(0.25, 1.5);
-  Ekf ekf(params);
-  ekf.initialize(hoverState(), randomCovariance(3));
-  const AnchorTable anchors = filtertest::arenaAnchors();
   TdoaUpdateOptions opt;
-  opt.gate_sigma = 0.0;
-  updateTdoa(ekf, anchors, {0.0, 3, 4, 0.5}, opt);
-  updateTdoa(ekf, anchors, {0.0, 5, 6, -0.2}, opt);
+  Ekf ekf = correlatedFilter(params, 3, {{0.0, 3, 4, 0.5}, {0.0, 5, 6, -0.2}}, &opt);
   const CrossMat cross0 = ekf.rangeBias()->cross();
   const BiasMat Pbb0 = ekf.rangeBias()->covariance();
   Ekf plain(EkfParams{});  // the same filter without range-bias states gives the δx block
@@ -171,12 +172,8 @@ TEST(EkfRangeBias, TdoaOnlyPropagationIsTheAugmentedTransition) {
   // GIVEN a TDoA-only (constant-velocity) filter with cross-covariances
   EkfParams params = rangeBiasParams(0.2, 3.0);
   params.process_model = ProcessModel::kConstantVelocity;
-  Ekf ekf(params);
-  ekf.initialize(hoverState(), randomCovariance(4));
-  const AnchorTable anchors = filtertest::arenaAnchors();
   TdoaUpdateOptions opt;
-  opt.gate_sigma = 0.0;
-  updateTdoa(ekf, anchors, {0.0, 2, 3, 0.1}, opt);
+  Ekf ekf = correlatedFilter(params, 4, {{0.0, 2, 3, 0.1}}, &opt);
   const CrossMat cross0 = ekf.rangeBias()->cross();
   // WHEN 0.05 s pass
   const double T = 0.05;
@@ -189,12 +186,8 @@ TEST(EkfRangeBias, TdoaOnlyPropagationIsTheAugmentedTransition) {
 }
 
 TEST(EkfRangeBias, ResetsClearTheCrossCovarianceOfWhatTheyReset) {
-  Ekf ekf(rangeBiasParams());
-  ekf.initialize(hoverState(), randomCovariance(5));
-  const AnchorTable anchors = filtertest::arenaAnchors();
   TdoaUpdateOptions opt;
-  opt.gate_sigma = 0.0;
-  updateTdoa(ekf, anchors, {0.0, 0, 1, 0.3}, opt);
+  Ekf ekf = correlatedFilter(rangeBiasParams(), 5, {{0.0, 0, 1, 0.3}}, &opt);
   ASSERT_GT(ekf.rangeBias()->cross().middleRows<3>(kPos).norm(), 0.0);
   ekf.resetPosition(Vec3(1, 2, 1), 0.5);
   EXPECT_EQ(ekf.rangeBias()->cross().middleRows<3>(kPos).norm(), 0.0);
