@@ -345,7 +345,33 @@ std::optional<InnovationStats> Ekf::correctAugmented(double y, double var, const
 
 Ekf::RangeBiasGain Ekf::rangeBiasGain(const ScalarLinearMessage<kDim>& message, int id_a, int id_b) {
   const int slot_a = range_bias_->slot(id_a), slot_b = range_bias_->slot(id_b);
-  return augmentedGain(augmentedMessage(message, slot_a, slot_b));
+  if (!message.a.segment<3>(kVel).isZero() || !message.a.segment<6>(kAccBias).isZero())
+    return augmentedGain(augmentedMessage(message, slot_a, slot_b));
+  // jointGain for a TDoA row h = [a, e_B − e_A] (a non-zero in δp and δθ only) without forming the 31-entry row:
+  // with v = P_βx aᵀ, u = [P aᵀ + P_xβ (e_B − e_A); v + P_ββ (e_B − e_A)] and
+  // h u = a P aᵀ + 2 (v_B − v_A) + P_ββ,BB + P_ββ,AA − 2 P_ββ,AB (a slot < 0 contributes nothing)
+  const BiasRowsMat& P_bx = range_bias_->biasRows();
+  const BiasMat& P_bb = range_bias_->covariance();
+  const Vec3 a_p = message.a.segment<3>(kPos).transpose(), a_att = message.a.segment<3>(kAtt).transpose();
+  RangeBiasGain g;
+  g.u_x.noalias() = P_.middleCols<3>(kPos) * a_p;
+  g.u_x.noalias() += P_.middleCols<3>(kAtt) * a_att;
+  g.u_b.noalias() = P_bx.middleCols<3>(kPos) * a_p;
+  g.u_b.noalias() += P_bx.middleCols<3>(kAtt) * a_att;
+  const auto entry = [](const BiasVec& v, int k) { return k < 0 ? 0.0 : v(k); };
+  const auto cov = [&P_bb](int i, int j) { return i < 0 || j < 0 ? 0.0 : P_bb(i, j); };
+  g.h_u = a_p.dot(g.u_x.segment<3>(kPos)) + a_att.dot(g.u_x.segment<3>(kAtt)) +
+          2.0 * (entry(g.u_b, slot_b) - entry(g.u_b, slot_a)) + cov(slot_b, slot_b) + cov(slot_a, slot_a) -
+          2.0 * cov(slot_a, slot_b);
+  if (slot_b >= 0) {
+    g.u_x.noalias() += P_bx.row(slot_b).transpose();
+    g.u_b.noalias() += P_bb.col(slot_b);
+  }
+  if (slot_a >= 0) {
+    g.u_x.noalias() -= P_bx.row(slot_a).transpose();
+    g.u_b.noalias() -= P_bb.col(slot_a);
+  }
+  return g;
 }
 
 std::optional<InnovationStats> Ekf::correctWithRangeBias(const ScalarLinearMessage<kDim>& message,
