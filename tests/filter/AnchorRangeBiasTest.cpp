@@ -134,6 +134,40 @@ TEST(EkfRangeBias, TdoaCorrectionIsTheKalmanUpdateOfTheAugmentedState) {
   EXPECT_LT((dx_node - dx).norm(), 1e-12);
 }
 
+/// The dense Kalman update of the joint state [δx, δβ] with covariance J by the scalar row h, innovation y, variance r.
+void denseUpdate(AugMat& J, AugVec& dx, const Eigen::Matrix<double, 1, kAugDim>& h, double y, double r) {
+  const double S = (h * J * h.transpose())(0, 0) + r;
+  const AugVec K = J * h.transpose() / S;
+  dx += K * (y - (h * dx)(0, 0));
+  J -= K * S * K.transpose();
+}
+
+TEST(EkfRangeBias, MessagesOnTheStateAloneMoveTheBiasesThroughTheCrossCovariance) {
+  // GIVEN a filter with correlated range-bias states
+  TdoaUpdateOptions opt;
+  Ekf ekf = correlatedFilter(rangeBiasParams(), 6, {{0.0, 0, 1, 0.4}, {0.0, 3, 4, -0.6}, {0.0, 5, 6, 0.9}}, &opt);
+  AugMat J = ekf.rangeBias()->joint(ekf.covariance());
+  const BiasVec beta0 = ekf.rangeBias()->means();
+  const NavState x0 = ekf.state();
+  // WHEN a height and the zero-velocity messages (rows on δp and δv only, F14, F22) are applied
+  ekf.positionUpdate(2, 1.1, 0.05);
+  ekf.zeroVelocityUpdate(0.02);
+  // THEN they are the dense Kalman updates of [δx, δβ] (F27c): β̂ moves although no row reaches it
+  AugVec dx = AugVec::Zero();
+  Eigen::Matrix<double, 1, kAugDim> h = Eigen::Matrix<double, 1, kAugDim>::Zero();
+  h(kPos + 2) = 1.0;
+  denseUpdate(J, dx, h, 1.1 - x0.w_p_b.z(), 0.05 * 0.05);
+  for (int i = 0; i < 3; ++i) {
+    h.setZero();
+    h(kVel + i) = 1.0;
+    denseUpdate(J, dx, h, -x0.w_v_b(i), 0.02 * 0.02);
+  }
+  EXPECT_LT((ekf.rangeBias()->joint(ekf.covariance()) - J).norm(), 1e-10);
+  EXPECT_LT((ekf.rangeBias()->means() - (beta0 + dx.tail<kMaxBiasAnchors>())).norm(), 1e-10);
+  EXPECT_GT(dx.tail<kMaxBiasAnchors>().norm(), 1e-6);
+  EXPECT_LT((ekf.state().w_v_b - (x0.w_v_b + dx.segment<3>(kVel))).norm(), 1e-10);
+}
+
 TEST(EkfRangeBias, ImuPropagationIsTheAugmentedTransition) {
   // GIVEN a filter with cross-covariances, and the same IMU steps accumulated by hand
   EkfParams params = rangeBiasParams(0.25, 1.5);
