@@ -199,9 +199,6 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
   Ekf::RangeBiasGain gain;
   if (range_bias) {
     gain = ekf.rangeBiasGain(*msg, z.id_a, z.id_b);
-    st.innovation_m = msg->y;
-    st.innovation_var_m2 = gain.h_u + msg->var;
-    st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
   } else {
     const ErrMat& P = ekf.covariance();
     const Vec3 a_p = msg->a.segment<3>(kPos).transpose();
@@ -209,10 +206,10 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
     P_a.noalias() = P.middleCols<3>(kPos) * a_p;
     P_a.noalias() += P.middleCols<3>(kAtt) * a_att;
     a_P_a = a_p.dot(P_a.segment<3>(kPos)) + a_att.dot(P_a.segment<3>(kAtt));
-    st.innovation_m = msg->y;  // prior error state is zero
-    st.innovation_var_m2 = a_P_a + msg->var;
-    st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
   }
+  st.innovation_m = msg->y;  // prior error state is zero
+  st.innovation_var_m2 = (range_bias ? gain.h_u : a_P_a) + msg->var;
+  st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
   res.innovation_m = st.innovation_m;
   res.nis = st.nis;
   res.innovation_var_m2 = st.innovation_var_m2;
