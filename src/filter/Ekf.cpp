@@ -255,11 +255,9 @@ void Ekf::propagateCovariance() {
 
 InnovationStats Ekf::innovation(const ScalarLinearMessage<kDim>& message) const {
   if (range_bias_) {
-    const ScalarLinearMessage<kAugDim> m = augmentedMessage(message, -1, -1);
-    const RangeBiasGain g = augmentedGain(m);
     InnovationStats st;
     st.innovation_m = message.y;
-    st.innovation_var_m2 = g.h_u + message.var;
+    st.innovation_var_m2 = jointGain(message.a, -1, -1).h_u + message.var;
     st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
     return st;
   }
@@ -270,64 +268,45 @@ double Ekf::rangeBiasDifference(int id_a, int id_b) const {
   return range_bias_ ? range_bias_->mean(id_b) - range_bias_->mean(id_a) : 0.0;
 }
 
-ScalarLinearMessage<kAugDim> Ekf::augmentedMessage(const ScalarLinearMessage<kDim>& message, int slot_a,
-                                                   int slot_b) const {
-  // (F27c) z − ẑ − (β̂_B − β̂_A) = a δx + δβ_B − δβ_A + e
-  ScalarLinearMessage<kAugDim> m;
-  m.a.setZero();
-  m.a.head<kDim>() = message.a;
-  if (slot_a >= 0) m.a(kDim + slot_a) -= 1.0;
-  if (slot_b >= 0) m.a(kDim + slot_b) += 1.0;
-  m.y = message.y;
-  m.var = message.var;
-  return m;
-}
-
-namespace {
-
-/// u = J hᵀ for the joint covariance J = [[P, P_xβ], [P_βx, P_ββ]] and a row h = [a, e], from the blocks and the
-/// non-zero entries of h: the same u as J hᵀ up to summation order. A TDoA row (G16) is non-zero only in δp and δθ
-/// and at two anchors: those are read as 3-column blocks (as equalityRankOneTwoBlocksInPlace); other rows by entry.
-void jointGain(const ErrMat& P, const AnchorRangeBias& b, const ScalarLinearMessage<kAugDim>& m, ErrVec& u_x,
-               BiasVec& u_b) {
-  const BiasRowsMat& P_bx = b.biasRows();
-  const bool two_blocks = m.a.segment<3>(kVel).isZero() && m.a.segment<6>(kAccBias).isZero();
-  if (two_blocks) {
-    const Vec3 a_p = m.a.segment<3>(kPos).transpose(), a_att = m.a.segment<3>(kAtt).transpose();
-    u_x.noalias() = P.middleCols<3>(kPos) * a_p;
-    u_x.noalias() += P.middleCols<3>(kAtt) * a_att;
-    u_b.noalias() = P_bx.middleCols<3>(kPos) * a_p;
-    u_b.noalias() += P_bx.middleCols<3>(kAtt) * a_att;
+Ekf::RangeBiasGain Ekf::jointGain(const ErrRow& a, int slot_a, int slot_b) const {
+  // (F27c) u = J hᵀ for the joint covariance J = [[P, P_xβ], [P_βx, P_ββ]] and the row h = [a, e_B − e_A] (no entry for
+  // a slot < 0), from the blocks: with v = P_βx aᵀ, u = [P aᵀ + P_xβ (e_B − e_A); v + P_ββ (e_B − e_A)] and
+  // h u = a P aᵀ + 2 (v_B − v_A) + P_ββ,BB + P_ββ,AA − 2 P_ββ,AB. A TDoA row a (G16) is non-zero only in δp and δθ: those
+  // are read as 3-column blocks (as equalityRankOneTwoBlocksInPlace); other rows (ZUPT, floor, ToF) by entry.
+  const BiasRowsMat& P_bx = range_bias_->biasRows();
+  const BiasMat& P_bb = range_bias_->covariance();
+  RangeBiasGain g;
+  if (a.segment<3>(kVel).isZero() && a.segment<6>(kAccBias).isZero()) {
+    const Vec3 a_p = a.segment<3>(kPos).transpose(), a_att = a.segment<3>(kAtt).transpose();
+    g.u_x.noalias() = P_.middleCols<3>(kPos) * a_p;
+    g.u_x.noalias() += P_.middleCols<3>(kAtt) * a_att;
+    g.u_b.noalias() = P_bx.middleCols<3>(kPos) * a_p;
+    g.u_b.noalias() += P_bx.middleCols<3>(kAtt) * a_att;
   } else {
-    u_x.setZero();
-    u_b.setZero();
     for (int c = 0; c < kDim; ++c) {
-      const double a_c = m.a(c);
-      if (a_c == 0.0) continue;
-      u_x.noalias() += P.col(c) * a_c;
-      u_b.noalias() += P_bx.col(c) * a_c;
+      if (a(c) == 0.0) continue;
+      g.u_x.noalias() += P_.col(c) * a(c);
+      g.u_b.noalias() += P_bx.col(c) * a(c);
     }
   }
-  for (int k = 0; k < kMaxBiasAnchors; ++k) {
-    const double e_k = m.a(kDim + k);
-    if (e_k == 0.0) continue;
-    u_x.noalias() += P_bx.row(k).transpose() * e_k;
-    u_b.noalias() += b.covariance().col(k) * e_k;
+  const auto entry = [](const BiasVec& v, int k) { return k < 0 ? 0.0 : v(k); };
+  const auto cov = [&P_bb](int i, int j) { return i < 0 || j < 0 ? 0.0 : P_bb(i, j); };
+  g.h_u = a.dot(g.u_x.transpose()) + 2.0 * (entry(g.u_b, slot_b) - entry(g.u_b, slot_a)) + cov(slot_b, slot_b) +
+          cov(slot_a, slot_a) - 2.0 * cov(slot_a, slot_b);
+  if (slot_b >= 0) {
+    g.u_x.noalias() += P_bx.row(slot_b).transpose();
+    g.u_b.noalias() += P_bb.col(slot_b);
   }
-}
-
-}  // namespace
-
-Ekf::RangeBiasGain Ekf::augmentedGain(const ScalarLinearMessage<kAugDim>& message) const {
-  RangeBiasGain g;
-  jointGain(P_, *range_bias_, message, g.u_x, g.u_b);
-  g.h_u = message.a.head<kDim>().dot(g.u_x.transpose()) + message.a.tail<kMaxBiasAnchors>().dot(g.u_b.transpose());
+  if (slot_a >= 0) {
+    g.u_x.noalias() -= P_bx.row(slot_a).transpose();
+    g.u_b.noalias() -= P_bb.col(slot_a);
+  }
   return g;
 }
 
 std::optional<InnovationStats> Ekf::correctAugmented(double y, double var, const RangeBiasGain& g) {
-  // (G18) the equality node on [δx, δβ] with the joint prior N(0, [[P, P_xβ], [P_βx, P_ββ]]) (F27c), by blocks:
-  // S = h u + var, [δx, δβ] = u r/S, J ← J − w wᵀ with w = u/√S (detail::applyRankOneGain on the joint J).
+  // (G18) the equality node on [δx, δβ] with the joint prior N(0, J) (F27c), by blocks: S = h u + var,
+  // [δx, δβ] = u r/S, J ← J − w wᵀ with w = u/√S (detail::applyRankOneGain on the joint J).
   InnovationStats st;
   st.innovation_m = y;  // the prior error state [δx, δβ] is zero
   st.innovation_var_m2 = g.h_u + var;
@@ -345,33 +324,7 @@ std::optional<InnovationStats> Ekf::correctAugmented(double y, double var, const
 
 Ekf::RangeBiasGain Ekf::rangeBiasGain(const ScalarLinearMessage<kDim>& message, int id_a, int id_b) {
   const int slot_a = range_bias_->slot(id_a), slot_b = range_bias_->slot(id_b);
-  if (!message.a.segment<3>(kVel).isZero() || !message.a.segment<6>(kAccBias).isZero())
-    return augmentedGain(augmentedMessage(message, slot_a, slot_b));
-  // jointGain for a TDoA row h = [a, e_B − e_A] (a non-zero in δp and δθ only) without forming the 31-entry row:
-  // with v = P_βx aᵀ, u = [P aᵀ + P_xβ (e_B − e_A); v + P_ββ (e_B − e_A)] and
-  // h u = a P aᵀ + 2 (v_B − v_A) + P_ββ,BB + P_ββ,AA − 2 P_ββ,AB (a slot < 0 contributes nothing)
-  const BiasRowsMat& P_bx = range_bias_->biasRows();
-  const BiasMat& P_bb = range_bias_->covariance();
-  const Vec3 a_p = message.a.segment<3>(kPos).transpose(), a_att = message.a.segment<3>(kAtt).transpose();
-  RangeBiasGain g;
-  g.u_x.noalias() = P_.middleCols<3>(kPos) * a_p;
-  g.u_x.noalias() += P_.middleCols<3>(kAtt) * a_att;
-  g.u_b.noalias() = P_bx.middleCols<3>(kPos) * a_p;
-  g.u_b.noalias() += P_bx.middleCols<3>(kAtt) * a_att;
-  const auto entry = [](const BiasVec& v, int k) { return k < 0 ? 0.0 : v(k); };
-  const auto cov = [&P_bb](int i, int j) { return i < 0 || j < 0 ? 0.0 : P_bb(i, j); };
-  g.h_u = a_p.dot(g.u_x.segment<3>(kPos)) + a_att.dot(g.u_x.segment<3>(kAtt)) +
-          2.0 * (entry(g.u_b, slot_b) - entry(g.u_b, slot_a)) + cov(slot_b, slot_b) + cov(slot_a, slot_a) -
-          2.0 * cov(slot_a, slot_b);
-  if (slot_b >= 0) {
-    g.u_x.noalias() += P_bx.row(slot_b).transpose();
-    g.u_b.noalias() += P_bb.col(slot_b);
-  }
-  if (slot_a >= 0) {
-    g.u_x.noalias() -= P_bx.row(slot_a).transpose();
-    g.u_b.noalias() -= P_bb.col(slot_a);
-  }
-  return g;
+  return jointGain(message.a, slot_a, slot_b);
 }
 
 std::optional<InnovationStats> Ekf::correctWithRangeBias(const ScalarLinearMessage<kDim>& message,
@@ -385,7 +338,7 @@ void Ekf::scaleCovariance(double factor) {
 }
 
 std::optional<InnovationStats> Ekf::correct(const ScalarLinearMessage<kDim>& message) {
-  if (range_bias_) return correctAugmented(message.y, message.var, augmentedGain(augmentedMessage(message, -1, -1)));
+  if (range_bias_) return correctAugmented(message.y, message.var, jointGain(message.a, -1, -1));
   // Paper Fig. 3: equality node between the predicted error state N(0, P) and the TDoA message (G18).
   ErrVec dx = ErrVec::Zero();
   const std::optional<InnovationStats> st = equalityRankOneInPlace<kDim>(dx, P_, message);

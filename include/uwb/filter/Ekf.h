@@ -137,11 +137,8 @@ class Ekf {
   double pending_cv_dt_s_ = 0.0;
   std::optional<AnchorRangeBias> range_bias_;  ///< F27, with range_bias_sigma_m > 0
   void propagateTdoaOnlyCovariance();
-  /// The message on [δx, δβ]: its δx row, −1 at slot_a and +1 at slot_b (a slot < 0: no entry).
-  ScalarLinearMessage<kAugDim> augmentedMessage(const ScalarLinearMessage<kDim>& message, int slot_a,
-                                                int slot_b) const;
-  /// The gain of a message on the augmented state (jointGain).
-  RangeBiasGain augmentedGain(const ScalarLinearMessage<kAugDim>& message) const;
+  /// u = J hᵀ and h u for the row h = [a, e_B − e_A] on [δx, δβ] (a slot < 0 has no entry; both < 0: a row on δx).
+  RangeBiasGain jointGain(const ErrRow& a, int slot_a, int slot_b) const;
   /// (G18) on the augmented state with its gain, then the reset (F8) of δx and β̂ += δβ.
   std::optional<InnovationStats> correctAugmented(double y, double var, const RangeBiasGain& gain);
 };
