@@ -209,6 +209,7 @@ void runLocalize(const LocalizeArgs& a) {
   j["n_reacquisitions"] = s.n_reacquisitions;
   j["n_rejection_faults"] = s.n_rejection_faults;
   j["n_reverted_motion"] = s.n_reverted_motion;
+  j["start_replayed"] = s.start_replayed;
   j["fuse_tof"] = params.fuse_tof;
   j["n_tof"] = s.n_tof_total;
   j["n_tof_used"] = s.n_tof_used;

@@ -21,6 +21,7 @@
 #include "uwb/filter/QuadImuProcess.h"
 #include "uwb/filter/RestDetector.h"
 #include "uwb/filter/SensorEvents.h"
+#include "uwb/filter/StartReplay.h"
 #include "uwb/filter/StartUp.h"
 #include "uwb/filter/StateIndex.h"
 #include "uwb/filter/TdoaLocalizer.h"

@@ -201,6 +201,8 @@ std::vector<EkfParamInfo> makeRegistry() {
            "Multilateration window of the start and of a re-acquisition (F16)"),
       real("moving_start_vel_sigma_mps", &P::moving_start_vel_sigma_mps, "m/s", kPositive,
            "Velocity std when the IMU starts while moving (F15)"),
+      boolean("start_replay", &P::start_replay,
+              "A first start in motion runs the filter again over the start window from the fix (F16g)"),
       real("moving_start_att_sigma_rad", &P::moving_start_att_sigma_rad, "rad", kPositive,
            "Roll/pitch std when the IMU starts while moving (F15)"),
       real("moving_start_yaw_sigma_rad", &P::moving_start_yaw_sigma_rad, "rad", kPositive,

@@ -115,7 +115,8 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
       descent_(DescentBoundParams{params.descent_margin_m}),
       ekf_(params),
       start_(anchors_, params.b_t_tag,
-             StartUpParams{params.start_window_s, 40, 3.0, 0.2, params.init_pos_sigma_m, 0.15, 1.0}) {
+             StartUpParams{params.start_window_s, 40, 3.0, 0.2, params.init_pos_sigma_m, 0.15, 1.0}),
+      replay_(params) {
   params_.validate();
   if (anchors_.size() < 4) throw std::invalid_argument("Estimator: at least 4 anchors are needed");
   floor_anchors_ = FloorLevelAnchors(anchors_, params_.ground_z_m, params_.floor_anchor_height_m);
@@ -210,10 +211,23 @@ void Estimator::startAcquisition(double t_s, bool reacquisition) {
   }
   // at rest the body stays where it is: position only; otherwise position and velocity (F16b)
   start_.begin(t_s, ekf_.state(), !(imu_mode_ && on_ground_), reacquisition);
+  // (F16g) the first start in motion is run again from its fix; a re-acquisition's prediction is relaxed (F16e)
+  if (params_.start_replay && imu_mode_ && !on_ground_ && !reacquisition && !ready_) replay_.begin(ekf_, t_s);
+  else replay_.stop();
 }
 
 void Estimator::finishStart(double t_s, const StartFix& fix) {
-  ekf_.resetPositionVelocity(fix.w_p_b, fix.w_v_b, fix.cov);
+  // (F16g) in motion, the filter runs again over the window from the fix's starting point; otherwise (on the floor,
+  // a re-acquisition, or a window not recorded whole) the fix becomes the state now (F16b)
+  const bool replayed =
+      fix.with_velocity && replay_.recording() && replay_.referenceTime() == fix.t_ref_s &&
+      replay_.replay(ekf_, fix.w_p0, fix.w_v0, std::sqrt(fix.cov(0, 0)), params_.moving_start_vel_sigma_mps,
+                     params_.cov_period_s, [this](Ekf& f, const TdoaObservation& z) {
+                       updateTdoa(f, anchors_, z, acq_opt_, bias_ ? &bias_ : nullptr);
+                     });
+  replay_.stop();
+  if (replayed) summary_.start_replayed = true;
+  else ekf_.resetPositionVelocity(fix.w_p_b, fix.w_v_b, fix.cov);
   if (!fix.anchor_delay_m.empty()) floor_anchors_.setDelays(fix.anchor_delay_m);  // (F16f) a fix on the floor
   if (ready_ && summary_.reacquired_t_s.size() < summary_.reacquisition_t_s.size())
     summary_.reacquired_t_s.push_back(t_s);
@@ -258,6 +272,7 @@ void Estimator::predictTo(double t_s) {
       ekf_.inject(dx);
     } else {
       ekf_.predict(m, dt);
+      if (replay_.recording()) replay_.recordPredict(m, dt);
     }
   } else {
     ekf_.predictTdoaOnly(dt);
@@ -279,6 +294,7 @@ void Estimator::propagate(bool force) {
 void Estimator::handleTimeJump(double t_s, double gap_s) {
   // (F17) nothing is integrated across a gap or a backward jump: the covariance grows by what a body could do in it
   ++summary_.n_time_jumps;
+  replay_.stop();  // (F16g) the record holds predictions and TDoA only
   descent_.clear();
   climb_.clear();
   propagate(true);
@@ -296,6 +312,7 @@ void Estimator::handleTimeJump(double t_s, double gap_s) {
 
 void Estimator::leaveGround(double t_s, bool climbing) {
   on_ground_ = false;
+  replay_.stop();  // (F16g) the record holds predictions and TDoA only
   descent_.clear();  // (F26) the climb is not dead-reckoned from the floor: the detector's climb speed lags
   // (F16f) leaving rest (motors off) without a detected climb, the body still sits on the floor (rotors spun up
   // without floor shaking, or lifted by hand): its height is dead-reckoned from there for the fade of the floor-level
@@ -327,6 +344,7 @@ void Estimator::leaveGround(double t_s, bool climbing) {
 
 void Estimator::enterGround(double t_s) {
   on_ground_ = true;
+  replay_.stop();  // (F16g) the record holds predictions and TDoA only
   descent_.clear();
   climb_.clear();
   n_low_z_ = 0;
@@ -611,9 +629,12 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     propagate(!imu_mode_);
     const std::optional<double> floor_z =
         on_ground_ && params_.floor_constraint ? std::optional<double>(params_.ground_z_m) : std::nullopt;
+    if (replay_.recording()) replay_.recordTdoa(z);
     if (const std::optional<StartFix> fix = start_.add(z, ekf_.state(), floor_z)) {
       propagate(true);
       finishStart(t, *fix);
+    } else if (replay_.recording() && start_.referenceTime() != replay_.referenceTime()) {
+      replay_.begin(ekf_, start_.referenceTime());  // (F16b) a failed solve moved the reference to now
     }
     return;
   }

@@ -70,6 +70,8 @@ std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x
   StartFix fix;
   fix.with_velocity = moving;
   fix.w_p0 = r->w_p0;
+  fix.w_v0 = moving ? r->w_v0 : x_ref_.w_v_b;
+  fix.t_ref_s = t_ref_;
   fix.rms_residual_m = r->rms_residual_m;
   fix.anchor_delay_m = r->anchor_delay_m;
   const double T = z.t_s - t_ref_;

@@ -165,6 +165,9 @@ struct EkfParams {
   double leave_rest_pos_sigma_m = 0.2;
   double start_window_s = 0.6;           ///< multilateration window of the start / re-acquisition [s] (F16)
   double moving_start_vel_sigma_mps = 1.0;  ///< velocity std when the IMU starts while moving (in the air) [m/s]
+  /// A first start in motion runs the filter again over the multilateration window from the fix (F16g), instead of
+  /// writing the fix into the state at its end (F16b).
+  bool start_replay = true;
   double moving_start_att_sigma_rad = 0.1;  ///< roll/pitch std when the IMU starts while moving [rad]
   double moving_start_yaw_sigma_rad = 0.02; ///< yaw std when the IMU starts while moving [rad] (yaw 0 assumed)
   /// Std of one pair's slowly varying TDoA bias (F23; each anchor's range bias σ_b/√2): the reported position

@@ -33,6 +33,7 @@
 #include "uwb/filter/EkfParams.h"
 #include "uwb/filter/RestDetector.h"
 #include "uwb/filter/SensorEvents.h"
+#include "uwb/filter/StartReplay.h"
 #include "uwb/filter/StartUp.h"
 #include "uwb/filter/TdoaUpdate.h"
 #include "uwb/filter/TofUpdate.h"
@@ -92,6 +93,7 @@ struct LocalizerSummary {
   std::size_t n_rest_periods = 0;      ///< times the body came to rest
   std::size_t n_rejection_faults = 0; ///< re-acquisitions because most TDoA were rejected (F16d)
   std::size_t n_reverted_motion = 0;  ///< of them, with the state put back to the motion before the fault (F16d)
+  bool start_replayed = false;         ///< the first start in motion ran the filter again from its fix (F16g)
   std::size_t n_reacquisitions = 0;    ///< lost or diverged → position found again by multilateration (F16)
   std::size_t n_time_jumps = 0;        ///< sensor-time gaps or backward jumps handled (F17)
   std::vector<double> reacquisition_t_s;  ///< when each re-acquisition started (first 100)
@@ -182,6 +184,7 @@ class Estimator {
   Ekf ekf_;
   RestDetector rest_;
   StartUp start_;
+  StartReplay replay_;  ///< the first start in motion, run again from the fix (F16g)
   FloorLevelAnchors floor_anchors_;  ///< floor-level anchors and their delays on the floor (F16f)
   ClimbFromFloor climb_;             ///< height since leaving the ground without a detected climb (F16f)
   TdoaUpdateOptions track_opt_, acq_opt_, rest_opt_;

@@ -18,7 +18,9 @@ struct StartFix {
   Vec3 w_p_b = Vec3::Zero();   ///< body origin now [m]
   Vec3 w_v_b = Vec3::Zero();   ///< body velocity now [m/s]
   Eigen::Matrix<double, 6, 6> cov = Eigen::Matrix<double, 6, 6>::Identity();  ///< of (p, v) now
-  Vec3 w_p0 = Vec3::Zero();    ///< body origin at the window's start [m]
+  Vec3 w_p0 = Vec3::Zero();    ///< body origin at the window's reference instant t_ref_s [m]
+  Vec3 w_v0 = Vec3::Zero();    ///< body velocity then (the predicted one when solved without velocity) [m/s]
+  double t_ref_s = 0.0;        ///< the reference instant: start of the collection, or its last move (F16b) [s]
   double rms_residual_m = 0.0;
   bool with_velocity = false;
   /// (F16f) a fix on the floor: the range delay of each floor-level anchor, by anchor id (NaN: none found) [m]
@@ -46,6 +48,8 @@ class StartUp {
   /// TDoA can disagree by metres, and the fix is revised in the air).
   void begin(double t_s, const NavState& x_ref, bool moving, bool reacquisition = false);
   bool active() const { return active_; }
+  /// The instant the displacements are counted from (begin(), moved forward when a solve fails, F16b) [s].
+  double referenceTime() const { return t_ref_; }
   /// (F16f) By anchor id, 1 for a floor-level anchor: a fix on the floor solves a range delay for each of them.
   void setFloorLevelAnchors(const std::vector<unsigned char>& floor_level) { floor_level_ = floor_level; }
   void cancel() { active_ = false; samples_.clear(); }
