@@ -23,8 +23,10 @@ int BiasFloorGeometry::slot(int id, const Vec3& w_p_anchor) {
   if (n_anchors_ == kMaxAnchors) return -1;
   const Vec3 d = w_p_tag_ - w_p_anchor;
   if (!(d.norm() > 1e-6)) return -1;
-  ids_[n_anchors_] = id;
-  unit_[n_anchors_] = d.normalized();
+  const int n = n_anchors_;
+  ids_[n] = id;
+  unit_[n] = d.normalized();
+  for (int k = 0; k <= n; ++k) laplacian_[n][k] = laplacian_[k][n] = 0.0;
   return n_anchors_++;
 }
 

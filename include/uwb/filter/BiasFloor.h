@@ -44,7 +44,9 @@ class BiasFloorGeometry {
   int n_anchors_ = 0, n_pairs_ = 0;
   std::array<int, kMaxAnchors> ids_{};
   std::array<Vec3, kMaxAnchors> unit_{};                               ///< J's rows ∂d_i/∂p
-  std::array<std::array<double, kMaxAnchors>, kMaxAnchors> laplacian_{};  ///< L = DᵀD
+  /// L = DᵀD; only the leading n_anchors_ × n_anchors_ block is initialised (slot() zeroes each new row and column:
+  /// the whole array is 8 KB, and the geometry is rebuilt at the TDoA rate)
+  std::array<std::array<double, kMaxAnchors>, kMaxAnchors> laplacian_;
 };
 
 }  // namespace uwb
