@@ -5,9 +5,11 @@
 # range-bias states at the same white-noise std ("off 0.2"), and without them at the std of the filter without the
 # states ("off 0.35"). Prints one row per flight and the median and range of the change on / off.
 #
-# Usage: scripts/zero_bias_drift.sh [BUILD_DIR]
+# Usage: scripts/zero_bias_drift.sh [BUILD_DIR] [FLAGS...]   (FLAGS: added to the "on" run, e.g. filter parameters)
 set -euo pipefail
 BUILD=${1:-build}
+shift || true
+ON_FLAGS=("$@")
 CLI="$BUILD/uwbtdoa"
 [ -x "$CLI" ] || { echo "zero_bias_drift: $CLI not found (build first)" >&2; exit 2; }
 PY=/usr/bin/python3
@@ -28,7 +30,7 @@ for tr in circle figure8 zigzag circle-sine; do
       n="$tr-s$seed-$anchors"
       "$CLI" simulate --trajectory "$tr" --seed "$seed" --anchors-preset "$anchors" --duration 120 \
         --config "$WORK/cfg.json" --out "$WORK/$n.csv" --survey-out "$WORK/$n.txt" > /dev/null
-      on=$(rmse "$WORK/$n.csv" "$WORK/$n.txt")
+      on=$(rmse "$WORK/$n.csv" "$WORK/$n.txt" "${ON_FLAGS[@]}")
       off=$(rmse "$WORK/$n.csv" "$WORK/$n.txt" --range-bias-sigma-m 0)
       off35=$(rmse "$WORK/$n.csv" "$WORK/$n.txt" --range-bias-sigma-m 0 --tdoa-sigma-m 0.35)
       echo "| $n | $on | $off | $off35 |" | tee -a "$WORK/rows"

@@ -115,7 +115,10 @@ ErrMat AccumulatedTransition::rightMultiplyTransposed(const ErrMat& M) const {
 Ekf::Ekf(const EkfParams& params) : params_(params) {
   params_.validate();
   P_ = initialCovariance(params_);
-  if (params_.range_bias_sigma_m > 0.0) range_bias_.emplace(params_.range_bias_sigma_m, params_.range_bias_tau_s);
+  if (params_.range_bias_sigma_m > 0.0) {
+    range_bias_.emplace(params_.range_bias_sigma_m, params_.range_bias_tau_s);
+    range_bias_->enableAdaptation(params_.range_bias_adapt_s, params_.range_bias_min_fraction);
+  }
 }
 
 ErrMat initialCovariance(const EkfParams& p) {
@@ -137,7 +140,10 @@ void Ekf::initialize(const NavState& x0, const ErrMat& P0) {
   P_ = 0.5 * (P0 + P0.transpose());
   phi_ = AccumulatedTransition{};
   pending_cv_dt_s_ = 0.0;
-  if (params_.range_bias_sigma_m > 0.0) range_bias_.emplace(params_.range_bias_sigma_m, params_.range_bias_tau_s);
+  if (params_.range_bias_sigma_m > 0.0) {
+    range_bias_.emplace(params_.range_bias_sigma_m, params_.range_bias_tau_s);
+    range_bias_->enableAdaptation(params_.range_bias_adapt_s, params_.range_bias_min_fraction);
+  }
 }
 
 void Ekf::predict(const ImuReading& imu, double dt_s) {
@@ -324,12 +330,17 @@ std::optional<InnovationStats> Ekf::correctAugmented(double y, double var, const
 
 Ekf::RangeBiasGain Ekf::rangeBiasGain(const ScalarLinearMessage<kDim>& message, int id_a, int id_b) {
   const int slot_a = range_bias_->slot(id_a), slot_b = range_bias_->slot(id_b);
-  return jointGain(message.a, slot_a, slot_b);
+  RangeBiasGain g = jointGain(message.a, slot_a, slot_b);
+  g.slot_a = slot_a;
+  g.slot_b = slot_b;
+  return g;
 }
 
 std::optional<InnovationStats> Ekf::correctWithRangeBias(const ScalarLinearMessage<kDim>& message,
                                                          const RangeBiasGain& gain) {
-  return correctAugmented(message.y, message.var, gain);
+  std::optional<InnovationStats> st = correctAugmented(message.y, message.var, gain);
+  if (st) range_bias_->adapt(gain.slot_a, gain.slot_b);  // (F27e)
+  return st;
 }
 
 void Ekf::scaleCovariance(double factor) {

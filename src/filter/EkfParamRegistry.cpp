@@ -131,6 +131,10 @@ std::vector<EkfParamInfo> makeRegistry() {
            "0 off (F27)"),
       real("range_bias_tau_s", &P::range_bias_tau_s, "s", kPositive,
            "Correlation time of each anchor's range bias state (F27)"),
+      real("range_bias_adapt_s", &P::range_bias_adapt_s, "s", kNonNegative,
+           "Adapt the range-bias std to the flight by online EM with this time constant; 0 off (F27e)"),
+      real("range_bias_min_fraction", &P::range_bias_min_fraction, "", kPositive,
+           "Lower bound of the adapted range-bias std, as a fraction of range_bias_sigma_m (F27e)"),
       integer("antenna_bias_degree", &P::antenna_bias_degree, EkfParamRange{0, 4},
               "Learn the tag antenna-pattern TDoA bias in flight from the innovations: spherical harmonics of degrees "
               "2..this of the anchor's body-frame direction; 0 off, 1 invalid (F25)"),

@@ -46,6 +46,9 @@ void EkfParams::validate() const {
   requireNonNegative(pair_bias_tau_s, "pair_bias_tau_s");
   requireNonNegative(range_bias_sigma_m, "range_bias_sigma_m");
   requirePositive(range_bias_tau_s, "range_bias_tau_s");
+  requireNonNegative(range_bias_adapt_s, "range_bias_adapt_s");
+  if (!(range_bias_min_fraction > 0.0 && range_bias_min_fraction <= 1.0))
+    throw std::invalid_argument("EkfParams.range_bias_min_fraction must be in (0, 1]");
   if (antenna_bias_degree != 0 && (antenna_bias_degree < 2 || antenna_bias_degree > 4))
     throw std::invalid_argument("EkfParams.antenna_bias_degree must be 0 (off) or in [2, 4]");
   requirePositive(antenna_bias_sigma_m, "antenna_bias_sigma_m");

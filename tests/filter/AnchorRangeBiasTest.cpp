@@ -219,6 +219,61 @@ TEST(EkfRangeBias, TdoaOnlyPropagationIsTheAugmentedTransition) {
   EXPECT_LT((ekf.rangeBias()->cross() - F * cross0 * std::exp(-T / 3.0)).norm(), 1e-12);
 }
 
+TEST(AnchorRangeBias, AdaptedStdFollowsThePosteriorSecondMomentWithinItsBounds) {
+  // GIVEN bias states whose first two anchors were corrected to a near-zero posterior (β̂ = 0, P_kk ≈ 0)
+  const auto corrected = []() {
+    AnchorRangeBias b(0.1, 0.5);
+    b.slot(10);
+    b.slot(11);
+    for (const int k : {0, 1}) {
+      BiasVec w = BiasVec::Zero();
+      w(k) = std::sqrt(b.covariance()(k, k) - 1e-8);
+      b.downdate(ErrVec::Zero(), w, BiasVec::Zero());
+    }
+    return b;
+  };
+  // WHEN nothing adapts, the std is the constructor's
+  AnchorRangeBias fixed = corrected();
+  fixed.decay(0.01);
+  fixed.adapt(0, 1);
+  EXPECT_DOUBLE_EQ(fixed.adaptedSigma(), 0.1);
+  // WHEN adapting (time constant 0.3 s) after each 10 ms step while the posterior stays near zero
+  AnchorRangeBias b = corrected();
+  b.enableAdaptation(0.3, 0.2);
+  double previous = b.adaptedSigma();
+  for (int k = 0; k < 300; ++k) {
+    b.decay(0.01);
+    BiasVec w = BiasVec::Zero();  // keep correcting both anchors
+    w(0) = std::sqrt(std::max(b.covariance()(0, 0) - 1e-8, 0.0));
+    b.downdate(ErrVec::Zero(), w, BiasVec::Zero());
+    w.setZero();
+    w(1) = std::sqrt(std::max(b.covariance()(1, 1) - 1e-8, 0.0));
+    b.downdate(ErrVec::Zero(), w, BiasVec::Zero());
+    b.adapt(0, 1);
+    EXPECT_LE(b.adaptedSigma(), previous + 1e-15);  // (F27e) it only falls while the evidence says there is no bias
+    previous = b.adaptedSigma();
+  }
+  // THEN the std falls to its floor and not below; an anchor without a slot has the adapted prior
+  EXPECT_NEAR(b.adaptedSigma(), 0.02, 1e-12);
+  EXPECT_NEAR(b.stddev(99), 0.02, 1e-12);
+  EXPECT_DOUBLE_EQ(b.sigma(), 0.1);
+  // WHEN the anchors then show a bias of 0.3 m (β̂ = ±0.3)
+  BiasVec dbeta = BiasVec::Zero();
+  dbeta(0) = 0.3;
+  dbeta(1) = -0.3;
+  b.downdate(ErrVec::Zero(), BiasVec::Zero(), dbeta);
+  for (int k = 0; k < 100; ++k) {
+    b.decay(0.01);
+    b.adapt(0, 1);
+  }
+  // THEN the std grows back, up to the constructor's and not above
+  EXPECT_DOUBLE_EQ(b.adaptedSigma(), 0.1);
+  EXPECT_DOUBLE_EQ(b.stddev(99), 0.1);
+  EXPECT_THROW(b.enableAdaptation(-1.0, 0.2), std::invalid_argument);
+  EXPECT_THROW(b.enableAdaptation(1.0, 0.0), std::invalid_argument);
+  EXPECT_THROW(b.enableAdaptation(1.0, 1.5), std::invalid_argument);
+}
+
 TEST(EkfRangeBias, ResetsClearTheCrossCovarianceOfWhatTheyReset) {
   TdoaUpdateOptions opt;
   Ekf ekf = correlatedFilter(rangeBiasParams(), 5, {{0.0, 0, 1, 0.3}}, &opt);
@@ -285,6 +340,63 @@ TEST(EkfRangeBias, LearnsAnAnchorRangeBiasThatMovedThePosition) {
   EXPECT_NEAR(b.mean(3) - others, kBias_m, 0.1);
   EXPECT_GT(e_off, 0.08);  // the bias does move the plain filter
   EXPECT_LT(e_on, 0.5 * e_off);
+}
+
+TEST(EkfRangeBias, TheAdaptedStdShrinksWithoutBiasAndGrowsBackWhenABiasAppears) {
+  // GIVEN a circle flight without bias for 30 s, after which anchor 3 reads every range 0.4 m long
+  const AnchorTable anchors = filtertest::arenaAnchors();
+  constexpr double kBias_m = 0.15, kOnset_s = 30.0;
+  const auto offset = [](double t, int a) {
+    if (t < kOnset_s) return 0.0;
+    return a == 2 ? kBias_m : (a == 3 ? -kBias_m : 0.0);
+  };
+  const SensorLog log = filtertest::flightLog(anchors, circle, 0.0, 70.0, 0.05, true, 12, offset);
+  struct Run {
+    double sigma_before = NAN, sigma_end = NAN, learned_m = NAN, rmse_end_m = NAN;
+  };
+  const auto run = [&](double adapt_s) {
+    EkfParams p;
+    p.ground_phase = GroundPhase::kNone;
+    p.range_bias_adapt_s = adapt_s;  // the other range-bias parameters at their defaults
+    Estimator est(p, anchors);
+    Run r;
+    double s2 = 0.0;
+    int n = 0;
+    SensorEventCursor cursor(log);
+    for (SensorEvent ev; cursor.next(ev);) {
+      if (ev.kind == SensorEvent::Kind::kImu) {
+        est.addImu(ev.t_s, log.imu[ev.index].imu);
+        continue;
+      }
+      if (ev.kind != SensorEvent::Kind::kTdoa) continue;
+      est.addTdoa(log.tdoa[ev.index]);
+      if (ev.t_s < kOnset_s) r.sigma_before = est.ekf().rangeBias()->adaptedSigma();
+      if (ev.t_s > 60.0) {
+        s2 += (est.state().w_p_b - circle(ev.t_s).p).squaredNorm();
+        ++n;
+      }
+    }
+    const AnchorRangeBias& b = *est.ekf().rangeBias();
+    double others = 0.0;
+    for (int id = 0; id < 8; ++id)
+      if (id != 3) others += b.mean(id) / 7.0;
+    r.sigma_end = b.adaptedSigma();
+    r.learned_m = b.mean(3) - others;
+    r.rmse_end_m = std::sqrt(s2 / std::max(n, 1));
+    return r;
+  };
+  // WHEN localizing with the defaults, the prior std fixed and adapted (F27e)
+  const Run fixed = run(0.0), adapted = run(0.3);
+  // THEN without bias the adapted prior shrank (to its floor, 0.2 σ₀); once the bias appeared it grew back (the EM
+  // fixed point: about the RMS of the anchors' biases), and the bias and the position are as with the fixed prior
+  const double sigma0 = EkfParams{}.range_bias_sigma_m;
+  EXPECT_DOUBLE_EQ(fixed.sigma_end, sigma0);
+  EXPECT_LT(adapted.sigma_before, 0.5 * sigma0);
+  EXPECT_GT(adapted.sigma_end, 2.0 * adapted.sigma_before);
+  EXPECT_LE(adapted.sigma_end, sigma0);
+  EXPECT_NEAR(adapted.learned_m, fixed.learned_m, 0.02);
+  EXPECT_GT(adapted.learned_m, 0.03);
+  EXPECT_LT(adapted.rmse_end_m, 1.05 * fixed.rmse_end_m);
 }
 
 TEST(EkfRangeBias, ABiasFreeFlightStaysAsGood) {

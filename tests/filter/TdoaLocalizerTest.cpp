@@ -62,9 +62,17 @@ TEST(TdoaLocalizer, ConstantVelocityConverges) {
   p.ground_phase = GroundPhase::kNone;
   // WHEN localizing 10 s
   const LocalizerResult r = TdoaLocalizer(p, anchors).run(makeLog(anchors, truth, 10.0, 0.1, true, 2));
-  // THEN the position and the velocity are tracked
+  // THEN the position and the velocity are tracked (the velocity over the last 4 s: one sample's error is noisy)
   EXPECT_LT(finalError(r, truth), 0.15);
-  EXPECT_LT((r.estimates.back().x.w_v_b - v).norm(), 0.25);
+  double v_err2 = 0.0;
+  int n = 0;
+  for (const LocalizerEstimate& e : r.estimates) {
+    if (e.t_s < 6.0) continue;
+    v_err2 += (e.x.w_v_b - v).squaredNorm();
+    ++n;
+  }
+  ASSERT_GT(n, 100);
+  EXPECT_LT(std::sqrt(v_err2 / n), 0.2);
 }
 
 TEST(TdoaLocalizer, TdoaOnlyModeIsSelectedWithoutImuAndConverges) {

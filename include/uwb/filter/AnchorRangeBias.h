@@ -12,6 +12,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 
 #include <Eigen/Core>
 
@@ -70,12 +71,28 @@ class AnchorRangeBias {
   /// P_xβ = P_βxᵀ (15 × kMaxBiasAnchors).
   CrossMat cross() const { return P_bx_.transpose(); }
   const BiasMat& covariance() const { return P_bb_; }
-  double sigma() const { return sigma_m_; }
+  /// The constructor's stationary std σ₀ [m].
+  double sigma() const { return sigma0_m_; }
+  /// The stationary std in use [m]: σ₀, or the adapted one (F27e); also the prior of an anchor without a slot.
+  double adaptedSigma() const { return std::sqrt(var_m2_); }
+  /// (F27e) Adapts the anchors' common stationary std to the flight by online EM: σ² follows the posterior second
+  /// moment β̂_k² + P_ββ,kk of the anchors corrected, averaged with time constant time_constant_s and bounded to
+  /// [min_fraction² σ₀², σ₀²]. time_constant_s = 0 turns it off. Throws std::invalid_argument for time_constant_s < 0
+  /// or min_fraction outside (0, 1].
+  void enableAdaptation(double time_constant_s, double min_fraction);
+  /// (F27e) One EM step after a correction that involved slots slot_a and slot_b (a slot < 0 is skipped); it weighs
+  /// the time decay() was given since the last step.
+  void adapt(int slot_a, int slot_b);
   double tau() const { return tau_s_; }
 
  private:
-  double sigma_m_;
+  double sigma0_m_;
   double tau_s_;
+  double var_m2_;                  ///< σ² in use (σ₀² without adaptation, F27e)
+  double adapt_s_ = 0.0;           ///< EM time constant [s]; 0 off
+  double min_var_m2_ = 0.0;        ///< lower bound of the adapted σ²
+  double second_moment_m2_ = 0.0;  ///< time average of β̂_k² + P_ββ,kk over the corrected anchors
+  double t_since_adapt_s_ = 0.0;
   std::array<int, kMaxBiasAnchors> ids_{};
   int n_ = 0;
   BiasVec beta_ = BiasVec::Zero();

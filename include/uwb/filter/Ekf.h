@@ -93,6 +93,7 @@ class Ekf {
     ErrVec u_x = ErrVec::Zero();
     BiasVec u_b = BiasVec::Zero();
     double h_u = 0.0;  ///< h J hᵀ: the innovation variance is h_u + the message's var (G17)
+    int slot_a = -1, slot_b = -1;  ///< the pair's range-bias slots (−1: none)
   };
   /// (F27c) The gain of a TDoA message of pair (A, B) on the augmented state: its row gains −1 at δβ_A and +1 at δβ_B
   /// (the anchors get a state on first sight). message.y must already exclude β̂_B − β̂_A. Requires rangeBias().

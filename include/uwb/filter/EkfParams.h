@@ -104,6 +104,10 @@ struct EkfParams {
   /// (docs/math/filter.md F27).
   double range_bias_sigma_m = 0.07;
   double range_bias_tau_s = 0.5;         ///< correlation time of each anchor's range bias [s] (F27)
+  /// (F27e) The stationary std adapted to the flight by online EM with this time constant [s]; 0 keeps
+  /// range_bias_sigma_m. The adapted std stays within [range_bias_min_fraction, 1] × range_bias_sigma_m.
+  double range_bias_adapt_s = 0.3;
+  double range_bias_min_fraction = 0.2;
   /// Tag antenna-pattern bias learned in flight from the innovations (F25): spherical harmonics of degrees
   /// 2…antenna_bias_degree (2–4) of the anchor's body-frame direction; 0 off.
   int antenna_bias_degree = 0;
