@@ -105,7 +105,8 @@ struct EkfParams {
   double range_bias_sigma_m = 0.07;
   double range_bias_tau_s = 0.5;         ///< correlation time of each anchor's range bias [s] (F27)
   /// (F27e) The stationary std adapted to the flight by online EM with this time constant [s]; 0 keeps
-  /// range_bias_sigma_m. The adapted std stays within [range_bias_min_fraction, 1] × range_bias_sigma_m.
+  /// range_bias_sigma_m. The adapted std stays within [range_bias_min_fraction, 1] × range_bias_sigma_m. Chosen on
+  /// simulated flights with and without bias; the real flights do not move (docs/math/filter.md F27e).
   double range_bias_adapt_s = 0.3;
   double range_bias_min_fraction = 0.2;
   /// Tag antenna-pattern bias learned in flight from the innovations (F25): spherical harmonics of degrees
