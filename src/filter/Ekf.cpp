@@ -115,10 +115,14 @@ ErrMat AccumulatedTransition::rightMultiplyTransposed(const ErrMat& M) const {
 Ekf::Ekf(const EkfParams& params) : params_(params) {
   params_.validate();
   P_ = initialCovariance(params_);
-  if (params_.range_bias_sigma_m > 0.0) {
-    range_bias_.emplace(params_.range_bias_sigma_m, params_.range_bias_tau_s);
-    range_bias_->enableAdaptation(params_.range_bias_adapt_s, params_.range_bias_min_fraction);
-  }
+  resetRangeBias();
+}
+
+void Ekf::resetRangeBias() {
+  // (F27) the range-bias states at their prior; (F27e) with the prior's adaptation when asked for
+  if (!(params_.range_bias_sigma_m > 0.0)) return;
+  range_bias_.emplace(params_.range_bias_sigma_m, params_.range_bias_tau_s);
+  range_bias_->enableAdaptation(params_.range_bias_adapt_s, params_.range_bias_min_fraction);
 }
 
 ErrMat initialCovariance(const EkfParams& p) {
@@ -140,10 +144,7 @@ void Ekf::initialize(const NavState& x0, const ErrMat& P0) {
   P_ = 0.5 * (P0 + P0.transpose());
   phi_ = AccumulatedTransition{};
   pending_cv_dt_s_ = 0.0;
-  if (params_.range_bias_sigma_m > 0.0) {
-    range_bias_.emplace(params_.range_bias_sigma_m, params_.range_bias_tau_s);
-    range_bias_->enableAdaptation(params_.range_bias_adapt_s, params_.range_bias_min_fraction);
-  }
+  resetRangeBias();
 }
 
 void Ekf::predict(const ImuReading& imu, double dt_s) {

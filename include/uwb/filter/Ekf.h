@@ -138,6 +138,8 @@ class Ekf {
   double pending_cv_dt_s_ = 0.0;
   std::optional<AnchorRangeBias> range_bias_;  ///< F27, with range_bias_sigma_m > 0
   void propagateTdoaOnlyCovariance();
+  /// range_bias_ at its prior (F27), adapting (F27e) as params_ say; none with range_bias_sigma_m = 0.
+  void resetRangeBias();
   /// u = J hᵀ and h u for the row h = [a, e_B − e_A] on [δx, δβ] (a slot < 0 has no entry; both < 0: a row on δx).
   RangeBiasGain jointGain(const ErrRow& a, int slot_a, int slot_b) const;
   /// (G18) on the augmented state with its gain, then the reset (F8) of δx and β̂ += δβ.
