@@ -371,11 +371,14 @@ void bindEval(py::module_& m) {
           else if (n == "num_threads") p.svgp.num_threads = py::cast<int>(value);
           else if (n == "mean_scale") p.mean_scale = py::cast<double>(value);
           else if (n == "full_variance") p.full_variance = py::cast<bool>(value);
+          else if (n == "predictive_dof") p.predictive_shape.dof = py::cast<double>(value);
+          else if (n == "predictive_scale") p.predictive_shape.scale = py::cast<double>(value);
           else if (n == "min_samples_per_inducing") p.min_samples_per_inducing = py::cast<int>(value);
           else
             throw std::invalid_argument("unknown training parameter '" + n +
                                         "' (known: epochs, batch_size, seed, lr, lr_inducing, natgrad_step, "
-                                        "train_inducing, num_threads, mean_scale, full_variance, min_samples_per_inducing)");
+                                        "train_inducing, num_threads, mean_scale, full_variance, predictive_dof, predictive_scale, "
+                                        "min_samples_per_inducing)");
         }
         p.validate();
         BiasTrainProgress cb;

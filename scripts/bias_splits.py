@@ -13,7 +13,11 @@ For each test flight `uwbtdoa localize FLIGHT --json` gives the airborne RMSE fo
 states (--range-bias-sigma-m 0 --tdoa-sigma-m 0.35), uncorrected and with the model ("offline"); with them (the
 defaults), uncorrected ("online") and with the model ("offline + online"). Change = 100 (RMSE / reference - 1).
 
-Usage: scripts/bias_splits.py [BUILD_DIR]   (data: $UWBTDOA_DATA or ../shared/data)
+With --calibration, instead of the filters: `uwbtdoa predict-bias TEST --model M --json` scores the model's predictive
+distribution of the bias (docs/math/gp.md P43) on each test flight; per split the 1σ and 2σ coverage (nominal 68.3 and
+95.4 %; mean, lowest, highest over the pairs) and the mean NLPD.
+
+Usage: scripts/bias_splits.py [BUILD_DIR] [--calibration]   (data: $UWBTDOA_DATA or ../shared/data)
 """
 import json
 import os
@@ -22,7 +26,9 @@ import subprocess
 import sys
 import tempfile
 
-BUILD = sys.argv[1] if len(sys.argv) > 1 else "build"
+ARGS = [a for a in sys.argv[1:] if a != "--calibration"]
+CALIBRATION = "--calibration" in sys.argv[1:]
+BUILD = ARGS[0] if ARGS else "build"
 CLI = os.path.join(BUILD, "uwbtdoa")
 DATA = os.environ.get("UWBTDOA_DATA", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared",
                                                    "data"))
@@ -48,6 +54,35 @@ def train(names, out):
 def rmse(name, flags):
     cmd = [CLI, "localize", path(name), "--anchors", survey(name[:4]), "--json", *flags]
     return json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)["rmse_airborne_m"]
+
+
+def calibration(name, model):
+    cmd = [CLI, "predict-bias", path(name), "--anchors", survey(name[:4]), "--model", model, "--json", "--out",
+           os.path.join(os.path.dirname(model), "predicted.csv")]
+    return json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)["calibration"]
+
+
+def main_calibration():
+    print(f"{'split':11s} {'n':>3s} | {'1σ coverage % mean [min, max]':>30s} | {'2σ coverage % mean [min, max]':>30s} | "
+          f"{'NLPD':>6s}")
+    with tempfile.TemporaryDirectory() as tmp:
+        cache = {}
+        for label, pairs in splits():
+            c1, c2, nlpd = [], [], []
+            for train_set, test in pairs:
+                key = tuple(train_set)
+                if key not in cache:
+                    cache[key] = os.path.join(tmp, f"model{len(cache)}.json")
+                    train(train_set, cache[key])
+                c = calibration(test, cache[key])
+                c1.append(100 * c["coverage_1sigma"])
+                c2.append(100 * c["coverage_2sigma"])
+                nlpd.append(c["nlpd"])
+
+            def cell(v):
+                return f"{statistics.mean(v):5.1f} [{min(v):5.1f}, {max(v):5.1f}]"
+            print(f"{label:11s} {len(pairs):3d} | {cell(c1):>30s} | {cell(c2):>30s} | {statistics.mean(nlpd):+6.3f}",
+                  flush=True)
 
 
 def splits():
@@ -92,4 +127,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    main_calibration() if CALIBRATION else main()

@@ -2,7 +2,9 @@
  *  @brief `uwbtdoa predict-bias FLIGHT.csv --anchors SURVEY.txt --model MODEL.json --out OUT.csv [--json]`
  *
  *  Applies a bias model (eval/BiasModel.h) to every TDoA measurement that has ground truth and writes t, ids,
- *  measured TDoA, ε (paper eq. 6), predicted mean and std. GP inputs (--inputs): "truth" = the interpolated
+ *  measured TDoA, ε (paper eq. 6), the predicted mean, the std of that mean (latent, var_f) and the predictive std of ε
+ *  (latent and likelihood noise, docs/math/gp.md P43). The summary scores the airborne samples (|ε| ≤ 1 m) against the
+ *  predictive distribution: coverage of the 1σ and 2σ intervals and the NLPD (eval/BiasCalibration.h). GP inputs (--inputs): "truth" = the interpolated
  *  ground-truth pose (every measurement, airborne flag), "estimate" = the uncorrected filter's estimate on this
  *  flight, as at run time (only the samples of the training-data rules, eval/BiasDataset.h). The default is the
  *  source the model was trained with (its file's "training.inputs"), else "truth". A model trained on estimated
@@ -16,6 +18,7 @@
 
 #include "Command.h"
 #include "uwb/core/Error.h"
+#include "uwb/eval/BiasCalibration.h"
 #include "uwb/eval/BiasDataset.h"
 #include "uwb/eval/BiasModel.h"
 #include "uwb/io/FileAccess.h"
@@ -52,21 +55,30 @@ void run(const Options& o) {
                  : "truth";
   }
   const uwb::BiasInputSource source = uwb::biasInputSourceFromString(inputs);
-  std::string out = "t,idA,idB,tdoa_meas,error_m,bias_mean_m,bias_std_m,airborne\n";
+  std::string out = "t,idA,idB,tdoa_meas,error_m,bias_mean_m,bias_std_m,predictive_std_m,airborne\n";
   double se_b = 0, se_a = 0;
   std::size_t n_air = 0, n_rows = 0;
+  std::vector<double> residual_m, variance_m2;  // (P43) of the scored samples with a covering GP
+  const auto score = [&](double error_m, const uwb::BiasPredictive& p) {
+    ++n_air;
+    se_b += error_m * error_m;
+    se_a += (error_m - p.mean_m) * (error_m - p.mean_m);
+    if (p.covered && p.varianceM2() > 0.0) {
+      residual_m.push_back(error_m - p.mean_m);
+      variance_m2.push_back(p.varianceM2());
+    }
+  };
   if (source == uwb::BiasInputSource::kFilterEstimate) {
     uwb::BiasDatasetParams dp;
     dp.inputs = source;
     dp.min_z_m = o.min_z;
     const uwb::BiasDataset data = uwb::buildBiasDataset({flight}, survey, dp);
     for (const auto& smp : data.samples) {
-      const uwb::BiasPrediction p = model.predict(smp.feature);
-      out += fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},1\n", smp.t_s, smp.feature.id_a, smp.feature.id_b,
-                         smp.measured_m, smp.error_m, p.mean_m, std::sqrt(p.variance_m2));
-      ++n_air;
-      se_b += smp.error_m * smp.error_m;
-      se_a += (smp.error_m - p.mean_m) * (smp.error_m - p.mean_m);
+      const uwb::BiasPredictive p = model.predictive(smp.feature);
+      out += fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},1\n", smp.t_s, smp.feature.id_a,
+                         smp.feature.id_b, smp.measured_m, smp.error_m, p.mean_m, std::sqrt(p.latent_variance_m2),
+                         std::sqrt(p.varianceM2()));
+      score(smp.error_m, p);
     }
     n_rows = data.samples.size();
   }
@@ -76,21 +88,20 @@ void run(const Options& o) {
   if (source == uwb::BiasInputSource::kGroundTruth) n_rows = residuals.size();
   for (const auto& r : residuals) {
     const uwb::TdoaFeature f = uwb::makeTdoaFeature(r.id_a, r.id_b, r.w_p_b, r.w_q_b, survey.position(r.id_a), survey.position(r.id_b));
-    const uwb::BiasPrediction p = model.predict(f);
+    const uwb::BiasPredictive p = model.predictive(f);
     const bool air = uwb::isAirborne(r.w_p_b.z(), o.min_z);
-    out += fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},{}\n", r.t_s, r.id_a, r.id_b, r.measured_m, r.residual_m,
-                       p.mean_m, std::sqrt(p.variance_m2), air ? 1 : 0);
-    if (air && std::abs(r.residual_m) <= 1.0) {
-      ++n_air;
-      se_b += r.residual_m * r.residual_m;
-      se_a += (r.residual_m - p.mean_m) * (r.residual_m - p.mean_m);
-    }
+    out += fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{}\n", r.t_s, r.id_a, r.id_b, r.measured_m,
+                       r.residual_m, p.mean_m, std::sqrt(p.latent_variance_m2), std::sqrt(p.varianceM2()), air ? 1 : 0);
+    if (air && std::abs(r.residual_m) <= 1.0) score(r.residual_m, p);
   }
   const double before = n_air ? std::sqrt(se_b / n_air) : std::nan(""), after = n_air ? std::sqrt(se_a / n_air) : std::nan("");
+  const uwb::BiasCalibration cal = uwb::biasCalibration(residual_m, variance_m2, model.predictiveShape());
+  nlohmann::json cal_json = uwb::toJson(cal);
+  cal_json["n_uncovered"] = n_air - cal.n;
   const std::string json_text = uwb::app::dumpJson(
       nlohmann::json{{"flight", o.flight}, {"model", o.model}, {"inputs", inputs}, {"n_rows", n_rows},
                      {"n_airborne", n_air}, {"bias_rmse_before_m", before}, {"bias_rmse_after_m", after},
-                     {"out", o.out}});
+                     {"calibration", cal_json}, {"out", o.out}});
   uwb::writeFileAtomically(o.out, out, "bias CSV");
   if (o.json_out) {
     std::cout << json_text << '\n';
@@ -99,6 +110,13 @@ void run(const Options& o) {
                              "before {:.4f} m, after {:.4f} m\n",
                              n_rows, o.out, inputs == "truth" ? "ground truth" : "uncorrected filter's estimate", n_air,
                              before, after);
+    const std::string shape = cal.shape.dof > 0.0
+                                  ? fmt::format("Student-t, {:g} dof, scale {:g} σ", cal.shape.dof, cal.shape.scale)
+                                  : fmt::format("Gaussian, scale {:g} σ", cal.shape.scale);
+    std::cout << fmt::format("predictive distribution (P43, {}; {} samples with a model): 1σ-mass interval coverage "
+                             "{:.1f} % (nominal 68.3), 2σ-mass {:.1f} % (95.4), NLPD {:.3f} nats, mean σ {:.3f} m\n",
+                             shape, cal.n, 100.0 * cal.coverage_1sigma, 100.0 * cal.coverage_2sigma, cal.nlpd,
+                             cal.mean_std_m);
   }
 }
 

@@ -37,6 +37,7 @@ struct TrainOptions {
   std::uint64_t seed = 1;
   double lr = 0.01, lr_inducing = 0.01, natgrad = 0.2, holdout = 0.2, extra_sigma = uwb::BiasTrainParams{}.extra_sigma_m;
   double min_z = uwb::kAirborneMinZ_m, max_abs_error = 1.0, mean_scale = 1.0;
+  uwb::PredictiveShape predictive_shape;
   bool neighbour_only = false, json_out = false, quiet = false, full_variance = false;
 };
 
@@ -108,6 +109,7 @@ void run(const TrainOptions& o) {
   tp.svgp.num_threads = o.threads;
   tp.extra_sigma_m = o.extra_sigma;
   tp.mean_scale = o.mean_scale;
+  tp.predictive_shape = o.predictive_shape;
   tp.full_variance = o.full_variance;
   if (!o.dump_arrays.empty()) dumpArrays(o.dump_arrays, data, tp);
   uwb::BiasTrainReport rep;
@@ -139,6 +141,8 @@ void run(const TrainOptions& o) {
                {"inputs", o.inputs},
                {"extra_sigma_m", o.extra_sigma},
                {"mean_scale", o.mean_scale},
+               {"predictive_dof", o.predictive_shape.dof},
+               {"predictive_scale", o.predictive_shape.scale},
                {"full_variance", o.full_variance},
                {"flights", o.flights},
                {"n_train", rep.n_train},
@@ -199,6 +203,13 @@ void setup(CLI::App& sub) {
   sub.add_option("--mean-scale", o->mean_scale,
                  "Factor w in [0, 1] on the predicted bias mean stored in the model (docs/math/gp.md P44)")
       ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  sub.add_option("--predictive-dof", o->predictive_shape.dof,
+                 "Degrees of freedom of the Student-t predictive distribution the calibration scores; 0 = Gaussian "
+                 "(docs/math/gp.md P43b)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  sub.add_option("--predictive-scale", o->predictive_shape.scale,
+                 "Scale of that distribution in units of the predictive std (docs/math/gp.md P43b)")
+      ->check(CLI::PositiveNumber)->capture_default_str();
   sub.add_flag("--full-variance", o->full_variance,
                "The filter uses the TDoA variance scaled by (var_f + noise)/E[eps^2] for corrected measurements instead "
                "of adding var_f (docs/math/gp.md P45)");

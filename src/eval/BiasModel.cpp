@@ -194,6 +194,7 @@ void BiasTrainParams::validate() const {
   if (min_samples_per_inducing < 1) throw std::invalid_argument("min_samples_per_inducing must be ≥ 1");
   if (!(extra_sigma_m >= 0) || !std::isfinite(extra_sigma_m)) throw std::invalid_argument("extra_sigma_m must be ≥ 0");
   if (!(mean_scale >= 0) || mean_scale > 1) throw std::invalid_argument("mean_scale must be in [0, 1]");
+  predictive_shape.validate();
   svgp.validate();
 }
 
@@ -221,6 +222,18 @@ void BiasModel::buildPredictors() {
 void BiasModel::setMeanScale(double w) {
   if (!(w >= 0.0) || w > 1.0) throw std::invalid_argument("bias model: mean_scale must be in [0, 1]");
   mean_scale_ = w;
+}
+
+void PredictiveShape::validate() const {
+  if (!std::isfinite(dof) || !(dof == 0.0 || dof > 2.0))
+    throw std::invalid_argument("predictive_dof must be 0 (Gaussian) or > 2 (a finite variance)");
+  if (!std::isfinite(scale) || !(scale > 0.0) || scale > 10.0)
+    throw std::invalid_argument("predictive_scale must be in (0, 10]");
+}
+
+void BiasModel::setPredictiveShape(const PredictiveShape& shape) {
+  shape.validate();
+  predictive_shape_ = shape;
 }
 
 void BiasModel::setExtraVariance(double variance_m2) {
@@ -320,6 +333,8 @@ nlohmann::json BiasModel::toJson() const {
           {"pair_means", means},
           {"extra_variance_m2", extra_variance_m2_},
           {"mean_scale", mean_scale_},
+          {"predictive_dof", predictive_shape_.dof},
+          {"predictive_scale", predictive_shape_.scale},
           {"full_variance", full_variance_},
           {"target_mean_square_m2", target_mean_square_m2_},
           {"training", meta}};
@@ -408,6 +423,10 @@ BiasModel BiasModel::fromJson(const nlohmann::json& j) {
       model.setExtraVariance(v);
     }
     if (j.contains("mean_scale")) model.setMeanScale(jsonDouble(j.at("mean_scale"), "mean_scale"));
+    PredictiveShape shape;  // (P43b) a file without the fields gets the defaults
+    if (j.contains("predictive_dof")) shape.dof = jsonDouble(j.at("predictive_dof"), "predictive_dof");
+    if (j.contains("predictive_scale")) shape.scale = jsonDouble(j.at("predictive_scale"), "predictive_scale");
+    model.setPredictiveShape(shape);
     if (j.contains("full_variance") && jsonBool(j.at("full_variance"), "full_variance"))
       model.setFullVariance(true, jsonDouble(jsonMember(j, "", "target_mean_square_m2"), "target_mean_square_m2"));
     return model;
@@ -541,6 +560,7 @@ BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params,
   BiasModel model(preset.name, preset.features, std::move(entries), std::move(means));
   model.setExtraVariance(params.extra_sigma_m * params.extra_sigma_m);  // (P31)
   model.setMeanScale(params.mean_scale);                                 // (P44)
+  model.setPredictiveShape(params.predictive_shape);                     // (P43b)
   if (params.full_variance) {  // (P45): E[ε²] of the training targets
     double sum_sq = 0.0, n = 0.0;
     for (std::size_t i = 0; i < data.samples.size(); ++i) {

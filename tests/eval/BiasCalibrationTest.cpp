@@ -1,5 +1,6 @@
 /** @file BiasCalibrationTest.cpp
- *  @brief Coverage and NLPD of predicted biases (docs/math/gp.md P43): calibrated, over- and under-confident.
+ *  @brief Coverage and NLPD of predicted biases (docs/math/gp.md P43): calibrated, over- and under-confident; the
+ *         Student-t predictive shape (P43b).
  */
 #include <gtest/gtest.h>
 
@@ -99,6 +100,102 @@ TEST(BiasCalibration, ModelPredictiveAddsTheLikelihoodNoiseAndSkipsUncoveredPair
   EXPECT_EQ(c.n, 1u);
   EXPECT_EQ(c.n_uncovered, 1u);
   EXPECT_NEAR(c.rmse_m, std::abs(0.2 - p.mean_m), 1e-12);
+}
+
+/// ∫ exp(log p(r)) dr over [a, b] by composite Simpson with n (even) intervals.
+double integrateDensity(double a, double b, double var, const PredictiveShape& shape, int n = 20000) {
+  const double h = (b - a) / n;
+  double sum = 0.0;
+  for (int i = 0; i <= n; ++i) {
+    const double w = (i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0);
+    sum += w * std::exp(predictiveLogDensity(a + i * h, var, shape));
+  }
+  return sum * h / 3.0;
+}
+
+TEST(PredictiveShape, TheIntervalHalfWidthHoldsItsProbabilityUnderTheDensity) {
+  // GIVEN the Gaussian and Student-t shapes, with and without a scale, and σ = 0.2 m
+  const double var = 0.04, sd = 0.2;
+  for (const PredictiveShape shape : {PredictiveShape::gaussian(), PredictiveShape{0.0, 0.8}, PredictiveShape{3.0, 1.0},
+                                      PredictiveShape{5.0, 0.9}, PredictiveShape{12.5, 1.3}}) {
+    SCOPED_TRACE(::testing::Message() << "dof " << shape.dof << " scale " << shape.scale);
+    // THEN the density integrates to one, and the central interval of each level holds that probability
+    EXPECT_NEAR(integrateDensity(-400.0 * sd, 400.0 * sd, var, shape, 400000), 1.0, 2e-3);
+    for (const double p : {0.2, kOneSigmaMass, 0.9, kTwoSigmaMass, 0.99}) {
+      const double w = centralIntervalHalfWidth(p, shape);
+      EXPECT_NEAR(integrateDensity(-w * sd, w * sd, var, shape), p, 1e-9) << "p " << p;
+    }
+  }
+  // AND known quantiles: t₅ at 0.975 (2.5705818366), the Gaussian's ±1σ and ±2σ masses
+  EXPECT_NEAR(centralIntervalHalfWidth(0.95, PredictiveShape{5.0, 1.0}), 2.5705818366147395, 1e-9);
+  EXPECT_NEAR(centralIntervalHalfWidth(kOneSigmaMass, PredictiveShape::gaussian()), 1.0, 1e-12);
+  EXPECT_NEAR(centralIntervalHalfWidth(kTwoSigmaMass, PredictiveShape::gaussian()), 2.0, 1e-12);
+  // AND a t with many degrees of freedom is the Gaussian
+  EXPECT_NEAR(centralIntervalHalfWidth(0.9, PredictiveShape{1e7, 1.0}), centralIntervalHalfWidth(0.9), 1e-6);
+  EXPECT_NEAR(predictiveLogDensity(0.3, var, PredictiveShape{1e7, 1.0}),
+              predictiveLogDensity(0.3, var, PredictiveShape::gaussian()), 1e-6);
+}
+
+TEST(PredictiveShape, InvalidShapesAreRejectedNamingTheField) {
+  for (const PredictiveShape bad : {PredictiveShape{1.5, 1.0}, PredictiveShape{-1.0, 1.0}, PredictiveShape{5.0, 0.0},
+                                    PredictiveShape{5.0, std::nan("")}, PredictiveShape{std::nan(""), 1.0}}) {
+    try {
+      bad.validate();
+      ADD_FAILURE() << "accepted dof " << bad.dof << " scale " << bad.scale;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_TRUE(std::string(e.what()).find("predictive_") != std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW(centralIntervalHalfWidth(1.0, PredictiveShape{}), std::invalid_argument);
+  EXPECT_THROW(biasCalibration({0.1}, {0.04}, PredictiveShape{2.0, 1.0}), std::invalid_argument);
+}
+
+TEST(PredictiveShape, HeavyTailedResidualsAreCoveredByTheMatchingShapeAndNotByTheGaussian) {
+  // GIVEN residuals r = 0.15 m · T₅ (std::student_t_distribution, independent of the implementation), whose
+  // variance is σ² = 0.15² · 5/3
+  std::mt19937_64 rng(7);
+  std::student_t_distribution<double> t5(5.0);
+  const double s = 0.15, var = s * s * 5.0 / 3.0;
+  std::vector<double> r(200000);
+  for (auto& v : r) v = s * t5(rng);
+  const std::vector<double> variance(r.size(), var);
+  // WHEN scored with the t₅ shape of scale s/σ and with the Gaussian of the same variance
+  const BiasCalibration matched = biasCalibration(r, variance, PredictiveShape{5.0, s / std::sqrt(var)});
+  const BiasCalibration gauss = biasCalibration(r, variance);
+  // THEN the matching shape covers each level as claimed, and its NLPD is lower
+  EXPECT_NEAR(matched.coverage_1sigma, kOneSigmaMass, 0.005);
+  EXPECT_NEAR(matched.coverage_2sigma, kTwoSigmaMass, 0.003);
+  const std::vector<double>& levels = calibrationLevels();
+  for (std::size_t k = 0; k < levels.size(); ++k) EXPECT_NEAR(matched.coverage[k], levels[k], 0.006) << levels[k];
+  EXPECT_LT(matched.nlpd, gauss.nlpd - 0.01);
+  // AND the Gaussian of the same variance is over-wide at 1σ and too narrow at the 2σ mass (the heavy-tail signature)
+  EXPECT_GT(gauss.coverage_1sigma, kOneSigmaMass + 0.03);
+  EXPECT_LT(gauss.coverage_2sigma, kTwoSigmaMass - 0.003);
+  EXPECT_EQ(matched.shape.dof, 5.0);
+  const nlohmann::json j = toJson(matched);
+  EXPECT_EQ(j.at("predictive_dof").get<double>(), 5.0);
+}
+
+TEST(PredictiveShape, TheModelFileCarriesTheShapeAndAnOlderFileGetsTheDefault) {
+  gp::Svgp svgp(gp::Kernel::preset("z1"), MatX::Random(5, 2));
+  BiasModel model("z1", FeatureMap::kYawAngles, {{0, 1, svgp}});
+  EXPECT_EQ(model.predictiveShape().dof, PredictiveShape{}.dof);
+  model.setPredictiveShape({7.0, 1.1});
+  nlohmann::json j = model.toJson();
+  const BiasModel back = BiasModel::fromJson(j);
+  EXPECT_EQ(back.predictiveShape().dof, 7.0);
+  EXPECT_EQ(back.predictiveShape().scale, 1.1);
+  j.erase("predictive_dof");
+  j.erase("predictive_scale");
+  EXPECT_EQ(BiasModel::fromJson(j).predictiveShape().dof, PredictiveShape{}.dof);
+  EXPECT_EQ(BiasModel::fromJson(j).predictiveShape().scale, PredictiveShape{}.scale);
+  j["predictive_dof"] = 1.0;
+  try {
+    BiasModel::fromJson(j);
+    ADD_FAILURE() << "dof 1 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_TRUE(std::string(e.what()).find("predictive_dof") != std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

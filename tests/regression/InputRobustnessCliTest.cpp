@@ -18,6 +18,7 @@
 #include <sstream>
 
 #include "support/TestSupport.h"
+#include "uwb/eval/BiasCalibration.h"
 #include "uwb/io/UtilCsv.h"
 
 namespace uwb {
@@ -226,7 +227,7 @@ TEST_F(RobustCli, CorruptBiasModelValuesAreErrorsNamingTheFileAndKey) {
   }
 }
 
-TEST_F(RobustCli, PredictBiasWritesTheMeasuredTdoaInEveryRow) {
+TEST_F(RobustCli, PredictBiasWritesTheMeasuredTdoaAndThePredictiveDistributionInEveryRow) {
   // The measured TDoA of the flight by (time, pair), as the CSV prints it (6 decimals of time, 7 digits of TDoA).
   const Flight f = readFlightCsv(flight_);
   std::map<std::string, double> measured;
@@ -240,21 +241,46 @@ TEST_F(RobustCli, PredictBiasWritesTheMeasuredTdoaInEveryRow) {
     std::istringstream lines(read(out));
     std::string line;
     std::getline(lines, line);
-    ASSERT_EQ(line, "t,idA,idB,tdoa_meas,error_m,bias_mean_m,bias_std_m,airborne");
+    ASSERT_EQ(line, "t,idA,idB,tdoa_meas,error_m,bias_mean_m,bias_std_m,predictive_std_m,airborne");
     std::size_t rows = 0;
+    // the summary's calibration (P43) recomputed from the rows: airborne, |ε| ≤ 1 m, r = ε − µ against the
+    // predictive std (the std of the mean plus the likelihood noise, so never below the std of the mean) and the
+    // central intervals of the model's predictive shape (P43b)
+    const BiasModel bias_model = BiasModel::load(model());
+    const double w1 = centralIntervalHalfWidth(kOneSigmaMass, bias_model.predictiveShape());
+    const double w2 = centralIntervalHalfWidth(kTwoSigmaMass, bias_model.predictiveShape());
+    std::size_t n_scored = 0, in1 = 0, in2 = 0;
     while (std::getline(lines, line)) {
       std::vector<std::string> cells;
       std::stringstream ss(line);
       for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
-      ASSERT_EQ(cells.size(), 8u) << line;
+      ASSERT_EQ(cells.size(), 9u) << line;
       ASSERT_FALSE(cells[3].empty()) << "empty tdoa_meas: " << line;
+      const double eps = std::stod(cells[4]), mu = std::stod(cells[5]), sd_mean = std::stod(cells[6]),
+                   sd = std::stod(cells[7]);
+      EXPECT_GE(sd, sd_mean) << line;
+      if (cells[8] == "1" && std::abs(eps) <= 1.0 && sd > 0.0) {
+        ++n_scored;
+        in1 += std::abs(eps - mu) <= w1 * sd ? 1 : 0;
+        in2 += std::abs(eps - mu) <= w2 * sd ? 1 : 0;
+      }
       const auto it = measured.find(cells[0] + "," + cells[1] + "," + cells[2]);
       ASSERT_NE(it, measured.end()) << line;
       EXPECT_NEAR(std::stod(cells[3]), it->second, 1e-6 * std::max(1.0, std::abs(it->second))) << line;
       ++rows;
     }
     EXPECT_GT(rows, 1000u);
-    EXPECT_EQ(nlohmann::json::parse(r.out)["n_rows"].get<std::size_t>(), rows);
+    const nlohmann::json summary = nlohmann::json::parse(r.out);
+    EXPECT_EQ(summary["n_rows"].get<std::size_t>(), rows);
+    const nlohmann::json& cal = summary["calibration"];
+    ASSERT_GT(n_scored, 100u);
+    EXPECT_EQ(cal["n"].get<std::size_t>(), n_scored);
+    // the CSV's 7 significant digits can move a sample across an interval's edge
+    EXPECT_NEAR(cal["coverage_1sigma"].get<double>(), static_cast<double>(in1) / n_scored, 2e-3);
+    EXPECT_NEAR(cal["coverage_2sigma"].get<double>(), static_cast<double>(in2) / n_scored, 2e-3);
+    EXPECT_LT(cal["coverage_1sigma"].get<double>(), cal["coverage_2sigma"].get<double>());
+    EXPECT_TRUE(std::isfinite(cal["nlpd"].get<double>()));
+    EXPECT_EQ(cal["predictive_dof"].get<double>(), bias_model.predictiveShape().dof);
   }
 }
 

@@ -65,6 +65,18 @@ struct BiasPreset {
   static std::vector<std::string> names();
 };
 
+/// (P43b) Shape of the predictive distribution of ε around µ with σ² = var_f + σ_n²: a Student-t with `dof` degrees of
+/// freedom and scale `scale`·σ; dof = 0 is the Gaussian N(µ, scale² σ²). The TDoA error's tails are heavier than a
+/// Gaussian's (kurtosis 4–6 on a flight the model was not trained on). The defaults were chosen on the 0426 splits of
+/// docs/math/gp.md P43b and reported on 0425. The filter is not affected: it uses µ and a variance (P45).
+struct PredictiveShape {
+  double dof = 5.0;
+  double scale = 0.9;
+  static PredictiveShape gaussian() { return {0.0, 1.0}; }
+  /// Throws std::invalid_argument unless dof = 0 or dof > 2 (a finite variance), and 0 < scale ≤ 10, both finite.
+  void validate() const;
+};
+
 struct BiasTrainParams {
   std::string preset = "z1";
   int num_inducing = 30;            ///< M (per GP)
@@ -77,6 +89,8 @@ struct BiasTrainParams {
   double extra_sigma_m = 0.0;
   /// Factor on the predicted mean stored in the model (P44); 1 = the paper's correction.
   double mean_scale = 1.0;
+  /// Shape of the predictive distribution stored in the model (P43b).
+  PredictiveShape predictive_shape;
   /// The filter's TDoA variance scaled by the unexplained share of the error (P45) instead of R + var_f.
   bool full_variance = false;
   void validate() const;
@@ -145,6 +159,9 @@ class BiasModel {
   /// Factor w ∈ [0, 1] on the predicted mean (docs/math/gp.md P44): the correction subtracts w·µ. 1 = the paper.
   double meanScale() const { return mean_scale_; }
   void setMeanScale(double w);  ///< throws std::invalid_argument outside [0, 1]
+  /// (P43b) The shape of the predictive distribution the calibration scores (default: PredictiveShape{}).
+  const PredictiveShape& predictiveShape() const { return predictive_shape_; }
+  void setPredictiveShape(const PredictiveShape& shape);  ///< throws std::invalid_argument (PredictiveShape::validate)
   /// Constant mean of the pair (0 when none was learned).
   double pairMean(int id_a, int id_b) const;
 
@@ -164,6 +181,7 @@ class BiasModel {
   std::vector<PairMean> pair_means_;
   double extra_variance_m2_ = 0.0;
   double mean_scale_ = 1.0;
+  PredictiveShape predictive_shape_;
   bool full_variance_ = false;
   double target_mean_square_m2_ = 0.0;
   std::shared_ptr<const std::vector<gp::SvgpPredictor>> predictors_;
