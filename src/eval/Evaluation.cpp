@@ -422,8 +422,9 @@ void writeEvaluation(const EvaluationResult& result, const AnchorSurvey& survey,
   md += fmt::format(
       "## Per test flight, best configuration ({} M = {}; repeats averaged)\n\n"
       "Airborne RMSE without and with the correction, and the calibration of the predicted bias on the test flight "
-      "(docs/math/gp.md P43): the share of TDoA errors ε inside µ ± σ and µ ± 2σ of the predictive distribution "
-      "N(µ, var_f + σ_n²) (nominal 68.3 % and 95.4 %) and its negative log predictive density per sample.\n\n",
+      "(docs/math/gp.md P43, P43b): the share of TDoA errors ε inside the central intervals of 68.3 % and 95.4 % of the "
+      "model's predictive distribution around µ with σ² = var_f + σ_n² (a Student-t of the model file's degrees of "
+      "freedom and scale, or a Gaussian) and its negative log predictive density per sample.\n\n",
       result.best_kernel, result.best_inducing);
   md += perFlightMarkdown(result.runs, result.best_kernel, result.best_inducing) + "\n";
   const auto hasFigure = [&](const std::string& name) {
