@@ -200,6 +200,8 @@ py::dict trainReportDict(const BiasTrainReport& r) {
   py::dict d;
   d["n_train"] = r.n_train, d["n_holdout"] = r.n_holdout, d["bias_rmse_before_m"] = r.bias_rmse_before_m;
   d["bias_rmse_after_m"] = r.bias_rmse_after_m, d["mean_predicted_std_m"] = r.mean_predicted_std_m;
+  d["mean_predictive_std_m"] = r.mean_predictive_std_m, d["holdout_coverage_1sigma"] = r.holdout_coverage_1sigma;
+  d["holdout_coverage_2sigma"] = r.holdout_coverage_2sigma, d["holdout_nlpd"] = r.holdout_nlpd;
   d["train_seconds"] = r.train_seconds, d["num_models"] = r.num_models, d["final_elbo"] = r.final_elbo;
   return d;
 }
@@ -403,7 +405,8 @@ void bindEval(py::module_& m) {
       py::arg("holdout_block_s") = 5.0, py::arg("progress") = py::none(),
       "Trains the preset's GP(s) on the dataset (time blocks held out). Keyword arguments: SVGP training\n"
       "parameters (epochs, batch_size, seed, lr, ...). Returns (BiasModel, report {n_train, n_holdout,\n"
-      "bias_rmse_before_m, bias_rmse_after_m, mean_predicted_std_m, train_seconds, num_models}).");
+      "bias_rmse_before_m, bias_rmse_after_m, mean_predicted_std_m, mean_predictive_std_m, holdout_coverage_1sigma, "
+      "holdout_coverage_2sigma, holdout_nlpd, train_seconds, num_models}).");
 
   m.def(
       "bias_calibration",

@@ -150,6 +150,10 @@ void run(const TrainOptions& o) {
                {"bias_rmse_before_m", rep.bias_rmse_before_m},
                {"bias_rmse_after_m", rep.bias_rmse_after_m},
                {"mean_predicted_std_m", rep.mean_predicted_std_m},
+               {"mean_predictive_std_m", rep.mean_predictive_std_m},
+               {"holdout_coverage_1sigma", rep.holdout_coverage_1sigma},
+               {"holdout_coverage_2sigma", rep.holdout_coverage_2sigma},
+               {"holdout_nlpd", rep.holdout_nlpd},
                {"train_seconds", rep.train_seconds},
                {"final_elbo", rep.final_elbo},
                {"threads", o.threads},
@@ -173,10 +177,16 @@ void run(const TrainOptions& o) {
                            "ELBO per datum {:.4f}\n",
                            o.kernel, rep.num_models, rep.num_models == 1 ? "" : "s", o.inducing, rep.n_train,
                            rep.train_seconds, rep.n_holdout, rep.final_elbo);
-  std::cout << fmt::format("bias RMSE on the held-out part: before {:.4f} m, after {:.4f} m ({:+.1f} %), mean predicted std {:.4f} m\n",
+  std::cout << fmt::format("bias RMSE on the held-out part: before {:.4f} m, after {:.4f} m ({:+.1f} %), mean std of "
+                           "the predicted mean {:.4f} m\n",
                            rep.bias_rmse_before_m, rep.bias_rmse_after_m,
                            100.0 * (rep.bias_rmse_after_m - rep.bias_rmse_before_m) / rep.bias_rmse_before_m,
                            rep.mean_predicted_std_m);
+  std::cout << fmt::format("predictive distribution on the held-out part (docs/math/gp.md P43): mean σ {:.4f} m, "
+                           "68.3 % interval covers {:.1f} %, 95.4 % interval {:.1f} %, NLPD {:.3f} nats (other flights: "
+                           "`uwbtdoa predict-bias`)\n",
+                           rep.mean_predictive_std_m, 100.0 * rep.holdout_coverage_1sigma,
+                           100.0 * rep.holdout_coverage_2sigma, rep.holdout_nlpd);
   std::cout << "learned hyperparameters:\n";
   for (const auto& [model_name, h] : hyper.items()) {
     std::cout << "  " << model_name << ":";

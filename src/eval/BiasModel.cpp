@@ -3,6 +3,8 @@
  */
 #include "uwb/eval/BiasModel.h"
 
+#include "uwb/eval/BiasCalibration.h"
+
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -577,6 +579,7 @@ BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params,
     r.num_models = static_cast<int>(model.entries().size());
     r.final_elbo = elbo_samples > 0 ? elbo_weighted / elbo_samples : std::nan("");
     double se_before = 0, se_after = 0, sum_std = 0;
+    std::vector<double> residual_m, variance_m2;  // (P43) of the held-out samples with a covering GP
     for (std::size_t i = 0; i < data.samples.size(); ++i) {
       if (!hold[i]) {
         ++r.n_train;
@@ -588,11 +591,21 @@ BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params,
       se_before += eps * eps;
       se_after += (eps - p.mean_m) * (eps - p.mean_m);
       sum_std += std::sqrt(p.variance_m2);
+      const BiasPredictive q = model.predictive(data.samples[i].feature);
+      if (q.covered && q.varianceM2() > 0.0) {
+        residual_m.push_back(eps - q.mean_m);
+        variance_m2.push_back(q.varianceM2());
+      }
     }
     const double n = static_cast<double>(r.n_holdout);
     r.bias_rmse_before_m = n > 0 ? std::sqrt(se_before / n) : std::nan("");
     r.bias_rmse_after_m = n > 0 ? std::sqrt(se_after / n) : std::nan("");
     r.mean_predicted_std_m = n > 0 ? sum_std / n : std::nan("");
+    const BiasCalibration cal = biasCalibration(residual_m, variance_m2, model.predictiveShape());  // NaN when empty
+    r.mean_predictive_std_m = cal.mean_std_m;
+    r.holdout_coverage_1sigma = cal.coverage_1sigma;
+    r.holdout_coverage_2sigma = cal.coverage_2sigma;
+    r.holdout_nlpd = cal.nlpd;
     *report = r;
   }
   return model;

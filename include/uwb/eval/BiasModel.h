@@ -101,7 +101,12 @@ struct BiasTrainReport {
   std::size_t n_train = 0, n_holdout = 0;
   double bias_rmse_before_m = 0.0;  ///< RMSE of raw ε on the held-out part
   double bias_rmse_after_m = 0.0;   ///< RMSE of ε − predicted mean on the held-out part
-  double mean_predicted_std_m = 0.0;  ///< mean predictive std (latent) on the held-out part
+  double mean_predicted_std_m = 0.0;  ///< mean std of the predicted mean (latent, what the filter adds) on the held-out part
+  /// The predictive distribution of ε (latent + likelihood noise, the model's shape; docs/math/gp.md P43, P43b) on the
+  /// held-out time blocks: mean σ, coverage of its 68.3 % and 95.4 % intervals, NLPD [nats] (NaN without a held-out
+  /// part). Blocks of the training flights: a flight the model was not trained on is scored by predict-bias/evaluate.
+  double mean_predictive_std_m = 0.0;
+  double holdout_coverage_1sigma = 0.0, holdout_coverage_2sigma = 0.0, holdout_nlpd = 0.0;
   double train_seconds = 0.0;
   int num_models = 0;
   /// Full-data ELBO per datum of the returned model(s) on their training samples (docs/math/gp.md P41); with
