@@ -419,9 +419,10 @@ void bindEval(py::module_& m) {
         return jsonToPython(toJson(c));
       },
       py::arg("dataset"), py::arg("model"),
-      "Calibration of the model's predicted bias on a dataset (docs/math/gp.md P43): r = ε − µ against\n"
-      "σ² = var_f + σ_n². Returns {n, n_uncovered, coverage_1sigma, coverage_2sigma, nlpd [nats], rmse_m,\n"
-      "mean_std_m, levels, coverage (at levels)}.");
+      "Calibration of the model's predicted bias on a dataset (docs/math/gp.md P43, P43b): r = ε − µ against\n"
+      "σ² = var_f + σ_n² and the central intervals of the model's predictive shape (Student-t or Gaussian).\n"
+      "Returns {n, n_uncovered, coverage_1sigma, coverage_2sigma, nlpd [nats], rmse_m, mean_std_m, levels,\n"
+      "coverage (at levels), predictive_dof, predictive_scale}.");
 
   // -------------------------------------------------------------------------------------- localization
   m.def(

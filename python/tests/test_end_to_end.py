@@ -48,6 +48,12 @@ def test_bias_calibration_on_a_flight_the_model_was_not_trained_on(flights, trai
     assert len(c["levels"]) == len(c["coverage"])
     assert all(a <= b + 1e-12 for a, b in zip(c["coverage"], c["coverage"][1:]))
     assert np.isfinite(c["nlpd"]) and c["rmse_m"] > 0
+    # scored with the model's predictive shape (docs/math/gp.md P43b), which the training report also scores on its
+    # held-out time blocks
+    assert (c["predictive_dof"], c["predictive_scale"]) == (5.0, 0.9)
+    assert 0.0 <= report["holdout_coverage_1sigma"] <= report["holdout_coverage_2sigma"] <= 1.0
+    assert report["mean_predictive_std_m"] > report["mean_predicted_std_m"] > 0
+    assert np.isfinite(report["holdout_nlpd"])
 
 
 def test_train_localize_and_compare(flights, trained, tmp_path):
