@@ -212,6 +212,8 @@ TEST_F(RobustCli, CorruptBiasModelValuesAreErrorsNamingTheFileAndKey) {
       {"mean", [](nlohmann::json& j) { j["pair_means"] = {{{"id_a", 0}, {"id_b", 1}, {"mean_m", 1e6}}}; },
        "pair_means[0].mean_m"},
       {"jitter", [](nlohmann::json& j) { j["models"][0]["svgp"]["jitter"] = -10; }, "models[0].svgp.jitter"},
+      {"dof", [](nlohmann::json& j) { j["predictive_dof"] = 1.0; }, "predictive_dof"},
+      {"scale", [](nlohmann::json& j) { j["predictive_scale"] = "wide"; }, "predictive_scale"},
       {"dims", [](nlohmann::json& j) { j["models"][0]["svgp"]["kernel"]["parts"][0]["active_dims"] = {1e300}; },
        "active_dims"},
   };
