@@ -70,8 +70,8 @@ struct BiasPreset {
 /// Gaussian's (kurtosis 4–6 on a flight the model was not trained on). The defaults were chosen on the 0426 splits of
 /// docs/math/gp.md P43b and reported on 0425. The filter is not affected: it uses µ and a variance (P45).
 struct PredictiveShape {
-  double dof = 5.0;
-  double scale = 0.9;
+  double dof = 4.0;
+  double scale = 0.85;
   static PredictiveShape gaussian() { return {0.0, 1.0}; }
   /// Throws std::invalid_argument unless dof = 0 or dof > 2 (a finite variance), and 0 < scale ≤ 10, both finite.
   void validate() const;
