@@ -55,7 +55,7 @@ void run(const Options& o) {
                  : "truth";
   }
   const uwb::BiasInputSource source = uwb::biasInputSourceFromString(inputs);
-  std::string out = "t,idA,idB,tdoa_meas,error_m,bias_mean_m,bias_std_m,predictive_std_m,airborne\n";
+  std::string out = "t,idA,idB,tdoa_meas,error_m,bias_mean_m,bias_std_m,airborne,predictive_std_m\n";
   double se_b = 0, se_a = 0;
   std::size_t n_air = 0, n_rows = 0;
   std::vector<double> residual_m, variance_m2;  // (P43) of the scored samples with a covering GP
@@ -75,7 +75,7 @@ void run(const Options& o) {
     const uwb::BiasDataset data = uwb::buildBiasDataset({flight}, survey, dp);
     for (const auto& smp : data.samples) {
       const uwb::BiasPredictive p = model.predictive(smp.feature);
-      out += fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},1\n", smp.t_s, smp.feature.id_a,
+      out += fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},1,{:.7g}\n", smp.t_s, smp.feature.id_a,
                          smp.feature.id_b, smp.measured_m, smp.error_m, p.mean_m, std::sqrt(p.latent_variance_m2),
                          std::sqrt(p.varianceM2()));
       score(smp.error_m, p);
@@ -90,8 +90,8 @@ void run(const Options& o) {
     const uwb::TdoaFeature f = uwb::makeTdoaFeature(r.id_a, r.id_b, r.w_p_b, r.w_q_b, survey.position(r.id_a), survey.position(r.id_b));
     const uwb::BiasPredictive p = model.predictive(f);
     const bool air = uwb::isAirborne(r.w_p_b.z(), o.min_z);
-    out += fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{}\n", r.t_s, r.id_a, r.id_b, r.measured_m,
-                       r.residual_m, p.mean_m, std::sqrt(p.latent_variance_m2), std::sqrt(p.varianceM2()), air ? 1 : 0);
+    out += fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},{},{:.7g}\n", r.t_s, r.id_a, r.id_b, r.measured_m,
+                       r.residual_m, p.mean_m, std::sqrt(p.latent_variance_m2), air ? 1 : 0, std::sqrt(p.varianceM2()));
     if (air && std::abs(r.residual_m) <= 1.0) score(r.residual_m, p);
   }
   const double before = n_air ? std::sqrt(se_b / n_air) : std::nan(""), after = n_air ? std::sqrt(se_a / n_air) : std::nan("");

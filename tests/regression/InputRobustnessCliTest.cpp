@@ -243,7 +243,7 @@ TEST_F(RobustCli, PredictBiasWritesTheMeasuredTdoaAndThePredictiveDistributionIn
     std::istringstream lines(read(out));
     std::string line;
     std::getline(lines, line);
-    ASSERT_EQ(line, "t,idA,idB,tdoa_meas,error_m,bias_mean_m,bias_std_m,predictive_std_m,airborne");
+    ASSERT_EQ(line, "t,idA,idB,tdoa_meas,error_m,bias_mean_m,bias_std_m,airborne,predictive_std_m");
     std::size_t rows = 0;
     // the summary's calibration (P43) recomputed from the rows: airborne, |ε| ≤ 1 m, r = ε − µ against the
     // predictive std (the std of the mean plus the likelihood noise, so never below the std of the mean) and the
@@ -259,9 +259,9 @@ TEST_F(RobustCli, PredictBiasWritesTheMeasuredTdoaAndThePredictiveDistributionIn
       ASSERT_EQ(cells.size(), 9u) << line;
       ASSERT_FALSE(cells[3].empty()) << "empty tdoa_meas: " << line;
       const double eps = std::stod(cells[4]), mu = std::stod(cells[5]), sd_mean = std::stod(cells[6]),
-                   sd = std::stod(cells[7]);
+                   sd = std::stod(cells[8]);
       EXPECT_GE(sd, sd_mean) << line;
-      if (cells[8] == "1" && std::abs(eps) <= 1.0 && sd > 0.0) {
+      if (cells[7] == "1" && std::abs(eps) <= 1.0 && sd > 0.0) {
         ++n_scored;
         in1 += std::abs(eps - mu) <= w1 * sd ? 1 : 0;
         in2 += std::abs(eps - mu) <= w2 * sd ? 1 : 0;
