@@ -122,14 +122,20 @@ TEST(BiasModel, TooFewSamplesForTheInducingPointsIsAClearError) {
   }
 }
 
-TEST(BiasModel, TheHeldOutPartScoresThePredictiveDistribution) {
-  // GIVEN the synthetic bias with white noise of 5 cm
-  const BiasDataset ds = buildBiasDataset({circleFlight(40, 0.05)}, ringSurvey());
+/// A z1 model with M = 15, 15 epochs of batches of 256: enough for the synthetic circle, in a fraction of a second.
+BiasTrainParams smallZ1Training() {
   BiasTrainParams p;
   p.preset = "z1";
   p.num_inducing = 15;
   p.svgp.epochs = 15;
   p.svgp.batch_size = 256;
+  return p;
+}
+
+TEST(BiasModel, TheHeldOutPartScoresThePredictiveDistribution) {
+  // GIVEN the synthetic bias with white noise of 5 cm
+  const BiasDataset ds = buildBiasDataset({circleFlight(40, 0.05)}, ringSurvey());
+  const BiasTrainParams p = smallZ1Training();
   BiasTrainReport rep;
   // WHEN we train
   trainBiasModel(ds, p, &rep);
@@ -146,11 +152,7 @@ TEST(BiasModel, TheHeldOutPartScoresThePredictiveDistribution) {
 TEST(BiasModel, LearnsTheSyntheticBiasAndRoundTripsBitIdentically) {
   // GIVEN a synthetic dataset with bias 0.1 sin(yaw_a)
   const BiasDataset ds = buildBiasDataset({circleFlight(30)}, ringSurvey());
-  BiasTrainParams p;
-  p.preset = "z1";
-  p.num_inducing = 15;
-  p.svgp.epochs = 15;
-  p.svgp.batch_size = 256;
+  const BiasTrainParams p = smallZ1Training();
   BiasTrainReport rep;
   // WHEN we train
   const BiasModel model = trainBiasModel(ds, p, &rep);
