@@ -7,6 +7,7 @@
 #include "uwb/filter/AnchorRangeBias.h"
 #include "uwb/filter/AntennaBias.h"
 #include "uwb/filter/BiasFloor.h"
+#include "uwb/filter/BiasLevel.h"
 #include "uwb/filter/BiasGuard.h"
 #include "uwb/filter/CooperativeRange.h"
 #include "uwb/filter/DescentBound.h"

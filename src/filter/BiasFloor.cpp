@@ -3,6 +3,8 @@
  */
 #include "uwb/filter/BiasFloor.h"
 
+#include <algorithm>
+
 namespace uwb {
 namespace {
 
@@ -71,6 +73,17 @@ Eigen::Matrix2d BiasFloorGeometry::horizontalCovariance(double sigma_pair_m) con
   moments(&A, &B);
   // (F23′) with z known, H_xy = DJ_xy: the x, y blocks of the same moments
   return sandwich<Eigen::Matrix2d>(A.topLeftCorner<2, 2>(), B.topLeftCorner<2, 2>(), 0.5 * s2);
+}
+
+double BiasFloorGeometry::unexplainedTrace() const {
+  if (n_pairs_ < 4) return 0.0;
+  Mat3 A, B;
+  moments(&A, &B);
+  // tr(Q DDᵀ) with Q = I − H(HᵀH)⁻¹Hᵀ, H = DJ: tr(DDᵀ) = tr(DᵀD) = tr(L), tr(H(HᵀH)⁻¹HᵀDDᵀ) = tr((HᵀH)⁻¹HᵀDDᵀH)
+  double trace_l = 0.0;
+  for (int i = 0; i < n_anchors_; ++i) trace_l += laplacian_[i][i];
+  const Mat3 A_inv = (A + kRegularisation * Mat3::Identity()).inverse();
+  return std::max(trace_l - (A_inv * B).trace(), 0.0);
 }
 
 }  // namespace uwb

@@ -213,6 +213,10 @@ std::vector<EkfParamInfo> makeRegistry() {
            "Yaw std when the IMU starts while moving (yaw 0 assumed, F15)"),
       real("output_bias_sigma_m", &P::output_bias_sigma_m, "m", kNonNegative,
            "Slow TDoA bias std mapped into the reported position covariance (F23)"),
+      real("output_bias_memory_s", &P::output_bias_memory_s, "s", kNonNegative,
+           "Memory of the flight's bias level measured in flight, which scales output_bias_sigma_m (F23c); 0 off"),
+      real("output_bias_level_m", &P::output_bias_level_m, "m", kPositive,
+           "Measured pair-bias level above which the reported pair-bias std grows with it (F23c)"),
       // --- downward ToF range (Flow deck VL53L1x, F21) ---
       boolean("fuse_tof", &P::fuse_tof, "Fuse the downward ToF range as a height update (F21)"),
       real("tof_sigma_m", &P::tof_sigma_m, "m", kPositive, "ToF range noise std"),

@@ -165,6 +165,8 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
   }
   bias_floor_ = Mat3::Identity() * params_.output_bias_sigma_m * params_.output_bias_sigma_m;
   recent_pairs_.reserve(64);
+  if (params_.output_bias_memory_s > 0.0 && params_.output_bias_sigma_m > 0.0)
+    bias_level_.emplace(params_.output_bias_memory_s);
 }
 
 void Estimator::initialize(double t_s, const Vec3& acc_mean_b, bool moving) {
@@ -663,6 +665,10 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     antenna_predicted_ = false;
   }
   const BiasPredictor* predictor = antenna_ ? &corrections_ : (bias_ ? &bias_ : nullptr);
+  // (F23c) the residual without the filter's range-bias states, at the prior tag position
+  const double range_bias_prior_m =
+      bias_level_ && ekf_.rangeBias() ? ekf_.rangeBiasDifference(z.id_a, z.id_b) : 0.0;
+  const Vec3 w_p_tag_prior = ekf_.state().w_p_b + ekf_.state().w_q_b * params_.b_t_tag;
   const TdoaUpdateResult r = updateTdoa(ekf_, anchors_, zc, opt, predictor);
   last_tdoa_ = r;
   if (antenna_ && antenna_predicted_ && !acquiring && !near_floor && r.outcome == UpdateOutcome::kApplied) {
@@ -712,6 +718,16 @@ void Estimator::addTdoa(const TdoaObservation& z) {
       n_healthy_ = std::min(n_healthy_ + 1, healthy_.size());
       t_healthy_sample_ = t;
     }
+  }
+  if (bias_level_) {
+    // (F23c) the flight's bias level from the TDoA used in flight; elsewhere (the floor-level bias on and near the
+    // ground, an acquisition's unsettled state) the open window is dropped
+    const Moments3* a = anchors_.find(z.id_a);
+    const Moments3* b = anchors_.find(z.id_b);
+    if (flying && r.outcome == UpdateOutcome::kApplied && a && b)
+      bias_level_->add(t, z.id_a, a->m, z.id_b, b->m, w_p_tag_prior, r.innovation_m + range_bias_prior_m);
+    else if (!flying)
+      bias_level_->interrupt();
   }
   if (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier) {
     // anchor pairs in view, for the reported bias floor (F23)
@@ -785,13 +801,22 @@ Mat3 Estimator::biasFloor() const {
   // on the floor the height is known (F22) and the TDoA carry the floor-level bias, for which the filter's own TDoA σ
   // on the ground stands (F14): the bias moves the horizontal position only (F23′)
   if (on_ground_ && params_.floor_constraint) {
-    const double s = std::max(params_.rest_tdoa_sigma_m, params_.output_bias_sigma_m);
+    const double s = std::max(params_.rest_tdoa_sigma_m, outputBiasSigma());
     Mat3 C = Mat3::Zero();
     C.topLeftCorner<2, 2>() = g.horizontalCovariance(s);
     C(2, 2) = kGroundHeightSigma_m * kGroundHeightSigma_m;  // the body's height on the floor, not the repeated updates'
     return C;
   }
-  return g.covariance(params_.output_bias_sigma_m);
+  return g.covariance(outputBiasSigma());
+}
+
+double Estimator::outputBiasSigma() const {
+  if (!bias_level_) return params_.output_bias_sigma_m;
+  // (F23c) σ_b = output_bias_sigma_m max(1, σ̂_a / σ_a,ref), σ_a,ref² = output_bias_level_m² / 2: a flight whose
+  // measured level exceeds the reference widens the band; a lower one does not narrow it (what no position explains
+  // is seen, what a position shift absorbs is not)
+  const double ref_a2 = 0.5 * params_.output_bias_level_m * params_.output_bias_level_m;
+  return params_.output_bias_sigma_m * std::max(1.0, std::sqrt(bias_level_->sigmaA2(ref_a2) / ref_a2));
 }
 
 LocalizerEstimate Estimator::estimate() const {

@@ -7,6 +7,8 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
+
 #include "uwb/filter/BiasFloor.h"
 
 namespace uwb {
@@ -128,6 +130,29 @@ TEST(BiasFloor, FewPairsSayNothingAndBadPairsAreNotCounted) {
   EXPECT_FALSE(h.addPair(3, arena()[3], 3, arena()[3]));
   EXPECT_FALSE(h.addPair(1, tag, 2, arena()[2]));
   EXPECT_EQ(h.numPairs(), 0);
+}
+
+TEST(BiasFloor, UnexplainedTraceIsTheExpectedResidualOfTheAnchorBiasesOffThePositionDirections) {
+  // (F23c) E‖(I − H(HᵀH)⁻¹Hᵀ) Dβ‖² = σ_a² tr(Q DDᵀ): the dense projector, by definition, for the cycle and all pairs
+  const std::vector<Vec3> a = arena();
+  for (const auto& pairs : {cyclePairs(), allPairs()}) {
+    const Vec3 tag(0.4, -0.7, 1.3);
+    const int m = static_cast<int>(pairs.size());
+    Eigen::MatrixXd H(m, 3), D = Eigen::MatrixXd::Zero(m, 8);
+    for (int k = 0; k < m; ++k) {
+      H.row(k) = ((tag - a[pairs[k].second]).normalized() - (tag - a[pairs[k].first]).normalized()).transpose();
+      D(k, pairs[k].first) = -1.0;
+      D(k, pairs[k].second) = 1.0;
+    }
+    const Eigen::MatrixXd Q = Eigen::MatrixXd::Identity(m, m) - H * (H.transpose() * H).inverse() * H.transpose();
+    const double expected = (Q * D * D.transpose()).trace();
+    EXPECT_NEAR(geometry(tag, pairs).unexplainedTrace(), expected, 1e-6 * expected) << m << " pairs";
+    // three position directions are taken out of the 2m of tr(DDᵀ), each at most DDᵀ's largest eigenvalue
+    const double largest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(D * D.transpose()).eigenvalues().maxCoeff();
+    EXPECT_LT(expected, 2.0 * m);
+    EXPECT_GE(expected, 2.0 * m - 3.0 * largest - 1e-9);
+  }
+  EXPECT_EQ(geometry(Vec3(0, 0, 1), {{0, 1}, {1, 2}, {2, 3}}).unexplainedTrace(), 0.0);
 }
 
 }  // namespace

@@ -34,6 +34,9 @@ class BiasFloorGeometry {
   Mat3 covariance(double sigma_pair_m) const;
   /// The same for the horizontal position with the height known (F23′): the x, y blocks of JᵀLJ and JᵀL²J.
   Eigen::Matrix2d horizontalCovariance(double sigma_pair_m) const;
+  /// (F23c) E‖(I − H(HᵀH)⁻¹Hᵀ) Dβ‖² per unit σ_a²: the part of the pair biases that no position shift explains,
+  /// tr(L) − tr((JᵀLJ)⁻¹ JᵀL²J) (= m − 3 for independent pair biases on a generic geometry). 0 with fewer than 4 pairs.
+  double unexplainedTrace() const;
 
  private:
   int slot(int id, const Vec3& w_p_anchor);

@@ -178,6 +178,11 @@ struct EkfParams {
   /// Std of one pair's slowly varying TDoA bias (F23; each anchor's range bias σ_b/√2): the reported position
   /// covariance is the filter's plus this bias mapped through the anchors in view. 0 reports the filter's P alone.
   double output_bias_sigma_m = 0.2;
+  /// (F23c) The flight's own bias level σ̂_b, measured in flight from the residuals that no position explains, widens
+  /// the reported band: σ_b = output_bias_sigma_m · max(1, σ̂_b / output_bias_level_m). The windows' statistics are
+  /// forgotten with output_bias_memory_s; 0 keeps output_bias_sigma_m fixed.
+  double output_bias_memory_s = 30.0;
+  double output_bias_level_m = 0.24;
 
   // --- downward ToF range (Flow deck VL53L1x), docs/math/filter.md F21 ---
   /// Fuse the ToF range as a height update while airborne (off by default: the published numbers are without).

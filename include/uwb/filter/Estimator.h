@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "uwb/filter/AntennaBias.h"
+#include "uwb/filter/BiasLevel.h"
 #include "uwb/filter/CooperativeRange.h"
 #include "uwb/filter/DescentBound.h"
 #include "uwb/filter/FloorLevelAnchors.h"
@@ -171,6 +172,8 @@ class Estimator {
   Mat3 reportedPositionCovariance() const;
   /// The covariance of the anchors' range biases seen through the pairs in view (F23, BiasFloor.h).
   Mat3 biasFloor() const;
+  /// The pair-bias std that biasFloor() maps: output_bias_sigma_m, scaled by the flight's measured level (F23c).
+  double outputBiasSigma() const;
 
   EkfParams params_;
   AnchorTable anchors_;
@@ -245,6 +248,7 @@ class Estimator {
   std::vector<RecentPair> recent_pairs_;
   TdoaUpdateResult last_tdoa_;
   Mat3 bias_floor_ = Mat3::Zero();  ///< biasFloor() at t_bias_floor_s_; σ_b² I before the first TDoA (F23)
+  std::optional<BiasLevel> bias_level_;  ///< the flight's bias level (F23c), with output_bias_memory_s > 0
   double t_bias_floor_s_ = -1e300;
 };
 
