@@ -31,7 +31,7 @@ void BiasLevel::add(double t_s, int id_a, const Vec3& w_p_a, int id_b, const Vec
   const Vec3& b = swapped ? w_p_a : w_p_b;
   if (swapped) std::swap(id_a, id_b);
   PairSum* p = nullptr;
-  for (int k = 0; k < n_pairs_; ++k)
+  for (int k = 0; k < n_pairs_ && !p; ++k)
     if (pairs_[k].id_a == id_a && pairs_[k].id_b == id_b) p = &pairs_[k];
   if (!p) {
     if (n_pairs_ == kMaxPairs) return;
