@@ -186,7 +186,9 @@ py::dict summaryDict(const LocalizerSummary& s) {
   d["n_tdoa_degenerate"] = s.n_tdoa_degenerate, d["n_tdoa_unknown_anchor"] = s.n_tdoa_unknown_anchor;
   d["n_predictions"] = s.n_predictions, d["n_covariance_propagations"] = s.n_covariance_propagations;
   d["n_reacquisitions"] = s.n_reacquisitions, d["n_rejection_faults"] = s.n_rejection_faults;
-  d["n_reverted_motion"] = s.n_reverted_motion, d["start_replayed"] = s.start_replayed, d["reacquisition_t_s"] = s.reacquisition_t_s;
+  d["n_reverted_motion"] = s.n_reverted_motion, d["start_replayed"] = s.start_replayed;
+  d["bias_level_m"] = s.bias_level_m, d["n_bias_level_windows"] = s.n_bias_level_windows;
+  d["reacquisition_t_s"] = s.reacquisition_t_s;
   d["reacquired_t_s"] = s.reacquired_t_s, d["takeoff_t_s"] = s.takeoff_t_s, d["landing_t_s"] = s.landing_t_s;
   d["start_t_s"] = s.start_t_s, d["end_t_s"] = s.end_t_s, d["process_model"] = toString(s.process_model);
   d["start_w_p_b"] = toNumpy(s.start_w_p_b, true), d["start_rms_residual_m"] = s.start_rms_residual_m;

@@ -210,6 +210,8 @@ void runLocalize(const LocalizeArgs& a) {
   j["n_rejection_faults"] = s.n_rejection_faults;
   j["n_reverted_motion"] = s.n_reverted_motion;
   j["start_replayed"] = s.start_replayed;
+  j["bias_level_m"] = std::isnan(s.bias_level_m) ? json(nullptr) : json(s.bias_level_m);
+  j["n_bias_level_windows"] = s.n_bias_level_windows;
   j["fuse_tof"] = params.fuse_tof;
   j["n_tof"] = s.n_tof_total;
   j["n_tof_used"] = s.n_tof_used;
@@ -287,6 +289,12 @@ void runLocalize(const LocalizeArgs& a) {
   }
   if (!std::isnan(s.ready_t_s)) std::cout << "position found at " << s.ready_t_s << " s\n";
   if (!std::isnan(s.takeoff_t_s)) std::cout << "left rest at " << s.takeoff_t_s << " s\n";
+  if (!std::isnan(s.bias_level_m)) {
+    // (F23c) the reported band is widened when the flight's level exceeds the reference
+    const double widen = std::max(1.0, s.bias_level_m / params.output_bias_level_m);
+    std::printf("TDoA bias level measured in flight %.3f m (reference %.2f m; reported bias std x%.2f)\n",
+                s.bias_level_m, params.output_bias_level_m, widen);
+  }
   for (const std::string& n : s.merge.notes()) std::cout << "note: " << n << "\n";
   for (const std::string& n : notes) std::cout << "note: " << n << "\n";
   if (run.metrics) {

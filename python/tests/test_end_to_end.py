@@ -72,6 +72,12 @@ def test_train_localize_and_compare(flights, trained, tmp_path):
         assert 0 < air["rmse_m"] < 1.5 and air["n"] > 100
         s = run["metrics"]["samples"]
         np.testing.assert_allclose(np.sqrt(np.mean(s["error_norm"][s["airborne"]] ** 2)), air["rmse_m"], rtol=1e-9)
+    # the bias level measured in flight (filter.md F23c) is reported, and switched off with its memory
+    assert plain["summary"]["n_bias_level_windows"] > 10 and 0 < plain["summary"]["bias_level_m"] < 1
+    fixed = u.localize_flight(test["flight"], test["survey"], params={"output_bias_memory_s": 0.0})
+    assert fixed["summary"]["n_bias_level_windows"] == 0 and np.isnan(fixed["summary"]["bias_level_m"])
+    np.testing.assert_array_equal(fixed["trajectory"]["p"], plain["trajectory"]["p"])
+    assert np.all(plain["trajectory"]["sigma_p"] >= fixed["trajectory"]["sigma_p"] - 1e-12)
     # the correction changes the estimate
     assert not np.allclose(plain["trajectory"]["p"], corrected["trajectory"]["p"])
     # metrics recomputed from the arrays agree with the filter run's

@@ -728,6 +728,11 @@ void Estimator::addTdoa(const TdoaObservation& z) {
       bias_level_->add(t, z.id_a, a->m, z.id_b, b->m, w_p_tag_prior, r.innovation_m + range_bias_prior_m);
     else if (!flying)
       bias_level_->interrupt();
+    if (static_cast<std::size_t>(bias_level_->numWindows()) != summary_.n_bias_level_windows) {
+      summary_.n_bias_level_windows = static_cast<std::size_t>(bias_level_->numWindows());
+      const double ref_a2 = 0.5 * params_.output_bias_level_m * params_.output_bias_level_m;
+      summary_.bias_level_m = std::sqrt(2.0 * bias_level_->sigmaA2(ref_a2));
+    }
   }
   if (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier) {
     // anchor pairs in view, for the reported bias floor (F23)

@@ -239,6 +239,10 @@ TEST(Generalization, RealFlightWithALargeBiasWidensItsReportedSigma) {
   EXPECT_GT(c.coverage_2sigma.minCoeff(), 0.85);
   EXPECT_LT(c_fixed.coverage_1sigma.z(), 0.45);
   EXPECT_EQ(run.metrics->airborne.rmse_m, run_fixed.metrics->airborne.rmse_m);
+  // and the level it measured is above the reference, reported in the summary; none is measured when it is off
+  EXPECT_GT(run.summary.bias_level_m, 0.3);
+  EXPECT_GT(run.summary.n_bias_level_windows, 40u);
+  EXPECT_TRUE(std::isnan(run_fixed.summary.bias_level_m));
 }
 
 TEST(Generalization, SimulatedTdoa3) {

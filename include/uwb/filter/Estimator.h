@@ -95,6 +95,10 @@ struct LocalizerSummary {
   std::size_t n_rejection_faults = 0; ///< re-acquisitions because most TDoA were rejected (F16d)
   std::size_t n_reverted_motion = 0;  ///< of them, with the state put back to the motion before the fault (F16d)
   bool start_replayed = false;         ///< the first start in motion ran the filter again from its fix (F16g)
+  /// The pair-bias level measured in flight (F23c), √(2σ̂_a²) with the prior's share, at the last window counted;
+  /// NaN before the first (or with output_bias_memory_s = 0)
+  double bias_level_m = std::numeric_limits<double>::quiet_NaN();
+  std::size_t n_bias_level_windows = 0;  ///< windows counted for it (F23c)
   std::size_t n_reacquisitions = 0;    ///< lost or diverged → position found again by multilateration (F16)
   std::size_t n_time_jumps = 0;        ///< sensor-time gaps or backward jumps handled (F17)
   std::vector<double> reacquisition_t_s;  ///< when each re-acquisition started (first 100)
