@@ -188,6 +188,8 @@ py::dict summaryDict(const LocalizerSummary& s) {
   d["n_reacquisitions"] = s.n_reacquisitions, d["n_rejection_faults"] = s.n_rejection_faults;
   d["n_reverted_motion"] = s.n_reverted_motion, d["start_replayed"] = s.start_replayed;
   d["bias_level_m"] = s.bias_level_m, d["n_bias_level_windows"] = s.n_bias_level_windows;
+  d["raw_bias_level_m"] = s.raw_bias_level_m, d["bias_model_mean_scale"] = s.bias_model_mean_scale;
+  d["min_bias_model_mean_scale"] = s.min_bias_model_mean_scale;
   d["reacquisition_t_s"] = s.reacquisition_t_s;
   d["reacquired_t_s"] = s.reacquired_t_s, d["takeoff_t_s"] = s.takeoff_t_s, d["landing_t_s"] = s.landing_t_s;
   d["start_t_s"] = s.start_t_s, d["end_t_s"] = s.end_t_s, d["process_model"] = toString(s.process_model);
@@ -214,6 +216,7 @@ py::dict flightReportDict(const BiasFlightReport& r) {
   d["n_no_ground_truth"] = r.n_no_ground_truth, d["n_pose_glitch"] = r.n_pose_glitch;
   d["n_on_ground"] = r.n_on_ground, d["n_non_neighbour"] = r.n_non_neighbour, d["n_outlier"] = r.n_outlier;
   d["n_used"] = r.n_used, d["n_pose_glitches_detected"] = r.n_pose_glitches_detected;
+  d["bias_level_m"] = r.bias_level_m;
   return d;
 }
 
@@ -343,6 +346,8 @@ void bindEval(py::module_& m) {
           },
           py::arg("features"),
           "Predicted bias of every row of a feature dict: {mean [m], var [m²] (latent)}; 0, 0 for uncovered pairs.")
+      .def_property("training_bias_level_m", &BiasModel::trainingBiasLevel, &BiasModel::setTrainingBiasLevel,
+                    "TDoA bias level of the training flights [m] (filter.md F24b; 0 unknown: the mean is not scaled)")
       .def_property("metadata_json", [](const BiasModel& b) { return b.metadata_json; },
                     [](BiasModel& b, const std::string& s) { b.metadata_json = s; })
       .def("save", &BiasModel::save, py::arg("path"), "Writes the model file (the CLI's --bias-model format).")
@@ -436,6 +441,7 @@ void bindEval(py::module_& m) {
         options.output_period_s = output_period_s;
         options.tdoa_only = tdoa_only;
         options.metrics.airborne_min_z_m = airborne_min_z_m;
+        if (bias_model) applyBiasModelLevel(*bias_model, &options.params);  // (F24b)
         LocalizationRun run;
         {
           py::gil_scoped_release release;

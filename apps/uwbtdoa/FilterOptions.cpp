@@ -66,9 +66,11 @@ FilterSetup buildFilterParams(const FilterOptionArgs& a) {
   return s;
 }
 
-BiasPredictor loadBiasPredictor(const FilterOptionArgs& a) {
+BiasPredictor loadBiasPredictor(const FilterOptionArgs& a, EkfParams* params) {
   if (a.bias_model.empty()) return {};
-  return BiasModel::load(a.bias_model).predictor();  // the GP as a plain BiasPredictor (the filter knows no GPs)
+  const BiasModel model = BiasModel::load(a.bias_model);
+  applyBiasModelLevel(model, params);                   // (F24b)
+  return model.predictor();  // the GP as a plain BiasPredictor (the filter knows no GPs)
 }
 
 }  // namespace uwb::app

@@ -35,7 +35,8 @@ struct FilterSetup {
 /// the tag offset.
 FilterSetup buildFilterParams(const FilterOptionArgs& a);
 
-/// The bias model's predictor, or an empty one without --bias-model.
-BiasPredictor loadBiasPredictor(const FilterOptionArgs& a);
+/// The bias model's predictor, or an empty one without --bias-model. Sets params->bias_model_training_level_m from
+/// the model file unless it was given (filter.md F24b).
+BiasPredictor loadBiasPredictor(const FilterOptionArgs& a, EkfParams* params);
 
 }  // namespace uwb::app

@@ -110,7 +110,7 @@ void runLocalize(const LocalizeArgs& a) {
   const bool process_model_given = setup.process_model_given, start_flag = setup.start_flag;
   if (a.no_ground_detect) params.ground_phase = uwb::GroundPhase::kNone;
   params.validate();
-  const uwb::BiasPredictor bias = uwb::app::loadBiasPredictor(a.filter);
+  const uwb::BiasPredictor bias = uwb::app::loadBiasPredictor(a.filter, &params);
 
   const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(a.anchors);
   warnings.addIssues(uwb::checkSurveyGeometry(survey));
@@ -212,6 +212,10 @@ void runLocalize(const LocalizeArgs& a) {
   j["start_replayed"] = s.start_replayed;
   j["bias_level_m"] = std::isnan(s.bias_level_m) ? json(nullptr) : json(s.bias_level_m);
   j["n_bias_level_windows"] = s.n_bias_level_windows;
+  j["raw_bias_level_m"] = std::isnan(s.raw_bias_level_m) ? json(nullptr) : json(s.raw_bias_level_m);
+  j["bias_model_training_level_m"] = params.bias_model_training_level_m;
+  j["bias_model_mean_scale"] = s.bias_model_mean_scale;
+  j["min_bias_model_mean_scale"] = s.min_bias_model_mean_scale;
   j["fuse_tof"] = params.fuse_tof;
   j["n_tof"] = s.n_tof_total;
   j["n_tof_used"] = s.n_tof_used;

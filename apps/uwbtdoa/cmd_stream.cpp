@@ -66,8 +66,8 @@ void runStream(const StreamArgs& a) {
   if (a.format != "json" && a.format != "csv")
     throw uwb::InputError("--format: expected json or csv, got '" + a.format + "'");
   const uwb::EstimateFormat format = a.format == "csv" ? uwb::EstimateFormat::kCsv : uwb::EstimateFormat::kJson;
-  const uwb::app::FilterSetup setup = uwb::app::buildFilterParams(a.filter);
-  const uwb::BiasPredictor bias = uwb::app::loadBiasPredictor(a.filter);
+  uwb::app::FilterSetup setup = uwb::app::buildFilterParams(a.filter);
+  const uwb::BiasPredictor bias = uwb::app::loadBiasPredictor(a.filter, &setup.params);
   const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(a.anchors);
   uwb::app::Warnings warnings;
   warnings.addIssues(uwb::checkSurveyGeometry(survey));

@@ -141,6 +141,7 @@ void run(const TrainOptions& o) {
                {"inputs", o.inputs},
                {"extra_sigma_m", o.extra_sigma},
                {"mean_scale", o.mean_scale},
+               {"training_bias_level_m", model.trainingBiasLevel()},
                {"predictive_dof", o.predictive_shape.dof},
                {"predictive_scale", o.predictive_shape.scale},
                {"full_variance", o.full_variance},
@@ -164,7 +165,8 @@ void run(const TrainOptions& o) {
   for (const auto& f : data.flights)
     excl.push_back({{"flight", f.source}, {"measurements", f.n_measurements}, {"unknown_anchor", f.n_unknown_anchor},
                     {"no_ground_truth", f.n_no_ground_truth}, {"pose_glitch", f.n_pose_glitch}, {"on_ground", f.n_on_ground},
-                    {"non_neighbour", f.n_non_neighbour}, {"outlier", f.n_outlier}, {"used", f.n_used}});
+                    {"non_neighbour", f.n_non_neighbour}, {"outlier", f.n_outlier}, {"used", f.n_used},
+                    {"bias_level_m", std::isnan(f.bias_level_m) ? json(nullptr) : json(f.bias_level_m)}});
   summary["exclusions"] = excl;
   model.metadata_json = uwb::app::dumpJson(summary);
   model.save(o.out);
@@ -187,6 +189,10 @@ void run(const TrainOptions& o) {
                            "`uwbtdoa predict-bias`)\n",
                            rep.mean_predictive_std_m, 100.0 * rep.holdout_coverage_1sigma,
                            100.0 * rep.holdout_coverage_2sigma, rep.holdout_nlpd);
+  if (model.trainingBiasLevel() > 0.0)
+    std::cout << fmt::format("TDoA bias level of the training flights (filter.md F23c) {:.3f} m: the filter scales the "
+                             "mean down on a flight of a lower level (F24b)\n",
+                             model.trainingBiasLevel());
   std::cout << "learned hyperparameters:\n";
   for (const auto& [model_name, h] : hyper.items()) {
     std::cout << "  " << model_name << ":";

@@ -78,6 +78,12 @@ def test_train_localize_and_compare(flights, trained, tmp_path):
     assert fixed["summary"]["n_bias_level_windows"] == 0 and np.isnan(fixed["summary"]["bias_level_m"])
     np.testing.assert_array_equal(fixed["trajectory"]["p"], plain["trajectory"]["p"])
     assert np.all(plain["trajectory"]["sigma_p"] >= fixed["trajectory"]["sigma_p"] - 1e-12)
+    # with a model the level of the uncorrected TDoA is measured too (filter.md F24b); the mean is scaled only when
+    # the model knows its training flights' level (trained on filter inputs) and this flight's is lower
+    cs = corrected["summary"]
+    assert 0 < cs["raw_bias_level_m"] < 1 and 0 < cs["min_bias_model_mean_scale"] <= cs["bias_model_mean_scale"] <= 1
+    if model.training_bias_level_m == 0:
+        assert cs["bias_model_mean_scale"] == 1.0
     # the correction changes the estimate
     assert not np.allclose(plain["trajectory"]["p"], corrected["trajectory"]["p"])
     # metrics recomputed from the arrays agree with the filter run's

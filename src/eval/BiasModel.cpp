@@ -233,6 +233,12 @@ void PredictiveShape::validate() const {
     throw std::invalid_argument("predictive_scale must be in (0, 10]");
 }
 
+void BiasModel::setTrainingBiasLevel(double level_m) {
+  if (!std::isfinite(level_m) || !(level_m >= 0.0) || level_m > 10.0)
+    throw std::invalid_argument("training_bias_level_m must be in [0, 10] m");
+  training_bias_level_m_ = level_m;
+}
+
 void BiasModel::setPredictiveShape(const PredictiveShape& shape) {
   shape.validate();
   predictive_shape_ = shape;
@@ -335,6 +341,7 @@ nlohmann::json BiasModel::toJson() const {
           {"pair_means", means},
           {"extra_variance_m2", extra_variance_m2_},
           {"mean_scale", mean_scale_},
+          {"training_bias_level_m", training_bias_level_m_},
           {"predictive_dof", predictive_shape_.dof},
           {"predictive_scale", predictive_shape_.scale},
           {"full_variance", full_variance_},
@@ -425,6 +432,8 @@ BiasModel BiasModel::fromJson(const nlohmann::json& j) {
       model.setExtraVariance(v);
     }
     if (j.contains("mean_scale")) model.setMeanScale(jsonDouble(j.at("mean_scale"), "mean_scale"));
+    if (j.contains("training_bias_level_m"))  // (F24b) an older file: unknown, no scaling
+      model.setTrainingBiasLevel(jsonDouble(j.at("training_bias_level_m"), "training_bias_level_m"));
     PredictiveShape shape;  // (P43b) a file without the fields gets the defaults
     if (j.contains("predictive_dof")) shape.dof = jsonDouble(j.at("predictive_dof"), "predictive_dof");
     if (j.contains("predictive_scale")) shape.scale = jsonDouble(j.at("predictive_scale"), "predictive_scale");
@@ -563,6 +572,17 @@ BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params,
   model.setExtraVariance(params.extra_sigma_m * params.extra_sigma_m);  // (P31)
   model.setMeanScale(params.mean_scale);                                 // (P44)
   model.setPredictiveShape(params.predictive_shape);                     // (P43b)
+  {  // (F24b) the training flights' bias level, as the filter measured it on them
+    double sum = 0.0;
+    int n = 0;
+    for (const BiasFlightReport& f : data.flights) {
+      if (std::isfinite(f.bias_level_m) && f.bias_level_m > 0.0) {
+        sum += f.bias_level_m;
+        ++n;
+      }
+    }
+    if (n > 0) model.setTrainingBiasLevel(sum / n);
+  }
   if (params.full_variance) {  // (P45): E[ε²] of the training targets
     double sum_sq = 0.0, n = 0.0;
     for (std::size_t i = 0; i < data.samples.size(); ++i) {
@@ -609,6 +629,10 @@ BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params,
     *report = r;
   }
   return model;
+}
+
+void applyBiasModelLevel(const BiasModel& model, EkfParams* params) {
+  if (!(params->bias_model_training_level_m > 0.0)) params->bias_model_training_level_m = model.trainingBiasLevel();
 }
 
 }  // namespace uwb

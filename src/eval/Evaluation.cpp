@@ -207,10 +207,12 @@ EvaluationResult runEvaluation(const std::vector<NamedFlight>& train, const std:
         BiasTrainReport report;
         BiasModel model = trainBiasModel(train_data, tp, &report);
         const BiasPredictor predictor = model.predictor();
+        LocalizationOptions corrected = params.localization;
+        applyBiasModelLevel(model, &corrected.params);  // (F24b)
         JobOutput& out = outputs[j];
         std::string line;
         for (const auto& f : test) {
-          LocalizationRun run = localizeFlight(f.flight, survey, params.localization, predictor);
+          LocalizationRun run = localizeFlight(f.flight, survey, corrected, predictor);
           EvaluationRun er;
           er.kernel = job.kernel;
           er.inducing = job.inducing;

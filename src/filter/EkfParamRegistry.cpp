@@ -157,6 +157,10 @@ std::vector<EkfParamInfo> makeRegistry() {
              toString,
              "With a bias model: the pose uncertainty of the correction, as variance ∇µᵀ P ∇µ or in the row "
              "∂(h + µ)/∂δx (gp.md P47)"),
+      real("bias_model_level_exponent", &P::bias_model_level_exponent, "", kNonNegative,
+           "With a bias model: its mean scaled by min(1, flight's bias level / training level)^this; 0 off (F24b)"),
+      real("bias_model_training_level_m", &P::bias_model_training_level_m, "m", kNonNegative,
+           "Bias level of the model's training flights (from the model file; 0 unknown: no scaling, F24b)"),
       real("max_lost_s", &P::max_lost_s, "s", kPositive,
            "All TDoA rejected this long: re-acquire (inflate P, open the gate)"),
       real("lost_velocity_tau_s", &P::lost_velocity_tau_s, "s", kNonNegative,

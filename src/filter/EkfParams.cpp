@@ -77,6 +77,8 @@ void EkfParams::validate() const {
   requirePositive(moving_start_yaw_sigma_rad, "moving_start_yaw_sigma_rad");
   requireNonNegative(output_bias_sigma_m, "output_bias_sigma_m");
   requireNonNegative(output_bias_memory_s, "output_bias_memory_s");
+  requireNonNegative(bias_model_level_exponent, "bias_model_level_exponent");
+  requireNonNegative(bias_model_training_level_m, "bias_model_training_level_m");
   requirePositive(output_bias_level_m, "output_bias_level_m");
   requirePositive(tof_sigma_m, "tof_sigma_m");
   if (!std::isfinite(tof_offset_m)) throw std::invalid_argument("EkfParams.tof_offset_m must be finite");

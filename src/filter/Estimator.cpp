@@ -167,6 +167,18 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
   recent_pairs_.reserve(64);
   if (params_.output_bias_memory_s > 0.0 && params_.output_bias_sigma_m > 0.0)
     bias_level_.emplace(params_.output_bias_memory_s);
+  if (bias_ && params_.output_bias_memory_s > 0.0) {
+    raw_level_.emplace(params_.output_bias_memory_s);
+    if (params_.bias_model_training_level_m > 0.0 && params_.bias_model_level_exponent > 0.0) {
+      // (F24b) the model's mean scaled by what this flight's own level says of the model's training flights
+      model_bias_ = std::move(bias_);
+      bias_ = [this](const TdoaFeature& feature) {
+        BiasPrediction b = model_bias_(feature);
+        b.mean_m *= model_mean_scale_;
+        return b;
+      };
+    }
+  }
 }
 
 void Estimator::initialize(double t_s, const Vec3& acc_mean_b, bool moving) {
@@ -667,7 +679,7 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   const BiasPredictor* predictor = antenna_ ? &corrections_ : (bias_ ? &bias_ : nullptr);
   // (F23c) the residual without the filter's range-bias states, at the prior tag position
   const double range_bias_prior_m =
-      bias_level_ && ekf_.rangeBias() ? ekf_.rangeBiasDifference(z.id_a, z.id_b) : 0.0;
+      (bias_level_ || raw_level_) && ekf_.rangeBias() ? ekf_.rangeBiasDifference(z.id_a, z.id_b) : 0.0;
   const Vec3 w_p_tag_prior = ekf_.state().w_p_b + ekf_.state().w_q_b * params_.b_t_tag;
   const TdoaUpdateResult r = updateTdoa(ekf_, anchors_, zc, opt, predictor);
   last_tdoa_ = r;
@@ -733,6 +745,18 @@ void Estimator::addTdoa(const TdoaObservation& z) {
       const double ref_a2 = 0.5 * params_.output_bias_level_m * params_.output_bias_level_m;
       summary_.bias_level_m = std::sqrt(2.0 * bias_level_->sigmaA2(ref_a2));
     }
+  }
+  if (raw_level_) {
+    // (F24b) the same statistic on the TDoA before the model's correction (bias_mean_m is what it subtracted)
+    const Moments3* a = anchors_.find(z.id_a);
+    const Moments3* b = anchors_.find(z.id_b);
+    const int n_before = raw_level_->numWindows();
+    if (flying && r.outcome == UpdateOutcome::kApplied && a && b)
+      raw_level_->add(t, z.id_a, a->m, z.id_b, b->m, w_p_tag_prior,
+                      r.innovation_m + range_bias_prior_m + r.bias_mean_m);
+    else if (!flying)
+      raw_level_->interrupt();
+    if (raw_level_->numWindows() != n_before) updateModelMeanScale();
   }
   if (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier) {
     // anchor pairs in view, for the reported bias floor (F23)
@@ -813,6 +837,20 @@ Mat3 Estimator::biasFloor() const {
     return C;
   }
   return g.covariance(outputBiasSigma());
+}
+
+void Estimator::updateModelMeanScale() {
+  // (F24b) ρ = the flight's uncorrected level / the model's training level, both pair levels √(2σ_a²); the estimate
+  // starts from the training level (ρ = 1, the model as trained) and follows the flight's windows
+  const double train = params_.bias_model_training_level_m;
+  const double level = std::sqrt(2.0 * raw_level_->sigmaA2(train > 0.0 ? 0.5 * train * train
+                                                                       : 0.5 * params_.output_bias_level_m *
+                                                                             params_.output_bias_level_m));
+  summary_.raw_bias_level_m = level;
+  if (!model_bias_) return;
+  model_mean_scale_ = std::pow(std::min(1.0, level / train), params_.bias_model_level_exponent);
+  summary_.bias_model_mean_scale = model_mean_scale_;
+  summary_.min_bias_model_mean_scale = std::min(summary_.min_bias_model_mean_scale, model_mean_scale_);
 }
 
 double Estimator::outputBiasSigma() const {

@@ -9,6 +9,8 @@
 #include <random>
 
 #include "uwb/eval/BiasCalibration.h"
+#include "uwb/eval/BiasModel.h"
+#include "uwb/filter/EkfParams.h"
 
 namespace uwb {
 namespace {
@@ -196,6 +198,26 @@ TEST(PredictiveShape, TheModelFileCarriesTheShapeAndAnOlderFileGetsTheDefault) {
   } catch (const std::invalid_argument& e) {
     EXPECT_TRUE(std::string(e.what()).find("predictive_dof") != std::string::npos) << e.what();
   }
+}
+
+TEST(BiasModelLevel, TheModelFileCarriesTheTrainingLevelAndTheFilterGetsItUnlessGiven) {
+  // (filter.md F24b) the training flights' bias level travels with the model to the filter's parameters
+  gp::Svgp svgp(gp::Kernel::preset("z1"), MatX::Random(5, 2));
+  BiasModel model("z1", FeatureMap::kYawAngles, {{0, 1, svgp}});
+  EXPECT_EQ(model.trainingBiasLevel(), 0.0);  // unknown
+  model.setTrainingBiasLevel(0.31);
+  nlohmann::json j = model.toJson();
+  EXPECT_EQ(BiasModel::fromJson(j).trainingBiasLevel(), 0.31);
+  EkfParams p;
+  applyBiasModelLevel(BiasModel::fromJson(j), &p);
+  EXPECT_EQ(p.bias_model_training_level_m, 0.31);
+  p.bias_model_training_level_m = 0.2;  // given by the user: kept
+  applyBiasModelLevel(BiasModel::fromJson(j), &p);
+  EXPECT_EQ(p.bias_model_training_level_m, 0.2);
+  j.erase("training_bias_level_m");  // an older file: unknown, no scaling
+  EXPECT_EQ(BiasModel::fromJson(j).trainingBiasLevel(), 0.0);
+  EXPECT_THROW(model.setTrainingBiasLevel(std::nan("")), std::invalid_argument);
+  EXPECT_THROW(model.setTrainingBiasLevel(-0.1), std::invalid_argument);
 }
 
 }  // namespace

@@ -55,6 +55,13 @@ TEST(TrainCli, DumpsNamedTrainingArraysAndIsRepeatableForASeedAndThreadCount) {
   // AND the two runs wrote the same model (the summary's file name aside)
   nlohmann::json ma = nlohmann::json::parse(readAll(dir / "a.json")), mb = nlohmann::json::parse(readAll(dir / "b.json"));
   EXPECT_EQ(ma.at("models").dump(), mb.at("models").dump());
+  // AND the model carries the bias level the filter measured on its training flight (filter.md F23c, F24b; GP inputs
+  // from the filter's estimate, the default), as the summary and the flight's row say
+  const double level = ma.at("training_bias_level_m").get<double>();
+  EXPECT_GT(level, 0.1);
+  EXPECT_LT(level, 0.5);
+  EXPECT_EQ(summary.at("training_bias_level_m").get<double>(), level);
+  EXPECT_EQ(summary.at("exclusions").at(0).at("bias_level_m").get<double>(), level);
   std::filesystem::remove_all(dir);
 }
 

@@ -276,6 +276,46 @@ TEST(Estimator, ReportedCovarianceAddsTheBiasFloor) {
   EXPECT_DOUBLE_EQ(std::sqrt(ea.cov_pose(2, 2)), ea.sigma_p_m.z());
 }
 
+TEST(Estimator, ABiasModelOfAMoreBiasedFlightIsScaledDownByThisFlightsLevel) {
+  // GIVEN a flight without TDoA bias (white noise 5 cm) and a bias model that does not fit it: ±0.3 m per pair, as a
+  // model trained on flights whose measured bias level was 0.5 m might predict
+  const SensorLog log = circleLog(0.0, 40.0, 3);
+  const BiasPredictor wrong = [](const TdoaFeature& f) {
+    BiasPrediction b;
+    b.mean_m = (f.id_a + f.id_b) % 2 == 0 ? 0.3 : -0.3;
+    b.variance_m2 = 0.01;
+    return b;
+  };
+  EkfParams scaled = lateralFullParams();
+  scaled.bias_model_training_level_m = 0.5;
+  EkfParams off = scaled;
+  off.bias_model_level_exponent = 0.0;
+  EkfParams unknown = scaled;
+  unknown.bias_model_training_level_m = 0.0;  // an older model file
+  const LocalizerResult a = TdoaLocalizer(scaled, arenaAnchors(), wrong).run(log, 0.1);
+  const LocalizerResult b = TdoaLocalizer(off, arenaAnchors(), wrong).run(log, 0.1);
+  const LocalizerResult c = TdoaLocalizer(unknown, arenaAnchors(), wrong).run(log, 0.1);
+  const auto rms = [](const LocalizerResult& r) {
+    double se = 0.0;
+    int n = 0;
+    for (const LocalizerEstimate& e : r.estimates)
+      if (e.t_s >= 20.0) se += (e.x.w_p_b - circle(e.t_s).p).squaredNorm(), ++n;
+    return std::sqrt(se / n);
+  };
+  // THEN the flight's own level (measured before the correction, F24b) is far below the model's: it starts from the
+  // training level (ρ = 1), which keeps the weight of 10 windows against the ≈ 50 windows of 40 s flown
+  // (√((10 · 0.5²) / 60) ≈ 0.2 m even with no bias at all), the mean is scaled down by (0.2 / 0.5)² and below,
+  // and the position error with it
+  EXPECT_LT(a.summary.raw_bias_level_m, 0.25);
+  EXPECT_LT(a.summary.bias_model_mean_scale, 0.25);
+  EXPECT_LE(a.summary.min_bias_model_mean_scale, a.summary.bias_model_mean_scale);
+  EXPECT_LT(rms(a), 0.5 * rms(b));
+  // the model as trained when the scaling is off or the training level unknown: the same run
+  EXPECT_EQ(b.summary.bias_model_mean_scale, 1.0);
+  EXPECT_EQ(rms(b), rms(c));
+  EXPECT_TRUE(std::isfinite(c.summary.raw_bias_level_m));  // still measured and reported
+}
+
 TEST(Estimator, OnTheFloorTheReportedCovarianceCarriesTheFloorLevelBias) {
   // GIVEN a take-off log (on the floor for 2 s, then a climb), localized with the bias floor of F23 and without it
   const SensorLog log = filtertest::takeoffLog(filtertest::TakeoffLogSpec{});

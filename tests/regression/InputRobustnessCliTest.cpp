@@ -214,6 +214,7 @@ TEST_F(RobustCli, CorruptBiasModelValuesAreErrorsNamingTheFileAndKey) {
       {"jitter", [](nlohmann::json& j) { j["models"][0]["svgp"]["jitter"] = -10; }, "models[0].svgp.jitter"},
       {"dof", [](nlohmann::json& j) { j["predictive_dof"] = 1.0; }, "predictive_dof"},
       {"scale", [](nlohmann::json& j) { j["predictive_scale"] = "wide"; }, "predictive_scale"},
+      {"level", [](nlohmann::json& j) { j["training_bias_level_m"] = -0.2; }, "training_bias_level_m"},
       {"dims", [](nlohmann::json& j) { j["models"][0]["svgp"]["kernel"]["parts"][0]["active_dims"] = {1e300}; },
        "active_dims"},
   };

@@ -167,6 +167,11 @@ class BiasModel {
   /// (P43b) The shape of the predictive distribution the calibration scores (default: PredictiveShape{}).
   const PredictiveShape& predictiveShape() const { return predictive_shape_; }
   void setPredictiveShape(const PredictiveShape& shape);  ///< throws std::invalid_argument (PredictiveShape::validate)
+  /// (F24b) The TDoA bias level of the training flights, measured by the filter in flight (filter.md F23c; the mean
+  /// of the flights' levels); 0 when unknown (trained on ground-truth inputs, or an older file). The filter scales
+  /// the mean down on a flight whose own level is lower (EkfParams::bias_model_training_level_m).
+  double trainingBiasLevel() const { return training_bias_level_m_; }
+  void setTrainingBiasLevel(double level_m);  ///< throws std::invalid_argument unless finite and ≥ 0
   /// Constant mean of the pair (0 when none was learned).
   double pairMean(int id_a, int id_b) const;
 
@@ -186,6 +191,7 @@ class BiasModel {
   std::vector<PairMean> pair_means_;
   double extra_variance_m2_ = 0.0;
   double mean_scale_ = 1.0;
+  double training_bias_level_m_ = 0.0;
   PredictiveShape predictive_shape_;
   bool full_variance_ = false;
   double target_mean_square_m2_ = 0.0;
@@ -204,5 +210,9 @@ std::vector<BiasModel::PairMean> pairMeans(const std::vector<BiasSample>& sample
 
 /// Indices of held-out samples: every k-th block of `block_s` seconds of each flight, k = round(1/fraction).
 std::vector<bool> holdoutMask(const std::vector<BiasSample>& samples, double fraction, double block_s);
+
+/// (F24b) Gives the filter the model's training level: sets params->bias_model_training_level_m to
+/// model.trainingBiasLevel() unless it is already > 0 (given by the user).
+void applyBiasModelLevel(const BiasModel& model, EkfParams* params);
 
 }  // namespace uwb

@@ -133,6 +133,12 @@ struct EkfParams {
   /// With a bias model: how the pose uncertainty of µ(x̂) enters (docs/math/gp.md P47). Off by default: neither form
   /// improved the leave-one-session-out splits (P47).
   BiasPoseUncertainty bias_model_pose = BiasPoseUncertainty::kNone;
+  /// (F24b) With a bias model whose training flights' bias level is known (bias_model_training_level_m > 0, set
+  /// from the model file): the model's mean is scaled by min(1, ρ)^γ, ρ = the bias level of this flight's
+  /// uncorrected TDoA measured in flight (F23c) / the training level, γ = bias_model_level_exponent (0 off). A
+  /// model of a more biased flight than this one over-corrects it.
+  double bias_model_level_exponent = 2.0;
+  double bias_model_training_level_m = 0.0;
 
   // --- scheduling ---
   double max_predict_dt_s = 0.01;        ///< IMU samples are averaged over at most this interval [s]

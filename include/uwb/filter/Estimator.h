@@ -99,6 +99,10 @@ struct LocalizerSummary {
   /// NaN before the first (or with output_bias_memory_s = 0)
   double bias_level_m = std::numeric_limits<double>::quiet_NaN();
   std::size_t n_bias_level_windows = 0;  ///< windows counted for it (F23c)
+  /// With a bias model: the level of the TDoA before its correction (F24b; without a model bias_level_m is that)
+  double raw_bias_level_m = std::numeric_limits<double>::quiet_NaN();
+  double bias_model_mean_scale = 1.0;      ///< the scale of the model's mean at the end (F24b)
+  double min_bias_model_mean_scale = 1.0;  ///< its lowest during the flight (F24b)
   std::size_t n_reacquisitions = 0;    ///< lost or diverged → position found again by multilateration (F16)
   std::size_t n_time_jumps = 0;        ///< sensor-time gaps or backward jumps handled (F17)
   std::vector<double> reacquisition_t_s;  ///< when each re-acquisition started (first 100)
@@ -178,6 +182,8 @@ class Estimator {
   Mat3 biasFloor() const;
   /// The pair-bias std that biasFloor() maps: output_bias_sigma_m, scaled by the flight's measured level (F23c).
   double outputBiasSigma() const;
+  /// (F24b) The scale of the bias model's mean from the flight's uncorrected level; after each window of raw_level_.
+  void updateModelMeanScale();
 
   EkfParams params_;
   AnchorTable anchors_;
@@ -253,6 +259,10 @@ class Estimator {
   TdoaUpdateResult last_tdoa_;
   Mat3 bias_floor_ = Mat3::Zero();  ///< biasFloor() at t_bias_floor_s_; σ_b² I before the first TDoA (F23)
   std::optional<BiasLevel> bias_level_;  ///< the flight's bias level (F23c), with output_bias_memory_s > 0
+  /// With a bias model: the level of the uncorrected TDoA (F24b), and the model as given, which bias_ scales
+  std::optional<BiasLevel> raw_level_;
+  BiasPredictor model_bias_;
+  double model_mean_scale_ = 1.0;
   double t_bias_floor_s_ = -1e300;
 };
 
