@@ -678,9 +678,9 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   }
   const BiasPredictor* predictor = antenna_ ? &corrections_ : (bias_ ? &bias_ : nullptr);
   // (F23c) the residual without the filter's range-bias states, at the prior tag position
-  const double range_bias_prior_m =
-      (bias_level_ || raw_level_) && ekf_.rangeBias() ? ekf_.rangeBiasDifference(z.id_a, z.id_b) : 0.0;
-  const Vec3 w_p_tag_prior = ekf_.state().w_p_b + ekf_.state().w_q_b * params_.b_t_tag;
+  const bool levels = bias_level_ || raw_level_;
+  const double range_bias_prior_m = levels && ekf_.rangeBias() ? ekf_.rangeBiasDifference(z.id_a, z.id_b) : 0.0;
+  const Vec3 w_p_tag_prior = levels ? Vec3(ekf_.state().w_p_b + ekf_.state().w_q_b * params_.b_t_tag) : Vec3::Zero();
   const TdoaUpdateResult r = updateTdoa(ekf_, anchors_, zc, opt, predictor);
   last_tdoa_ = r;
   if (antenna_ && antenna_predicted_ && !acquiring && !near_floor && r.outcome == UpdateOutcome::kApplied) {
@@ -731,33 +731,25 @@ void Estimator::addTdoa(const TdoaObservation& z) {
       t_healthy_sample_ = t;
     }
   }
-  if (bias_level_) {
-    // (F23c) the flight's bias level from the TDoA used in flight; elsewhere (the floor-level bias on and near the
-    // ground, an acquisition's unsettled state) the open window is dropped
+  // (F23c) a bias level from the TDoA used in flight; elsewhere (the floor-level bias on and near the ground, an
+  // acquisition's unsettled state) the open window is dropped. Returns whether a window was counted.
+  const auto feed = [&](BiasLevel& level, double residual_m) {
+    const int n_before = level.numWindows();
     const Moments3* a = anchors_.find(z.id_a);
     const Moments3* b = anchors_.find(z.id_b);
     if (flying && r.outcome == UpdateOutcome::kApplied && a && b)
-      bias_level_->add(t, z.id_a, a->m, z.id_b, b->m, w_p_tag_prior, r.innovation_m + range_bias_prior_m);
+      level.add(t, z.id_a, a->m, z.id_b, b->m, w_p_tag_prior, residual_m);
     else if (!flying)
-      bias_level_->interrupt();
-    if (static_cast<std::size_t>(bias_level_->numWindows()) != summary_.n_bias_level_windows) {
-      summary_.n_bias_level_windows = static_cast<std::size_t>(bias_level_->numWindows());
-      const double ref_a2 = 0.5 * params_.output_bias_level_m * params_.output_bias_level_m;
-      summary_.bias_level_m = std::sqrt(2.0 * bias_level_->sigmaA2(ref_a2));
-    }
+      level.interrupt();
+    return level.numWindows() != n_before;
+  };
+  if (bias_level_ && feed(*bias_level_, r.innovation_m + range_bias_prior_m)) {
+    summary_.n_bias_level_windows = static_cast<std::size_t>(bias_level_->numWindows());
+    const double ref_a2 = 0.5 * params_.output_bias_level_m * params_.output_bias_level_m;
+    summary_.bias_level_m = std::sqrt(2.0 * bias_level_->sigmaA2(ref_a2));
   }
-  if (raw_level_) {
-    // (F24b) the same statistic on the TDoA before the model's correction (bias_mean_m is what it subtracted)
-    const Moments3* a = anchors_.find(z.id_a);
-    const Moments3* b = anchors_.find(z.id_b);
-    const int n_before = raw_level_->numWindows();
-    if (flying && r.outcome == UpdateOutcome::kApplied && a && b)
-      raw_level_->add(t, z.id_a, a->m, z.id_b, b->m, w_p_tag_prior,
-                      r.innovation_m + range_bias_prior_m + r.bias_mean_m);
-    else if (!flying)
-      raw_level_->interrupt();
-    if (raw_level_->numWindows() != n_before) updateModelMeanScale();
-  }
+  // (F24b) the same statistic on the TDoA before the model's correction (bias_mean_m is what it subtracted)
+  if (raw_level_ && feed(*raw_level_, r.innovation_m + range_bias_prior_m + r.bias_mean_m)) updateModelMeanScale();
   if (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier) {
     // anchor pairs in view, for the reported bias floor (F23)
     auto it = std::find_if(recent_pairs_.begin(), recent_pairs_.end(),
