@@ -189,7 +189,7 @@ py::dict summaryDict(const LocalizerSummary& s) {
   d["n_reverted_motion"] = s.n_reverted_motion, d["start_replayed"] = s.start_replayed;
   d["bias_level_m"] = s.bias_level_m, d["n_bias_level_windows"] = s.n_bias_level_windows;
   d["raw_bias_level_m"] = s.raw_bias_level_m, d["bias_model_mean_scale"] = s.bias_model_mean_scale;
-  d["min_bias_model_mean_scale"] = s.min_bias_model_mean_scale;
+  d["min_bias_model_mean_scale"] = s.min_bias_model_mean_scale, d["model_mean_level_m"] = s.model_mean_level_m;
   d["reacquisition_t_s"] = s.reacquisition_t_s;
   d["reacquired_t_s"] = s.reacquired_t_s, d["takeoff_t_s"] = s.takeoff_t_s, d["landing_t_s"] = s.landing_t_s;
   d["start_t_s"] = s.start_t_s, d["end_t_s"] = s.end_t_s, d["process_model"] = toString(s.process_model);
@@ -348,6 +348,8 @@ void bindEval(py::module_& m) {
           "Predicted bias of every row of a feature dict: {mean [m], var [m²] (latent)}; 0, 0 for uncovered pairs.")
       .def_property("training_bias_level_m", &BiasModel::trainingBiasLevel, &BiasModel::setTrainingBiasLevel,
                     "TDoA bias level of the training flights [m] (filter.md F24b; 0 unknown: the mean is not scaled)")
+      .def_property("training_mean_level_m", &BiasModel::trainingMeanLevel, &BiasModel::setTrainingMeanLevel,
+                    "Level of the model's own mean on its training flights [m] (filter.md F24c; 0 unknown)")
       .def_property("metadata_json", [](const BiasModel& b) { return b.metadata_json; },
                     [](BiasModel& b, const std::string& s) { b.metadata_json = s; })
       .def("save", &BiasModel::save, py::arg("path"), "Writes the model file (the CLI's --bias-model format).")

@@ -214,6 +214,8 @@ void runLocalize(const LocalizeArgs& a) {
   j["n_bias_level_windows"] = s.n_bias_level_windows;
   j["raw_bias_level_m"] = std::isnan(s.raw_bias_level_m) ? json(nullptr) : json(s.raw_bias_level_m);
   j["bias_model_training_level_m"] = params.bias_model_training_level_m;
+  j["model_mean_level_m"] = std::isnan(s.model_mean_level_m) ? json(nullptr) : json(s.model_mean_level_m);
+  j["bias_model_training_mean_level_m"] = params.bias_model_training_mean_level_m;
   j["bias_model_mean_scale"] = s.bias_model_mean_scale;
   j["min_bias_model_mean_scale"] = s.min_bias_model_mean_scale;
   j["fuse_tof"] = params.fuse_tof;

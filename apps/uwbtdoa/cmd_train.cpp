@@ -142,6 +142,7 @@ void run(const TrainOptions& o) {
                {"extra_sigma_m", o.extra_sigma},
                {"mean_scale", o.mean_scale},
                {"training_bias_level_m", model.trainingBiasLevel()},
+               {"training_mean_level_m", model.trainingMeanLevel()},
                {"predictive_dof", o.predictive_shape.dof},
                {"predictive_scale", o.predictive_shape.scale},
                {"full_variance", o.full_variance},
@@ -193,6 +194,10 @@ void run(const TrainOptions& o) {
     std::cout << fmt::format("TDoA bias level of the training flights (filter.md F23c) {:.3f} m: the filter scales the "
                              "mean down on a flight of a lower level (F24b)\n",
                              model.trainingBiasLevel());
+  if (model.trainingMeanLevel() > 0.0)
+    std::cout << fmt::format("level of the model's own mean on them {:.3f} m: the filter compares it with the mean's "
+                             "level on the flight at hand (F24c)\n",
+                             model.trainingMeanLevel());
   std::cout << "learned hyperparameters:\n";
   for (const auto& [model_name, h] : hyper.items()) {
     std::cout << "  " << model_name << ":";

@@ -84,6 +84,11 @@ def test_train_localize_and_compare(flights, trained, tmp_path):
     assert 0 < cs["raw_bias_level_m"] < 1 and 0 < cs["min_bias_model_mean_scale"] <= cs["bias_model_mean_scale"] <= 1
     if model.training_bias_level_m == 0:
         assert cs["bias_model_mean_scale"] == 1.0
+    # the level of the model's own mean (F24c): measured on this flight when the model knows it from its training
+    if model.training_mean_level_m > 0:
+        assert model.training_bias_level_m > 0 and 0 <= cs["model_mean_level_m"] < 1
+    else:
+        assert np.isnan(cs["model_mean_level_m"])
     # the correction changes the estimate
     assert not np.allclose(plain["trajectory"]["p"], corrected["trajectory"]["p"])
     # metrics recomputed from the arrays agree with the filter run's

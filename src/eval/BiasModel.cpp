@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "uwb/core/Error.h"
+#include "uwb/filter/BiasLevel.h"
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/FileAccess.h"
 #include "uwb/io/JsonFile.h"
@@ -239,6 +240,12 @@ void BiasModel::setTrainingBiasLevel(double level_m) {
   training_bias_level_m_ = level_m;
 }
 
+void BiasModel::setTrainingMeanLevel(double level_m) {
+  if (!std::isfinite(level_m) || !(level_m >= 0.0) || level_m > 10.0)
+    throw std::invalid_argument("training_mean_level_m must be in [0, 10] m");
+  training_mean_level_m_ = level_m;
+}
+
 void BiasModel::setPredictiveShape(const PredictiveShape& shape) {
   shape.validate();
   predictive_shape_ = shape;
@@ -342,6 +349,7 @@ nlohmann::json BiasModel::toJson() const {
           {"extra_variance_m2", extra_variance_m2_},
           {"mean_scale", mean_scale_},
           {"training_bias_level_m", training_bias_level_m_},
+          {"training_mean_level_m", training_mean_level_m_},
           {"predictive_dof", predictive_shape_.dof},
           {"predictive_scale", predictive_shape_.scale},
           {"full_variance", full_variance_},
@@ -434,6 +442,8 @@ BiasModel BiasModel::fromJson(const nlohmann::json& j) {
     if (j.contains("mean_scale")) model.setMeanScale(jsonDouble(j.at("mean_scale"), "mean_scale"));
     if (j.contains("training_bias_level_m"))  // (F24b) an older file: unknown, no scaling
       model.setTrainingBiasLevel(jsonDouble(j.at("training_bias_level_m"), "training_bias_level_m"));
+    if (j.contains("training_mean_level_m"))  // (F24c) an older file: unknown, µ's level not compared
+      model.setTrainingMeanLevel(jsonDouble(j.at("training_mean_level_m"), "training_mean_level_m"));
     PredictiveShape shape;  // (P43b) a file without the fields gets the defaults
     if (j.contains("predictive_dof")) shape.dof = jsonDouble(j.at("predictive_dof"), "predictive_dof");
     if (j.contains("predictive_scale")) shape.scale = jsonDouble(j.at("predictive_scale"), "predictive_scale");
@@ -583,6 +593,9 @@ BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params,
     }
     if (n > 0) model.setTrainingBiasLevel(sum / n);
   }
+  // (F24c) and the level of the model's own mean on them, with the filter's memory, for flights whose level is known
+  if (model.trainingBiasLevel() > 0.0)
+    model.setTrainingMeanLevel(modelMeanLevel(model, data, data.params.localization.params.output_bias_memory_s));
   if (params.full_variance) {  // (P45): E[ε²] of the training targets
     double sum_sq = 0.0, n = 0.0;
     for (std::size_t i = 0; i < data.samples.size(); ++i) {
@@ -633,6 +646,28 @@ BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params,
 
 void applyBiasModelLevel(const BiasModel& model, EkfParams* params) {
   if (!(params->bias_model_training_level_m > 0.0)) params->bias_model_training_level_m = model.trainingBiasLevel();
+  if (!(params->bias_model_training_mean_level_m > 0.0))
+    params->bias_model_training_mean_level_m = model.trainingMeanLevel();
+}
+
+double modelMeanLevel(const BiasModel& model, const BiasDataset& data, double memory_s) {
+  // (F24c) per flight, the samples in time order through the F23c windows, µ in place of the residual; the body
+  // origin stands for the tag (the lever arm is centimetres, the windows' geometry does not feel it)
+  std::map<int, BiasLevel> levels;
+  for (const BiasSample& s : data.samples) {
+    auto it = levels.try_emplace(s.flight, memory_s).first;
+    const TdoaFeature& f = s.feature;
+    it->second.add(s.t_s, f.id_a, f.w_p_anchor_a, f.id_b, f.w_p_anchor_b, f.w_p_b, model.predict(f).mean_m);
+  }
+  double sum = 0.0;
+  int n = 0;
+  for (const auto& [flight, level] : levels) {
+    const double a2 = level.sigmaA2Data();
+    if (!std::isfinite(a2)) continue;
+    sum += std::sqrt(2.0 * a2);
+    ++n;
+  }
+  return n > 0 ? sum / n : 0.0;
 }
 
 }  // namespace uwb

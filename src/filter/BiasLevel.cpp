@@ -3,6 +3,8 @@
  */
 #include "uwb/filter/BiasLevel.h"
 
+#include <limits>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -103,6 +105,11 @@ double BiasLevel::sigmaA2(double prior_sigma_a2) const {
   // the prior counts as kPriorWindows windows of the mean weight τ̄ = Σ τ_w / Σ 1
   const double c = kPriorWindows * sum_tau_ / sum_n_;
   return std::max((sum_r_ + c * prior_sigma_a2) / (sum_tau_ + c), 0.0);
+}
+
+double BiasLevel::sigmaA2Data() const {
+  if (n_windows_ == 0 || !(sum_tau_ > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return std::max(sum_r_ / sum_tau_, 0.0);
 }
 
 }  // namespace uwb

@@ -161,6 +161,9 @@ std::vector<EkfParamInfo> makeRegistry() {
            "With a bias model: its mean scaled by min(1, flight's bias level / training level)^this; 0 off (F24b)"),
       real("bias_model_training_level_m", &P::bias_model_training_level_m, "m", kNonNegative,
            "Bias level of the model's training flights (from the model file; 0 unknown: no scaling, F24b)"),
+      real("bias_model_training_mean_level_m", &P::bias_model_training_mean_level_m, "m", kNonNegative,
+           "Level of the model's own mean on its training flights (from the model file; 0 unknown: the model's "
+           "level on this flight is not compared, F24c)"),
       real("max_lost_s", &P::max_lost_s, "s", kPositive,
            "All TDoA rejected this long: re-acquire (inflate P, open the gate)"),
       real("lost_velocity_tau_s", &P::lost_velocity_tau_s, "s", kNonNegative,

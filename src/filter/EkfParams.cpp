@@ -79,6 +79,7 @@ void EkfParams::validate() const {
   requireNonNegative(output_bias_memory_s, "output_bias_memory_s");
   requireNonNegative(bias_model_level_exponent, "bias_model_level_exponent");
   requireNonNegative(bias_model_training_level_m, "bias_model_training_level_m");
+  requireNonNegative(bias_model_training_mean_level_m, "bias_model_training_mean_level_m");
   requirePositive(output_bias_level_m, "output_bias_level_m");
   requirePositive(tof_sigma_m, "tof_sigma_m");
   if (!std::isfinite(tof_offset_m)) throw std::invalid_argument("EkfParams.tof_offset_m must be finite");

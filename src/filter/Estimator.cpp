@@ -174,9 +174,12 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
       model_bias_ = std::move(bias_);
       bias_ = [this](const TdoaFeature& feature) {
         BiasPrediction b = model_bias_(feature);
+        last_model_mean_m_ = b.mean_m;
         b.mean_m *= model_mean_scale_;
         return b;
       };
+      // (F24c) and what the model itself predicts on this flight, against what it predicted on its training flights
+      if (params_.bias_model_training_mean_level_m > 0.0) mean_level_.emplace(params_.output_bias_memory_s);
     }
   }
 }
@@ -748,6 +751,8 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     const double ref_a2 = 0.5 * params_.output_bias_level_m * params_.output_bias_level_m;
     summary_.bias_level_m = std::sqrt(2.0 * bias_level_->sigmaA2(ref_a2));
   }
+  // (F24c) the statistic on the model's own mean, over the same windows as the uncorrected level below
+  if (mean_level_) feed(*mean_level_, last_model_mean_m_);
   // (F24b) the same statistic on the TDoA before the model's correction (bias_mean_m is what it subtracted)
   if (raw_level_ && feed(*raw_level_, r.innovation_m + range_bias_prior_m + r.bias_mean_m)) updateModelMeanScale();
   if (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier) {
@@ -840,7 +845,16 @@ void Estimator::updateModelMeanScale() {
                                                                              params_.output_bias_level_m));
   summary_.raw_bias_level_m = level;
   if (!model_bias_) return;
-  model_mean_scale_ = std::pow(std::min(1.0, level / train), params_.bias_model_level_exponent);
+  double rho = level / train;
+  if (mean_level_) {
+    // (F24c) ρ = (ℓ / ℓ_train) / (ℓ_µ / ℓ_µ,train): the flight's level against the model's training flights,
+    // relative to what the model itself predicts here against there; ℓ_µ starts from ℓ_µ,train
+    const double mean_train = params_.bias_model_training_mean_level_m;
+    const double mean_level = std::sqrt(2.0 * mean_level_->sigmaA2(0.5 * mean_train * mean_train));
+    summary_.model_mean_level_m = mean_level;
+    if (mean_level > 0.0) rho *= mean_train / mean_level;
+  }
+  model_mean_scale_ = std::pow(std::min(1.0, rho), params_.bias_model_level_exponent);
   summary_.bias_model_mean_scale = model_mean_scale_;
   summary_.min_bias_model_mean_scale = std::min(summary_.min_bias_model_mean_scale, model_mean_scale_);
 }

@@ -10,6 +10,8 @@
 
 #include "uwb/eval/BiasCalibration.h"
 #include "uwb/eval/BiasModel.h"
+#include "uwb/eval/BiasDataset.h"
+#include "uwb/filter/BiasLevel.h"
 #include "uwb/filter/EkfParams.h"
 
 namespace uwb {
@@ -218,6 +220,73 @@ TEST(BiasModelLevel, TheModelFileCarriesTheTrainingLevelAndTheFilterGetsItUnless
   EXPECT_EQ(BiasModel::fromJson(j).trainingBiasLevel(), 0.0);
   EXPECT_THROW(model.setTrainingBiasLevel(std::nan("")), std::invalid_argument);
   EXPECT_THROW(model.setTrainingBiasLevel(-0.1), std::invalid_argument);
+}
+
+TEST(BiasModelLevel, TheModelFileCarriesTheTrainingMeanLevelAndTheFilterGetsItUnlessGiven) {
+  // (filter.md F24c) the level of the model's own mean on its training flights travels the same way
+  gp::Svgp svgp(gp::Kernel::preset("z1"), MatX::Random(5, 2));
+  BiasModel model("z1", FeatureMap::kYawAngles, {{0, 1, svgp}});
+  EXPECT_EQ(model.trainingMeanLevel(), 0.0);  // unknown
+  model.setTrainingMeanLevel(0.12);
+  nlohmann::json j = model.toJson();
+  EXPECT_EQ(BiasModel::fromJson(j).trainingMeanLevel(), 0.12);
+  EkfParams p;
+  applyBiasModelLevel(BiasModel::fromJson(j), &p);
+  EXPECT_EQ(p.bias_model_training_mean_level_m, 0.12);
+  p.bias_model_training_mean_level_m = 0.3;  // given by the user: kept
+  applyBiasModelLevel(BiasModel::fromJson(j), &p);
+  EXPECT_EQ(p.bias_model_training_mean_level_m, 0.3);
+  j.erase("training_mean_level_m");  // an older file: unknown, µ's level not compared
+  EXPECT_EQ(BiasModel::fromJson(j).trainingMeanLevel(), 0.0);
+  EXPECT_THROW(model.setTrainingMeanLevel(std::nan("")), std::invalid_argument);
+  EXPECT_THROW(model.setTrainingMeanLevel(11.0), std::invalid_argument);
+}
+
+TEST(BiasModelLevel, TheMeanLevelIsTheWindowStatisticOfTheModelsMeanAndScalesWithIt) {
+  // GIVEN eight anchors around a body that hovers in two flights, one sample of each neighbour pair every 10 ms for
+  // 20 s, and models that predict a constant mean per pair (no GP: the pair means of P28), c and 2c
+  const std::vector<Vec3> anchors = {{-4, -4, 0.2}, {4, -4, 0.2}, {4, 4, 0.2}, {-4, 4, 0.2},
+                                     {-4, -4, 2.8}, {4, -4, 2.8}, {4, 4, 2.8}, {-4, 4, 2.8}};
+  BiasDataset data;
+  for (int flight = 0; flight < 2; ++flight) {
+    for (int step = 0; step < 2000; ++step) {
+      const double t = 0.01 * step;
+      const Vec3 p(0.5 * std::cos(0.3 * t) + 0.2 * flight, 0.5 * std::sin(0.3 * t), 1.2);
+      for (int a = 0; a < 8; ++a) {
+        BiasSample s;
+        s.t_s = t + 1e-4 * a;
+        s.flight = flight;
+        s.feature.id_a = a;
+        s.feature.id_b = (a + 1) % 8;
+        s.feature.w_p_b = p;
+        s.feature.w_p_anchor_a = anchors[a];
+        s.feature.w_p_anchor_b = anchors[(a + 1) % 8];
+        data.samples.push_back(s);
+      }
+    }
+  }
+  std::vector<BiasModel::PairMean> means, doubled;
+  for (int a = 0; a < 8; ++a) {
+    const double c = 0.1 * std::sin(1.7 * a + 0.3);
+    means.push_back({a, (a + 1) % 8, c});
+    doubled.push_back({a, (a + 1) % 8, 2.0 * c});
+  }
+  const BiasModel model("z1", FeatureMap::kYawAngles, {}, means);
+  const BiasModel twice("z1", FeatureMap::kYawAngles, {}, doubled);
+  const BiasModel none("z1", FeatureMap::kYawAngles, {});
+  // THEN the level is F23c's statistic on µ, as BiasLevel gives it on the same residuals of one flight (the two
+  // flights' levels differ by their geometry only; both are averaged)
+  const double level = modelMeanLevel(model, data, 30.0);
+  BiasLevel direct(30.0);
+  for (const BiasSample& s : data.samples)
+    if (s.flight == 0)
+      direct.add(s.t_s, s.feature.id_a, s.feature.w_p_anchor_a, s.feature.id_b, s.feature.w_p_anchor_b,
+                 s.feature.w_p_b, model.predict(s.feature).mean_m);
+  EXPECT_GT(level, 0.02);
+  EXPECT_NEAR(level, std::sqrt(2.0 * direct.sigmaA2Data()), 0.1 * level);
+  // AND it scales with the mean, and a model that predicts nothing has none
+  EXPECT_NEAR(modelMeanLevel(twice, data, 30.0), 2.0 * level, 1e-9);
+  EXPECT_EQ(modelMeanLevel(none, data, 30.0), 0.0);
 }
 
 }  // namespace

@@ -62,6 +62,11 @@ TEST(TrainCli, DumpsNamedTrainingArraysAndIsRepeatableForASeedAndThreadCount) {
   EXPECT_LT(level, 0.5);
   EXPECT_EQ(summary.at("training_bias_level_m").get<double>(), level);
   EXPECT_EQ(summary.at("exclusions").at(0).at("bias_level_m").get<double>(), level);
+  // AND the level of the model's own mean on it (F24c): what the model explains of that level
+  const double mean_level = ma.at("training_mean_level_m").get<double>();
+  EXPECT_GT(mean_level, 0.02);
+  EXPECT_LT(mean_level, 0.5);
+  EXPECT_EQ(summary.at("training_mean_level_m").get<double>(), mean_level);
   std::filesystem::remove_all(dir);
 }
 

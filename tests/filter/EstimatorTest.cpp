@@ -316,6 +316,53 @@ TEST(Estimator, ABiasModelOfAMoreBiasedFlightIsScaledDownByThisFlightsLevel) {
   EXPECT_TRUE(std::isfinite(c.summary.raw_bias_level_m));  // still measured and reported
 }
 
+TEST(Estimator, ABiasModelThatPredictsThisFlightsSmallerBiasIsNotScaledDownForIt) {
+  // GIVEN a flight whose TDoA carry a constant bias per pair, and a model that knows it exactly, trained on flights
+  // with twice the bias: their level and the level of the model's mean on them were twice this flight's
+  const auto bias = [](int pair) { return 0.2 * std::sin(1.7 * pair + 0.3); };
+  const SensorLog log = filtertest::flightLog(arenaAnchors(), circle, 0.0, 40.0, 0.05, true, 3,
+                                              [&](double, int pair) { return bias(pair); }, 0.05);
+  const BiasPredictor knows = [&](const TdoaFeature& f) {
+    BiasPrediction b;
+    b.mean_m = bias(f.id_a);
+    b.variance_m2 = 1e-4;
+    return b;
+  };
+  // the two levels on this flight (F23c on the uncorrected TDoA and on µ), read from a run at its own levels
+  EkfParams probe = lateralFullParams();
+  probe.bias_model_training_level_m = 0.2;
+  probe.bias_model_training_mean_level_m = 0.2;
+  const LocalizerResult measured = TdoaLocalizer(probe, arenaAnchors(), knows).run(log, 0.1);
+  const double level = measured.summary.raw_bias_level_m, mean_level = measured.summary.model_mean_level_m;
+  ASSERT_GT(level, 0.05);
+  ASSERT_GT(mean_level, 0.05);
+  EkfParams levels_only = lateralFullParams();  // F24b: the training flights' level alone
+  levels_only.bias_model_training_level_m = 2.0 * level;
+  EkfParams with_mean = levels_only;  // F24c: and what the model predicted there
+  with_mean.bias_model_training_mean_level_m = 2.0 * mean_level;
+  EkfParams as_trained = levels_only;
+  as_trained.bias_model_level_exponent = 0.0;
+  const LocalizerResult b = TdoaLocalizer(levels_only, arenaAnchors(), knows).run(log, 0.1);
+  const LocalizerResult c = TdoaLocalizer(with_mean, arenaAnchors(), knows).run(log, 0.1);
+  const LocalizerResult t = TdoaLocalizer(as_trained, arenaAnchors(), knows).run(log, 0.1);
+  const auto rms = [](const LocalizerResult& r) {
+    double se = 0.0;
+    int n = 0;
+    for (const LocalizerEstimate& e : r.estimates)
+      if (e.t_s >= 20.0) se += (e.x.w_p_b - circle(e.t_s).p).squaredNorm(), ++n;
+    return std::sqrt(se / n);
+  };
+  // THEN the training level alone reads this flight as half as biased and halves the correction and more (F24b);
+  // with the model's own level the ratio is about one: the model predicts here the smaller bias it sees, and is used
+  // as trained (F24c)
+  EXPECT_LT(b.summary.bias_model_mean_scale, 0.5);
+  EXPECT_GT(c.summary.bias_model_mean_scale, 0.8);
+  EXPECT_LT(c.summary.model_mean_level_m, 1.5 * mean_level);
+  EXPECT_LT(rms(c), rms(b));
+  EXPECT_LT(rms(c), 1.1 * rms(t));
+  EXPECT_TRUE(std::isnan(b.summary.model_mean_level_m));  // not measured without the training mean level
+}
+
 TEST(Estimator, OnTheFloorTheReportedCovarianceCarriesTheFloorLevelBias) {
   // GIVEN a take-off log (on the floor for 2 s, then a climb), localized with the bias floor of F23 and without it
   const SensorLog log = filtertest::takeoffLog(filtertest::TakeoffLogSpec{});

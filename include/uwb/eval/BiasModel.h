@@ -172,6 +172,11 @@ class BiasModel {
   /// the mean down on a flight whose own level is lower (EkfParams::bias_model_training_level_m).
   double trainingBiasLevel() const { return training_bias_level_m_; }
   void setTrainingBiasLevel(double level_m);  ///< throws std::invalid_argument unless finite and ≥ 0
+  /// (F24c) The level of the model's own mean on its training flights: the statistic of F23c on µ at the training
+  /// samples (the mean over the flights); 0 when unknown. The filter compares it with µ's level on the flight at hand
+  /// (EkfParams::bias_model_training_mean_level_m).
+  double trainingMeanLevel() const { return training_mean_level_m_; }
+  void setTrainingMeanLevel(double level_m);  ///< throws std::invalid_argument unless finite and in [0, 10] m
   /// Constant mean of the pair (0 when none was learned).
   double pairMean(int id_a, int id_b) const;
 
@@ -192,6 +197,7 @@ class BiasModel {
   double extra_variance_m2_ = 0.0;
   double mean_scale_ = 1.0;
   double training_bias_level_m_ = 0.0;
+  double training_mean_level_m_ = 0.0;
   PredictiveShape predictive_shape_;
   bool full_variance_ = false;
   double target_mean_square_m2_ = 0.0;
@@ -209,10 +215,16 @@ std::vector<BiasModel::PairMean> pairMeans(const std::vector<BiasSample>& sample
                                            double n0 = 10.0);
 
 /// Indices of held-out samples: every k-th block of `block_s` seconds of each flight, k = round(1/fraction).
+/// (F24c) The level of `model`'s mean on the samples of each flight of `data` (F23c statistic on µ, windows of
+/// BiasLevel over each flight's samples in time order, forgotten with memory_s), averaged over the flights that
+/// counted a window; 0 when none did.
+double modelMeanLevel(const BiasModel& model, const BiasDataset& data, double memory_s);
+
 std::vector<bool> holdoutMask(const std::vector<BiasSample>& samples, double fraction, double block_s);
 
-/// (F24b) Gives the filter the model's training level: sets params->bias_model_training_level_m to
-/// model.trainingBiasLevel() unless it is already > 0 (given by the user).
+/// (F24b, F24c) Gives the filter the model's training levels: sets params->bias_model_training_level_m to
+/// model.trainingBiasLevel() and params->bias_model_training_mean_level_m to model.trainingMeanLevel(), each unless
+/// it is already > 0 (given by the user).
 void applyBiasModelLevel(const BiasModel& model, EkfParams* params);
 
 }  // namespace uwb

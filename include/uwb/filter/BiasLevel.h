@@ -39,6 +39,8 @@ class BiasLevel {
   /// (F23c) The anchors' bias variance σ̂_a² of the windows so far, shrunk towards prior_sigma_a2 by kPriorWindows
   /// windows of the mean weight; prior_sigma_a2 before the first window.
   double sigmaA2(double prior_sigma_a2) const;
+  /// The windows' σ̂_a² alone, without a prior; NaN before the first window.
+  double sigmaA2Data() const;
   /// Windows counted so far (not forgotten).
   int numWindows() const { return n_windows_; }
 

@@ -139,6 +139,10 @@ struct EkfParams {
   /// model of a more biased flight than this one over-corrects it.
   double bias_model_level_exponent = 2.0;
   double bias_model_training_level_m = 0.0;
+  /// (F24c) The level of the model's own mean on its training flights (the F23c statistic on µ; set from the model
+  /// file, 0 unknown). When known, ρ of F24b is divided by the level of µ on this flight / this one: a model that
+  /// itself predicts a smaller bias on this path than on its training flights is not scaled down for that.
+  double bias_model_training_mean_level_m = 0.0;
 
   // --- scheduling ---
   double max_predict_dt_s = 0.01;        ///< IMU samples are averaged over at most this interval [s]

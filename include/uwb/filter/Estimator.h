@@ -101,6 +101,8 @@ struct LocalizerSummary {
   std::size_t n_bias_level_windows = 0;  ///< windows counted for it (F23c)
   /// With a bias model: the level of the TDoA before its correction (F24b; without a model bias_level_m is that)
   double raw_bias_level_m = std::numeric_limits<double>::quiet_NaN();
+  /// With a bias model whose training mean level is known: the level of the model's own mean on this flight (F24c)
+  double model_mean_level_m = std::numeric_limits<double>::quiet_NaN();
   double bias_model_mean_scale = 1.0;      ///< the scale of the model's mean at the end (F24b)
   double min_bias_model_mean_scale = 1.0;  ///< its lowest during the flight (F24b)
   std::size_t n_reacquisitions = 0;    ///< lost or diverged → position found again by multilateration (F16)
@@ -261,6 +263,9 @@ class Estimator {
   std::optional<BiasLevel> bias_level_;  ///< the flight's bias level (F23c), with output_bias_memory_s > 0
   /// With a bias model: the level of the uncorrected TDoA (F24b), and the model as given, which bias_ scales
   std::optional<BiasLevel> raw_level_;
+  /// (F24c) the level of the model's own mean µ on this flight, and µ of the last TDoA before any scaling
+  std::optional<BiasLevel> mean_level_;
+  double last_model_mean_m_ = 0.0;
   BiasPredictor model_bias_;
   double model_mean_scale_ = 1.0;
   double t_bias_floor_s_ = -1e300;
