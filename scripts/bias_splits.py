@@ -13,11 +13,15 @@ For each test flight `uwbtdoa localize FLIGHT --json` gives the airborne RMSE fo
 states (--range-bias-sigma-m 0 --tdoa-sigma-m 0.35), uncorrected and with the model ("offline"); with them (the
 defaults), uncorrected ("online") and with the model ("offline + online"). Change = 100 (RMSE / reference - 1).
 
+With --pairs, each train -> test pair is printed as well: its four RMSEs, and from the run with the model and the states
+the model's mean scale at the end and its lowest (filter.md F24b, F24c), the flight's uncorrected bias level and the
+level of the model's mean on it.
+
 With --calibration, instead of the filters: `uwbtdoa predict-bias TEST --model M --json` scores the model's predictive
 distribution of the bias (docs/math/gp.md P43) on each test flight; per split the 1σ and 2σ coverage (nominal 68.3 and
 95.4 %; mean, lowest, highest over the pairs) and the mean NLPD.
 
-Usage: scripts/bias_splits.py [BUILD_DIR] [--calibration]   (data: $UWBTDOA_DATA or ../shared/data)
+Usage: scripts/bias_splits.py [BUILD_DIR] [--calibration | --pairs]   (data: $UWBTDOA_DATA or ../shared/data)
 """
 import json
 import os
@@ -26,8 +30,9 @@ import subprocess
 import sys
 import tempfile
 
-ARGS = [a for a in sys.argv[1:] if a != "--calibration"]
+ARGS = [a for a in sys.argv[1:] if a not in ("--calibration", "--pairs")]
 CALIBRATION = "--calibration" in sys.argv[1:]
+PAIRS = "--pairs" in sys.argv[1:]
 BUILD = ARGS[0] if ARGS else "build"
 CLI = os.path.join(BUILD, "uwbtdoa")
 DATA = os.environ.get("UWBTDOA_DATA", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared",
@@ -51,9 +56,13 @@ def train(names, out):
                     "30", "--out", out], check=True, capture_output=True)
 
 
-def rmse(name, flags):
+def localize(name, flags):
     cmd = [CLI, "localize", path(name), "--anchors", survey(name[:4]), "--json", *flags]
-    return json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)["rmse_airborne_m"]
+    return json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
+
+
+def rmse(name, flags):
+    return localize(name, flags)["rmse_airborne_m"]
 
 
 def calibration(name, model):
@@ -113,7 +122,16 @@ def main():
                     base[test] = (rmse(test, PLAIN), rmse(test, []))
                 plain, online = base[test]
                 offline = rmse(test, PLAIN + ["--bias-model", cache[key]])
-                both = rmse(test, ["--bias-model", cache[key]])
+                run = localize(test, ["--bias-model", cache[key]])
+                both = run["rmse_airborne_m"]
+                if PAIRS:
+                    def lv(k):
+                        return "–" if run.get(k) is None else f"{run[k]:.3f}"
+                    trained = train_set[0] if len(train_set) == 1 else f"{len(train_set)} flights"
+                    print(f"  {label:11s} {trained:>12s} -> {test:12s} plain {plain:.3f} online {online:.3f} "
+                          f"offline {offline:.3f} both {both:.3f} ({100 * (both / plain - 1):+6.1f} %) scale "
+                          f"{run['bias_model_mean_scale']:.2f} (lowest {run['min_bias_model_mean_scale']:.2f}) level "
+                          f"{lv('raw_bias_level_m')} model mean level {lv('model_mean_level_m')}", flush=True)
                 ch["offline"].append(100 * (offline / plain - 1))
                 ch["online"].append(100 * (online / plain - 1))
                 ch["both"].append(100 * (both / plain - 1))

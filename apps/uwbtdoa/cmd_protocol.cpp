@@ -100,6 +100,7 @@ struct Row {
   double used_frac = std::nan("");
   bool violated = false;
   std::size_t reacq = 0;
+  double bias_level = std::nan("");  ///< the flight's TDoA bias level measured in flight (filter.md F23c)
 };
 
 Row evaluateRun(const uwb::LocalizationRun& run, const std::string& name, const std::string& session,
@@ -110,6 +111,7 @@ Row evaluateRun(const uwb::LocalizationRun& run, const std::string& name, const 
   r.session = session;
   r.kind = kind;
   r.reacq = run.summary.n_reacquisitions;
+  r.bias_level = run.summary.bias_level_m;
   const std::size_t n_tdoa = run.summary.n_tdoa_total;
   r.used_frac = n_tdoa ? static_cast<double>(run.summary.n_tdoa_used + run.summary.n_tdoa_rejected +
                                              run.summary.n_tdoa_start) /
@@ -176,7 +178,8 @@ json rowJson(const Row& r) {
           {"coverage_2sigma_xyz", {num(r.cov2.x()), num(r.cov2.y()), num(r.cov2.z())}},
           {"tdoa_used_or_gated_fraction", num(r.used_frac)},
           {"floor_or_ceiling_violated", r.violated},
-          {"n_reacquisitions", r.reacq}};
+          {"n_reacquisitions", r.reacq},
+          {"bias_level_m", num(r.bias_level)}};
 }
 
 void printTable(const std::string& title, const std::vector<Row>& rows, bool cuts) {

@@ -1,0 +1,46 @@
+/** @file ProtocolCliTest.cpp
+ *  @brief `uwbtdoa protocol --json` on one real flight: each row carries the figures the protocol's tables print,
+ *         the flight's bias level among them (docs/math/filter.md F23c), and the session summary matches the row.
+ */
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "support/TestSupport.h"
+
+namespace uwb {
+namespace {
+
+TEST(ProtocolCli, JsonRowsCarryTheFiguresAndTheFlightsBiasLevel) {
+  if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
+  const auto flight = test::pilotFlight("0425-traj2");
+  UWB_REQUIRE_REAL_DATA(flight);
+  // WHEN the protocol runs on that one whole flight (no cuts, no simulations)
+  const test::CliResult r = test::runCli("protocol --data " + test::dataDir().string() +
+                                         " --only 0425-traj2 --no-sim --no-cuts --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  // THEN there is one row, with its RMSE, coverage and the level the filter measured in flight
+  const nlohmann::json& rows = j.at("rows");
+  ASSERT_EQ(rows.size(), 1u) << r.out.substr(0, 2000);
+  const nlohmann::json& row = rows.at(0);
+  EXPECT_EQ(row.at("name").get<std::string>(), "0425-traj2");
+  const double rmse = row.at("rmse_airborne_m").get<double>();
+  EXPECT_GT(rmse, 0.1);
+  EXPECT_LT(rmse, 0.3);
+  const double level = row.at("bias_level_m").get<double>();
+  EXPECT_GT(level, 0.1);
+  EXPECT_LT(level, 0.5);
+  for (int k = 0; k < 3; ++k) {
+    const double c1 = row.at("coverage_1sigma_xyz").at(k).get<double>(), c2 = row.at("coverage_2sigma_xyz").at(k).get<double>();
+    EXPECT_GT(c1, 0.0);
+    EXPECT_LE(c1, c2);
+    EXPECT_LE(c2, 1.0);
+  }
+  EXPECT_EQ(row.at("session").get<std::string>(), "0425");
+}
+
+}  // namespace
+}  // namespace uwb
