@@ -65,6 +65,10 @@ def rmse(name, flags):
     return localize(name, flags)["rmse_airborne_m"]
 
 
+def level_cell(run, key):
+    return "–" if run.get(key) is None else f"{run[key]:.3f}"
+
+
 def calibration(name, model):
     cmd = [CLI, "predict-bias", path(name), "--anchors", survey(name[:4]), "--model", model, "--json", "--out",
            os.path.join(os.path.dirname(model), "predicted.csv")]
@@ -125,13 +129,11 @@ def main():
                 run = localize(test, ["--bias-model", cache[key]])
                 both = run["rmse_airborne_m"]
                 if PAIRS:
-                    def lv(k):
-                        return "–" if run.get(k) is None else f"{run[k]:.3f}"
                     trained = train_set[0] if len(train_set) == 1 else f"{len(train_set)} flights"
                     print(f"  {label:11s} {trained:>12s} -> {test:12s} plain {plain:.3f} online {online:.3f} "
                           f"offline {offline:.3f} both {both:.3f} ({100 * (both / plain - 1):+6.1f} %) scale "
                           f"{run['bias_model_mean_scale']:.2f} (lowest {run['min_bias_model_mean_scale']:.2f}) level "
-                          f"{lv('raw_bias_level_m')} model mean level {lv('model_mean_level_m')}", flush=True)
+                          f"{level_cell(run, 'raw_bias_level_m')} model mean level {level_cell(run, 'model_mean_level_m')}", flush=True)
                 ch["offline"].append(100 * (offline / plain - 1))
                 ch["online"].append(100 * (online / plain - 1))
                 ch["both"].append(100 * (both / plain - 1))

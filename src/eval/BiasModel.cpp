@@ -234,16 +234,21 @@ void PredictiveShape::validate() const {
     throw std::invalid_argument("predictive_scale must be in (0, 10]");
 }
 
-void BiasModel::setTrainingBiasLevel(double level_m) {
+namespace {
+/// A bias level of the model file (F24b, F24c): finite and in [0, 10] m.
+double checkedLevel(double level_m, const char* field) {
   if (!std::isfinite(level_m) || !(level_m >= 0.0) || level_m > 10.0)
-    throw std::invalid_argument("training_bias_level_m must be in [0, 10] m");
-  training_bias_level_m_ = level_m;
+    throw std::invalid_argument(std::string(field) + " must be in [0, 10] m");
+  return level_m;
+}
+}  // namespace
+
+void BiasModel::setTrainingBiasLevel(double level_m) {
+  training_bias_level_m_ = checkedLevel(level_m, "training_bias_level_m");
 }
 
 void BiasModel::setTrainingMeanLevel(double level_m) {
-  if (!std::isfinite(level_m) || !(level_m >= 0.0) || level_m > 10.0)
-    throw std::invalid_argument("training_mean_level_m must be in [0, 10] m");
-  training_mean_level_m_ = level_m;
+  training_mean_level_m_ = checkedLevel(level_m, "training_mean_level_m");
 }
 
 void BiasModel::setPredictiveShape(const PredictiveShape& shape) {
@@ -662,9 +667,9 @@ double modelMeanLevel(const BiasModel& model, const BiasDataset& data, double me
   double sum = 0.0;
   int n = 0;
   for (const auto& [flight, level] : levels) {
-    const double a2 = level.sigmaA2Data();
-    if (!std::isfinite(a2)) continue;
-    sum += std::sqrt(2.0 * a2);
+    const double l = level.pairLevelData();
+    if (!std::isfinite(l)) continue;
+    sum += l;
     ++n;
   }
   return n > 0 ? sum / n : 0.0;

@@ -3,10 +3,9 @@
  */
 #include "uwb/filter/BiasLevel.h"
 
-#include <limits>
-
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "uwb/filter/BiasFloor.h"
@@ -107,9 +106,13 @@ double BiasLevel::sigmaA2(double prior_sigma_a2) const {
   return std::max((sum_r_ + c * prior_sigma_a2) / (sum_tau_ + c), 0.0);
 }
 
-double BiasLevel::sigmaA2Data() const {
+double BiasLevel::pairLevel(double prior_level_m) const {
+  return std::sqrt(2.0 * sigmaA2(0.5 * prior_level_m * prior_level_m));
+}
+
+double BiasLevel::pairLevelData() const {
   if (n_windows_ == 0 || !(sum_tau_ > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-  return std::max(sum_r_ / sum_tau_, 0.0);
+  return std::sqrt(2.0 * std::max(sum_r_ / sum_tau_, 0.0));
 }
 
 }  // namespace uwb

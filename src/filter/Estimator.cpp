@@ -736,20 +736,19 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   }
   // (F23c) a bias level from the TDoA used in flight; elsewhere (the floor-level bias on and near the ground, an
   // acquisition's unsettled state) the open window is dropped. Returns whether a window was counted.
+  const Moments3* anchor_a = levels ? anchors_.find(z.id_a) : nullptr;
+  const Moments3* anchor_b = levels ? anchors_.find(z.id_b) : nullptr;
   const auto feed = [&](BiasLevel& level, double residual_m) {
     const int n_before = level.numWindows();
-    const Moments3* a = anchors_.find(z.id_a);
-    const Moments3* b = anchors_.find(z.id_b);
-    if (flying && r.outcome == UpdateOutcome::kApplied && a && b)
-      level.add(t, z.id_a, a->m, z.id_b, b->m, w_p_tag_prior, residual_m);
+    if (flying && r.outcome == UpdateOutcome::kApplied && anchor_a && anchor_b)
+      level.add(t, z.id_a, anchor_a->m, z.id_b, anchor_b->m, w_p_tag_prior, residual_m);
     else if (!flying)
       level.interrupt();
     return level.numWindows() != n_before;
   };
   if (bias_level_ && feed(*bias_level_, r.innovation_m + range_bias_prior_m)) {
     summary_.n_bias_level_windows = static_cast<std::size_t>(bias_level_->numWindows());
-    const double ref_a2 = 0.5 * params_.output_bias_level_m * params_.output_bias_level_m;
-    summary_.bias_level_m = std::sqrt(2.0 * bias_level_->sigmaA2(ref_a2));
+    summary_.bias_level_m = bias_level_->pairLevel(params_.output_bias_level_m);
   }
   // (F24c) the statistic on the model's own mean, over the same windows as the uncorrected level below
   if (mean_level_) feed(*mean_level_, last_model_mean_m_);
@@ -840,9 +839,7 @@ void Estimator::updateModelMeanScale() {
   // (F24b) ρ = the flight's uncorrected level / the model's training level, both pair levels √(2σ_a²); the estimate
   // starts from the training level (ρ = 1, the model as trained) and follows the flight's windows
   const double train = params_.bias_model_training_level_m;
-  const double level = std::sqrt(2.0 * raw_level_->sigmaA2(train > 0.0 ? 0.5 * train * train
-                                                                       : 0.5 * params_.output_bias_level_m *
-                                                                             params_.output_bias_level_m));
+  const double level = raw_level_->pairLevel(train > 0.0 ? train : params_.output_bias_level_m);
   summary_.raw_bias_level_m = level;
   if (!model_bias_) return;
   double rho = level / train;
@@ -850,7 +847,7 @@ void Estimator::updateModelMeanScale() {
     // (F24c) ρ = (ℓ / ℓ_train) / (ℓ_µ / ℓ_µ,train): the flight's level against the model's training flights,
     // relative to what the model itself predicts here against there; ℓ_µ starts from ℓ_µ,train
     const double mean_train = params_.bias_model_training_mean_level_m;
-    const double mean_level = std::sqrt(2.0 * mean_level_->sigmaA2(0.5 * mean_train * mean_train));
+    const double mean_level = mean_level_->pairLevel(mean_train);
     summary_.model_mean_level_m = mean_level;
     if (mean_level > 0.0) rho *= mean_train / mean_level;
   }

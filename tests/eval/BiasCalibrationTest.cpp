@@ -202,44 +202,40 @@ TEST(PredictiveShape, TheModelFileCarriesTheShapeAndAnOlderFileGetsTheDefault) {
   }
 }
 
-TEST(BiasModelLevel, TheModelFileCarriesTheTrainingLevelAndTheFilterGetsItUnlessGiven) {
-  // (filter.md F24b) the training flights' bias level travels with the model to the filter's parameters
-  gp::Svgp svgp(gp::Kernel::preset("z1"), MatX::Random(5, 2));
-  BiasModel model("z1", FeatureMap::kYawAngles, {{0, 1, svgp}});
-  EXPECT_EQ(model.trainingBiasLevel(), 0.0);  // unknown
-  model.setTrainingBiasLevel(0.31);
-  nlohmann::json j = model.toJson();
-  EXPECT_EQ(BiasModel::fromJson(j).trainingBiasLevel(), 0.31);
-  EkfParams p;
-  applyBiasModelLevel(BiasModel::fromJson(j), &p);
-  EXPECT_EQ(p.bias_model_training_level_m, 0.31);
-  p.bias_model_training_level_m = 0.2;  // given by the user: kept
-  applyBiasModelLevel(BiasModel::fromJson(j), &p);
-  EXPECT_EQ(p.bias_model_training_level_m, 0.2);
-  j.erase("training_bias_level_m");  // an older file: unknown, no scaling
-  EXPECT_EQ(BiasModel::fromJson(j).trainingBiasLevel(), 0.0);
-  EXPECT_THROW(model.setTrainingBiasLevel(std::nan("")), std::invalid_argument);
-  EXPECT_THROW(model.setTrainingBiasLevel(-0.1), std::invalid_argument);
-}
-
-TEST(BiasModelLevel, TheModelFileCarriesTheTrainingMeanLevelAndTheFilterGetsItUnlessGiven) {
-  // (filter.md F24c) the level of the model's own mean on its training flights travels the same way
-  gp::Svgp svgp(gp::Kernel::preset("z1"), MatX::Random(5, 2));
-  BiasModel model("z1", FeatureMap::kYawAngles, {{0, 1, svgp}});
-  EXPECT_EQ(model.trainingMeanLevel(), 0.0);  // unknown
-  model.setTrainingMeanLevel(0.12);
-  nlohmann::json j = model.toJson();
-  EXPECT_EQ(BiasModel::fromJson(j).trainingMeanLevel(), 0.12);
-  EkfParams p;
-  applyBiasModelLevel(BiasModel::fromJson(j), &p);
-  EXPECT_EQ(p.bias_model_training_mean_level_m, 0.12);
-  p.bias_model_training_mean_level_m = 0.3;  // given by the user: kept
-  applyBiasModelLevel(BiasModel::fromJson(j), &p);
-  EXPECT_EQ(p.bias_model_training_mean_level_m, 0.3);
-  j.erase("training_mean_level_m");  // an older file: unknown, µ's level not compared
-  EXPECT_EQ(BiasModel::fromJson(j).trainingMeanLevel(), 0.0);
-  EXPECT_THROW(model.setTrainingMeanLevel(std::nan("")), std::invalid_argument);
-  EXPECT_THROW(model.setTrainingMeanLevel(11.0), std::invalid_argument);
+TEST(BiasModelLevel, TheModelFileCarriesTheTrainingLevelsAndTheFilterGetsThemUnlessGiven) {
+  // (filter.md F24b, F24c) the training flights' bias level and the level of the model's own mean on them travel with
+  // the model to the filter's parameters, each alike
+  struct Level {
+    const char* field;
+    double (BiasModel::*get)() const;
+    void (BiasModel::*set)(double);
+    double EkfParams::*param;
+  };
+  const Level levels[] = {
+      {"training_bias_level_m", &BiasModel::trainingBiasLevel, &BiasModel::setTrainingBiasLevel,
+       &EkfParams::bias_model_training_level_m},
+      {"training_mean_level_m", &BiasModel::trainingMeanLevel, &BiasModel::setTrainingMeanLevel,
+       &EkfParams::bias_model_training_mean_level_m}};
+  for (const Level& l : levels) {
+    SCOPED_TRACE(l.field);
+    gp::Svgp svgp(gp::Kernel::preset("z1"), MatX::Random(5, 2));
+    BiasModel model("z1", FeatureMap::kYawAngles, {{0, 1, svgp}});
+    EXPECT_EQ((model.*l.get)(), 0.0);  // unknown
+    (model.*l.set)(0.31);
+    nlohmann::json j = model.toJson();
+    EXPECT_EQ((BiasModel::fromJson(j).*l.get)(), 0.31);
+    EkfParams p;
+    applyBiasModelLevel(BiasModel::fromJson(j), &p);
+    EXPECT_EQ(p.*l.param, 0.31);
+    p.*l.param = 0.2;  // given by the user: kept
+    applyBiasModelLevel(BiasModel::fromJson(j), &p);
+    EXPECT_EQ(p.*l.param, 0.2);
+    j.erase(l.field);  // an older file: unknown, nothing scaled or compared
+    EXPECT_EQ((BiasModel::fromJson(j).*l.get)(), 0.0);
+    EXPECT_THROW((model.*l.set)(std::nan("")), std::invalid_argument);
+    EXPECT_THROW((model.*l.set)(-0.1), std::invalid_argument);
+    EXPECT_THROW((model.*l.set)(11.0), std::invalid_argument);
+  }
 }
 
 TEST(BiasModelLevel, TheMeanLevelIsTheWindowStatisticOfTheModelsMeanAndScalesWithIt) {
@@ -283,7 +279,7 @@ TEST(BiasModelLevel, TheMeanLevelIsTheWindowStatisticOfTheModelsMeanAndScalesWit
       direct.add(s.t_s, s.feature.id_a, s.feature.w_p_anchor_a, s.feature.id_b, s.feature.w_p_anchor_b,
                  s.feature.w_p_b, model.predict(s.feature).mean_m);
   EXPECT_GT(level, 0.02);
-  EXPECT_NEAR(level, std::sqrt(2.0 * direct.sigmaA2Data()), 0.1 * level);
+  EXPECT_NEAR(level, direct.pairLevelData(), 0.1 * level);
   // AND it scales with the mean, and a model that predicts nothing has none
   EXPECT_NEAR(modelMeanLevel(twice, data, 30.0), 2.0 * level, 1e-9);
   EXPECT_EQ(modelMeanLevel(none, data, 30.0), 0.0);

@@ -40,6 +40,15 @@ EkfParams lateralFullParams() {
   return p;
 }
 
+/// RMS position error against the circle from t0_s on.
+double circleRmsFrom(const LocalizerResult& r, double t0_s) {
+  double se = 0.0;
+  int n = 0;
+  for (const LocalizerEstimate& e : r.estimates)
+    if (e.t_s >= t0_s) se += (e.x.w_p_b - circle(e.t_s).p).squaredNorm(), ++n;
+  return std::sqrt(se / n);
+}
+
 TEST(Estimator, BatchRunEqualsTheOnlineLoop) {
   // GIVEN a synthetic take-off log and the default parameters
   filtertest::TakeoffLogSpec spec;
@@ -295,13 +304,7 @@ TEST(Estimator, ABiasModelOfAMoreBiasedFlightIsScaledDownByThisFlightsLevel) {
   const LocalizerResult a = TdoaLocalizer(scaled, arenaAnchors(), wrong).run(log, 0.1);
   const LocalizerResult b = TdoaLocalizer(off, arenaAnchors(), wrong).run(log, 0.1);
   const LocalizerResult c = TdoaLocalizer(unknown, arenaAnchors(), wrong).run(log, 0.1);
-  const auto rms = [](const LocalizerResult& r) {
-    double se = 0.0;
-    int n = 0;
-    for (const LocalizerEstimate& e : r.estimates)
-      if (e.t_s >= 20.0) se += (e.x.w_p_b - circle(e.t_s).p).squaredNorm(), ++n;
-    return std::sqrt(se / n);
-  };
+  const auto rms = [](const LocalizerResult& r) { return circleRmsFrom(r, 20.0); };
   // THEN the flight's own level (measured before the correction, F24b) is far below the model's: it starts from the
   // training level (ρ = 1), which keeps the weight of 10 windows against the ≈ 50 windows of 40 s flown
   // (√((10 · 0.5²) / 60) ≈ 0.2 m even with no bias at all), the mean is scaled down by (0.2 / 0.5)² and below,
@@ -345,13 +348,7 @@ TEST(Estimator, ABiasModelThatPredictsThisFlightsSmallerBiasIsNotScaledDownForIt
   const LocalizerResult b = TdoaLocalizer(levels_only, arenaAnchors(), knows).run(log, 0.1);
   const LocalizerResult c = TdoaLocalizer(with_mean, arenaAnchors(), knows).run(log, 0.1);
   const LocalizerResult t = TdoaLocalizer(as_trained, arenaAnchors(), knows).run(log, 0.1);
-  const auto rms = [](const LocalizerResult& r) {
-    double se = 0.0;
-    int n = 0;
-    for (const LocalizerEstimate& e : r.estimates)
-      if (e.t_s >= 20.0) se += (e.x.w_p_b - circle(e.t_s).p).squaredNorm(), ++n;
-    return std::sqrt(se / n);
-  };
+  const auto rms = [](const LocalizerResult& r) { return circleRmsFrom(r, 20.0); };
   // THEN the training level alone reads this flight as half as biased and halves the correction and more (F24b);
   // with the model's own level the ratio is about one: the model predicts here the smaller bias it sees, and is used
   // as trained (F24c)

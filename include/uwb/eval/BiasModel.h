@@ -214,12 +214,12 @@ BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params,
 std::vector<BiasModel::PairMean> pairMeans(const std::vector<BiasSample>& samples, const std::vector<bool>& use,
                                            double n0 = 10.0);
 
-/// Indices of held-out samples: every k-th block of `block_s` seconds of each flight, k = round(1/fraction).
 /// (F24c) The level of `model`'s mean on the samples of each flight of `data` (F23c statistic on µ, windows of
 /// BiasLevel over each flight's samples in time order, forgotten with memory_s), averaged over the flights that
 /// counted a window; 0 when none did.
 double modelMeanLevel(const BiasModel& model, const BiasDataset& data, double memory_s);
 
+/// Indices of held-out samples: every k-th block of `block_s` seconds of each flight, k = round(1/fraction).
 std::vector<bool> holdoutMask(const std::vector<BiasSample>& samples, double fraction, double block_s);
 
 /// (F24b, F24c) Gives the filter the model's training levels: sets params->bias_model_training_level_m to

@@ -39,8 +39,11 @@ class BiasLevel {
   /// (F23c) The anchors' bias variance σ̂_a² of the windows so far, shrunk towards prior_sigma_a2 by kPriorWindows
   /// windows of the mean weight; prior_sigma_a2 before the first window.
   double sigmaA2(double prior_sigma_a2) const;
-  /// The windows' σ̂_a² alone, without a prior; NaN before the first window.
-  double sigmaA2Data() const;
+  /// The pair-bias level √(2σ̂_a²) (2σ_a² is a pair's bias variance, F23), shrunk towards prior_level_m as sigmaA2
+  /// is towards prior_level_m² / 2.
+  double pairLevel(double prior_level_m) const;
+  /// The windows' pair-bias level alone, without a prior; NaN before the first window.
+  double pairLevelData() const;
   /// Windows counted so far (not forgotten).
   int numWindows() const { return n_windows_; }
 
