@@ -225,6 +225,7 @@ void runLocalize(const LocalizeArgs& a) {
   j["n_tof_invalid"] = s.n_tof_invalid;
   j["n_tof_tilted"] = s.n_tof_tilted;
   j["n_tof_not_ready"] = s.n_tof_not_ready;
+  j["started_in_motion"] = s.started_in_motion;
   j["takeoff_t_s"] = std::isnan(s.takeoff_t_s) ? json(nullptr) : json(s.takeoff_t_s);
   j["landing_t_s"] = std::isnan(s.landing_t_s) ? json(nullptr) : json(s.landing_t_s);
   j["start_position_m"] = {s.start_w_p_b.x(), s.start_w_p_b.y(), s.start_w_p_b.z()};
@@ -293,6 +294,7 @@ void runLocalize(const LocalizeArgs& a) {
               << " / tilted " << s.n_tof_tilted << " / before the start " << s.n_tof_not_ready << " of "
               << s.n_tof_total << (s.n_tof_total == 0 ? " (the flight has no ToF stream)" : "") << "\n";
   }
+  if (s.started_in_motion) std::cout << "the log starts with the body in motion (in the air or carried)\n";
   if (!std::isnan(s.ready_t_s)) std::cout << "position found at " << s.ready_t_s << " s\n";
   if (!std::isnan(s.takeoff_t_s)) std::cout << "left rest at " << s.takeoff_t_s << " s\n";
   if (!std::isnan(s.bias_level_m)) {

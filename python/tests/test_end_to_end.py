@@ -72,6 +72,9 @@ def test_train_localize_and_compare(flights, trained, tmp_path):
         assert 0 < air["rmse_m"] < 1.5 and air["n"] > 100
         s = run["metrics"]["samples"]
         np.testing.assert_allclose(np.sqrt(np.mean(s["error_norm"][s["airborne"]] ** 2)), air["rmse_m"], rtol=1e-9)
+    # a flight logged from the ground does not start in motion; its take-off comes before its landing
+    assert plain["summary"]["started_in_motion"] is False
+    assert plain["summary"]["ready_t_s"] <= plain["summary"]["takeoff_t_s"] < plain["summary"]["landing_t_s"]
     # the bias level measured in flight (filter.md F23c) is reported, and switched off with its memory
     assert plain["summary"]["n_bias_level_windows"] > 10 and 0 < plain["summary"]["bias_level_m"] < 1
     fixed = u.localize_flight(test["flight"], test["survey"], params={"output_bias_memory_s": 0.0})

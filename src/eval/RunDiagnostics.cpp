@@ -17,11 +17,14 @@ namespace uwb {
 
 namespace {
 
-/// The moving phase the statistics cover: take-off to landing as the estimator saw them, else the whole estimate.
+/// The moving phase the statistics cover: take-off (or, for a log that began in motion, the first fix) to landing as
+/// the estimator saw them, else the whole estimate. A log that starts in the air and ends on the floor has its first
+/// take-off, if any, after the landing: from there only the floor-level residuals would be counted.
 std::pair<double, double> movingWindow(const LocalizationRun& run) {
   const LocalizerSummary& s = run.summary;
-  double t0 = std::isfinite(s.takeoff_t_s) ? s.takeoff_t_s : (std::isfinite(s.ready_t_s) ? s.ready_t_s : -1e300);
-  double t1 = std::isfinite(s.landing_t_s) && s.landing_t_s > t0 ? s.landing_t_s : 1e300;
+  const double t_ready = std::isfinite(s.ready_t_s) ? s.ready_t_s : -1e300;
+  const double t0 = std::isfinite(s.takeoff_t_s) && !s.started_in_motion ? s.takeoff_t_s : t_ready;
+  const double t1 = std::isfinite(s.landing_t_s) && s.landing_t_s > t0 ? s.landing_t_s : 1e300;
   return {t0, t1};
 }
 

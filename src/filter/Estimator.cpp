@@ -249,6 +249,12 @@ void Estimator::finishStart(double t_s, const StartFix& fix) {
   if (ready_ && summary_.reacquired_t_s.size() < summary_.reacquisition_t_s.size())
     summary_.reacquired_t_s.push_back(t_s);
   if (!ready_) {
+    // a first fix in motion (F16b: no ground evidence, the velocity solved for) is a log that began in the air or
+    // carried: the body has moved, and its next rest is a landing
+    if (imu_mode_ && fix.with_velocity && !on_ground_) {
+      summary_.started_in_motion = true;
+      moved_ = true;
+    }
     summary_.ready_t_s = t_s;
     summary_.start_w_p_b = fix.w_p0;
     summary_.start_rms_residual_m = fix.rms_residual_m;

@@ -4,6 +4,8 @@
  */
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "support/TestSupport.h"
 #include "uwb/eval/FaultInjection.h"
 #include "uwb/eval/RunDiagnostics.h"
@@ -91,6 +93,26 @@ TEST(RunDiagnosticsReal, CleanFlightIsSilent) {
   EXPECT_EQ(d.anchors.named_id, -1);
   EXPECT_FALSE(d.clock.offset);
   EXPECT_GE(d.clock.lags_s.size(), 6u);  // the coarse grid and the two refinements around its best
+}
+
+// A log that starts in the air and ends on the floor (a user's log started mid-flight): its first "take-off" is after
+// the landing (the body leaving rest on the floor), so a check that counted from there saw only floor-level residuals
+// and reported a clean survey as one of another arena (residual RMS 0.91 m).
+TEST(RunDiagnosticsReal, ALogThatStartsInTheAirAndLandsIsSilent) {
+  const auto real = loadReal();
+  UWB_REQUIRE_REAL_DATA(real);
+  const Flight cut = sliceFlight(real->flight, 10.0, real->flight.timeSpan().second);
+  const LocalizationOptions opt;
+  const LocalizationRun run = localizeFlight(cut, real->survey, opt);
+  EXPECT_TRUE(run.summary.started_in_motion);
+  ASSERT_FALSE(std::isnan(run.summary.landing_t_s));  // the rest at the end is a landing
+  EXPECT_GT(run.summary.landing_t_s, run.summary.ready_t_s);
+  const RunDiagnostics d = diagnoseRun(cut, real->survey, opt, run, {}, only(true, false, false));
+  EXPECT_FALSE(d.survey.misfit) << d.verdict();
+  EXPECT_LT(d.survey.truncated_rms_m, RunDiagnosticParams{}.survey_fit_max_rms_m);
+  EXPECT_GT(d.survey.n, 5000u);  // the whole flight from the fix to the landing, not the floor after it
+  // the whole flight from the ground does not start in motion
+  EXPECT_FALSE(localizeFlight(real->flight, real->survey, opt).summary.started_in_motion);
 }
 
 TEST(RunDiagnosticsReal, NamesTheAnchorSurveyedOneMetreOff) {

@@ -110,6 +110,10 @@ struct LocalizerSummary {
   std::vector<double> reacquisition_t_s;  ///< when each re-acquisition started (first 100)
   /// when each of those ended with a fix (same order; fewer when the last one had not ended)
   std::vector<double> reacquired_t_s;
+  /// The log began with the body in motion (in the air or carried): the first fix was one in motion (F16b, no ground
+  /// evidence). It moved before any take-off, so a later rest is a landing and the first time it leaves rest is not
+  /// where its motion began.
+  bool started_in_motion = false;
   double takeoff_t_s = std::numeric_limits<double>::quiet_NaN();  ///< first time it left rest
   double landing_t_s = std::numeric_limits<double>::quiet_NaN();  ///< last time it came to rest after moving
   double ready_t_s = std::numeric_limits<double>::quiet_NaN();    ///< first position fix
