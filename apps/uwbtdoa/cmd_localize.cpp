@@ -297,6 +297,7 @@ void runLocalize(const LocalizeArgs& a) {
   if (s.started_in_motion) std::cout << "the log starts with the body in motion (in the air or carried)\n";
   if (!std::isnan(s.ready_t_s)) std::cout << "position found at " << s.ready_t_s << " s\n";
   if (!std::isnan(s.takeoff_t_s)) std::cout << "left rest at " << s.takeoff_t_s << " s\n";
+  if (!std::isnan(s.landing_t_s)) std::cout << "last came to rest after moving (landed) at " << s.landing_t_s << " s\n";
   if (!std::isnan(s.bias_level_m)) {
     // (F23c) the reported band is widened when the flight's level exceeds the reference
     const double widen = std::max(1.0, s.bias_level_m / params.output_bias_level_m);
