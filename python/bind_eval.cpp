@@ -193,6 +193,7 @@ py::dict summaryDict(const LocalizerSummary& s) {
   d["reacquisition_t_s"] = s.reacquisition_t_s;
   d["reacquired_t_s"] = s.reacquired_t_s, d["takeoff_t_s"] = s.takeoff_t_s, d["landing_t_s"] = s.landing_t_s;
   d["started_in_motion"] = s.started_in_motion, d["ready_t_s"] = s.ready_t_s;
+  d["ground_entered_t_s"] = s.ground_entered_t_s, d["ground_left_t_s"] = s.ground_left_t_s;
   d["start_t_s"] = s.start_t_s, d["end_t_s"] = s.end_t_s, d["process_model"] = toString(s.process_model);
   d["start_w_p_b"] = toNumpy(s.start_w_p_b, true), d["start_rms_residual_m"] = s.start_rms_residual_m;
   d["n_tof_total"] = s.n_tof_total, d["n_tof_used"] = s.n_tof_used, d["n_tof_rejected"] = s.n_tof_rejected;

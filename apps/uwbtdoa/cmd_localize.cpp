@@ -226,6 +226,8 @@ void runLocalize(const LocalizeArgs& a) {
   j["n_tof_tilted"] = s.n_tof_tilted;
   j["n_tof_not_ready"] = s.n_tof_not_ready;
   j["started_in_motion"] = s.started_in_motion;
+  j["ground_entered_t_s"] = s.ground_entered_t_s;
+  j["ground_left_t_s"] = s.ground_left_t_s;
   j["takeoff_t_s"] = std::isnan(s.takeoff_t_s) ? json(nullptr) : json(s.takeoff_t_s);
   j["landing_t_s"] = std::isnan(s.landing_t_s) ? json(nullptr) : json(s.landing_t_s);
   j["start_position_m"] = {s.start_w_p_b.x(), s.start_w_p_b.y(), s.start_w_p_b.z()};

@@ -75,6 +75,9 @@ def test_train_localize_and_compare(flights, trained, tmp_path):
     # a flight logged from the ground does not start in motion; its take-off comes before its landing
     assert plain["summary"]["started_in_motion"] is False
     assert plain["summary"]["ready_t_s"] <= plain["summary"]["takeoff_t_s"] < plain["summary"]["landing_t_s"]
+    # the ground periods: entered before the take-off, left at it, and the landing the last one entered
+    entered, left = plain["summary"]["ground_entered_t_s"], plain["summary"]["ground_left_t_s"]
+    assert entered[0] < plain["summary"]["takeoff_t_s"] == left[0] and entered[-1] == plain["summary"]["landing_t_s"]
     # the bias level measured in flight (filter.md F23c) is reported, and switched off with its memory
     assert plain["summary"]["n_bias_level_windows"] > 10 and 0 < plain["summary"]["bias_level_m"] < 1
     fixed = u.localize_flight(test["flight"], test["survey"], params={"output_bias_memory_s": 0.0})

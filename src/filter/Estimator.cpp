@@ -46,6 +46,9 @@ constexpr double kHealthyRejectionRate = 0.3;
 constexpr double kHealthyPeriod_s = 0.05;
 constexpr double kRevertLead_s = 0.6;
 constexpr double kRevertMaxAge_s = 1.2;
+/// Events listed in the summary (re-acquisitions, ground periods): the first this many, reserved at construction so
+/// that no event allocates
+constexpr std::size_t kMaxListedEvents = 100;
 /// (F16e) The horizontal motion relaxed towards rest over Δt from (p0, v0): v = v0 e^{−Δt/τ},
 /// p = p0 + v0 τ (1 − e^{−Δt/τ}); writes x and y of *p and *v, leaves z.
 void relaxHorizontal(const Vec3& p0, const Vec3& v0, double dt, double tau, Vec3* p, Vec3* v) {
@@ -122,6 +125,9 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
   floor_anchors_ = FloorLevelAnchors(anchors_, params_.ground_z_m, params_.floor_anchor_height_m);
   if (floor_anchors_.any()) start_.setFloorLevelAnchors(floor_anchors_.mask());
   summary_.process_model = params_.process_model;
+  for (std::vector<double>* list : {&summary_.reacquisition_t_s, &summary_.reacquired_t_s,
+                                    &summary_.ground_entered_t_s, &summary_.ground_left_t_s})
+    list->reserve(kMaxListedEvents);
   const AnchorBox box = anchorBox(anchors_);
   box_min_ = box.min;
   box_max_ = box.max;
@@ -224,7 +230,7 @@ void Estimator::startAcquisition(double t_s, bool reacquisition) {
   climb_.clear();
   if (reacquisition) {
     ++summary_.n_reacquisitions;
-    if (summary_.reacquisition_t_s.size() < 100) summary_.reacquisition_t_s.push_back(t_s);
+    if (summary_.reacquisition_t_s.size() < kMaxListedEvents) summary_.reacquisition_t_s.push_back(t_s);
   }
   // at rest the body stays where it is: position only; otherwise position and velocity (F16b)
   start_.begin(t_s, ekf_.state(), !(imu_mode_ && on_ground_), reacquisition);
@@ -343,6 +349,7 @@ void Estimator::leaveGround(double t_s, bool climbing) {
   const bool from_rest = t_s - t_last_rest_ < kFromRest_s && t_s - t_last_shake_ >= kContactHold_s;
   if (floor_anchors_.hasDelays() && !climbing && from_rest) climb_.start(t_s);
   t_left_ground_ = t_s;
+  if (summary_.ground_left_t_s.size() < summary_.ground_entered_t_s.size()) summary_.ground_left_t_s.push_back(t_s);
   t_last_shake_ = -1e300;
   if (std::isnan(summary_.takeoff_t_s)) summary_.takeoff_t_s = t_s;
   moved_ = true;
@@ -373,6 +380,7 @@ void Estimator::enterGround(double t_s) {
   n_low_z_ = 0;
   v_climb_ = 0.0;
   ++summary_.n_rest_periods;
+  if (summary_.ground_entered_t_s.size() < kMaxListedEvents) summary_.ground_entered_t_s.push_back(t_s);
   if (moved_) summary_.landing_t_s = t_s;
   if (imu_mode_ && rest_.atRest()) ekf_.setAccelModel(params_.ground_accel_model);  // (F15) levelled from all axes
   if (ready_ && phase_ != FlightPhase::kAcquisition) phase_ = moved_ ? FlightPhase::kLanded : FlightPhase::kGround;

@@ -2,7 +2,7 @@
  *  @brief Checks after a localization run that catch the "wrong but plausible" inputs, which the filter itself
  *         cannot tell from a hard flight (docs/robustness.md, "Wrong but plausible"):
  *
- *  - survey fit: the TDoA residuals against the estimated trajectory over the flight (a survey of another arena or
+ *  - survey fit: the TDoA residuals against the estimated trajectory in flight (a survey of another arena or
  *    with swapped ids does not fit the TDoA), and, with ground truth, a constant offset between the estimate and the
  *    truth (a survey shifted as a whole: TDoA cannot see a translation, the truth can);
  *  - per-anchor survey: leave one anchor out, localize with the others, and fit the left-out anchor's position
@@ -43,14 +43,14 @@ struct RunDiagnosticParams {
   /// Residuals are clipped at this in the residual power and left out of the anchor fits [m]
   /// (kGrossResidual_m of io/ResidualStats.h).
   double gross_residual_m = 1.0;
-  /// Survey fit: truncated RMS of the residuals above this → the survey does not fit the TDoA [m]. Clean dev
-  /// flights 0.15–0.29 m; docs/robustness.md gives the data.
+  /// Survey fit: truncated RMS of the airborne residuals above this → the survey does not fit the TDoA [m]. Clean
+  /// dev flights 0.23–0.39 m; docs/robustness.md gives the data.
   double survey_fit_max_rms_m = 0.45;
   /// With ground truth: the mean airborne error vector longer than this → the survey and the truth are in
   /// different frames [m].
   double max_mean_error_m = 1.0;
   /// Anchor check: the anchor whose fitted offset lowers its pairs' residual RMS the most (the fit gain,
-  /// rms_before − rms_after) is named when the gain exceeds this [m] … (clean 0425 flights: at most 0.205 m;
+  /// rms_before − rms_after) is named when the gain exceeds this [m] … (clean 0425 flights: at most 0.21 m;
   /// docs/robustness.md gives the data)
   double anchor_min_gain_m = 0.25;
   /// … and is at least this many times the second largest gain (a wrong anchor corrupts its neighbours' runs).

@@ -114,6 +114,10 @@ struct LocalizerSummary {
   /// evidence). It moved before any take-off, so a later rest is a landing and the first time it leaves rest is not
   /// where its motion began.
   bool started_in_motion = false;
+  /// When the estimator entered the ground (rest or floor contact, F18) and when it left it again (first 100 each,
+  /// same order; one fewer left when the log ends on the ground). Its TDoA there carry the floor-level bias (F14).
+  std::vector<double> ground_entered_t_s;
+  std::vector<double> ground_left_t_s;
   double takeoff_t_s = std::numeric_limits<double>::quiet_NaN();  ///< first time it left rest
   double landing_t_s = std::numeric_limits<double>::quiet_NaN();  ///< last time it came to rest after moving
   double ready_t_s = std::numeric_limits<double>::quiet_NaN();    ///< first position fix
