@@ -40,6 +40,24 @@ TEST(ProtocolCli, JsonRowsCarryTheFiguresAndTheFlightsBiasLevel) {
     EXPECT_LE(c2, 1.0);
   }
   EXPECT_EQ(row.at("session").get<std::string>(), "0425");
+  EXPECT_FALSE(row.at("survey_fit_warning").get<bool>());  // the check after the run is silent on a clean flight
+}
+
+TEST(ProtocolCli, TheCutsAreAlsoLoggedToTheLandingAndTheSurveyCheckStaysSilentOnThem) {
+  if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
+  const auto flight = test::pilotFlight("0425-traj2");
+  UWB_REQUIRE_REAL_DATA(flight);
+  // WHEN the protocol cuts one flight at 10 s
+  const test::CliResult r = test::runCli("protocol --data " + test::dataDir().string() +
+                                         " --only 0425-traj2 --no-sim --cuts 10 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  // THEN the whole flight and the cut ending mid-air are rows, the cut logged on to the end (landing included) is
+  // counted, and no run warns of a survey misfit
+  ASSERT_EQ(j.at("rows").size(), 2u);
+  for (const nlohmann::json& row : j.at("rows")) EXPECT_FALSE(row.at("survey_fit_warning").get<bool>());
+  EXPECT_EQ(j.at("landed_cuts").at("n").get<int>(), 1);
+  EXPECT_TRUE(j.at("landed_cuts").at("survey_fit_warnings").empty()) << j.at("landed_cuts").dump();
 }
 
 }  // namespace
