@@ -7,24 +7,36 @@
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "support/TestSupport.h"
 
 namespace uwb {
 namespace {
 
-TEST(ProtocolCli, JsonRowsCarryTheFiguresAndTheFlightsBiasLevel) {
-  if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
-  const auto flight = test::pilotFlight("0425-traj2");
-  UWB_REQUIRE_REAL_DATA(flight);
+/// The protocol on 0425-traj2 alone; skips where the CLI or the real data is absent.
+class ProtocolCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
+    UWB_REQUIRE_REAL_DATA(test::pilotFlight("0425-traj2"));
+  }
+  /// `uwbtdoa protocol --json --no-sim` on the flight with `options`; its JSON output.
+  nlohmann::json run(const std::string& options) {
+    out_ = test::runCli("protocol --data " + test::dataDir().string() + " --only 0425-traj2 --no-sim --json " +
+                        options);
+    EXPECT_EQ(out_.exit_code, 0) << out_.err;
+    return nlohmann::json::parse(out_.out);
+  }
+  test::CliResult out_;
+};
+
+TEST_F(ProtocolCli, JsonRowsCarryTheFiguresAndTheFlightsBiasLevel) {
   // WHEN the protocol runs on that one whole flight (no cuts, no simulations)
-  const test::CliResult r = test::runCli("protocol --data " + test::dataDir().string() +
-                                         " --only 0425-traj2 --no-sim --no-cuts --json");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const nlohmann::json j = nlohmann::json::parse(r.out);
+  const nlohmann::json j = run("--no-cuts");
   // THEN there is one row, with its RMSE, coverage and the level the filter measured in flight
   const nlohmann::json& rows = j.at("rows");
-  ASSERT_EQ(rows.size(), 1u) << r.out.substr(0, 2000);
+  ASSERT_EQ(rows.size(), 1u) << out_.out.substr(0, 2000);
   const nlohmann::json& row = rows.at(0);
   EXPECT_EQ(row.at("name").get<std::string>(), "0425-traj2");
   const double rmse = row.at("rmse_airborne_m").get<double>();
@@ -43,15 +55,9 @@ TEST(ProtocolCli, JsonRowsCarryTheFiguresAndTheFlightsBiasLevel) {
   EXPECT_FALSE(row.at("survey_fit_warning").get<bool>());  // the check after the run is silent on a clean flight
 }
 
-TEST(ProtocolCli, TheCutsAreAlsoLoggedToTheLandingAndTheSurveyCheckStaysSilentOnThem) {
-  if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
-  const auto flight = test::pilotFlight("0425-traj2");
-  UWB_REQUIRE_REAL_DATA(flight);
+TEST_F(ProtocolCli, TheCutsAreAlsoLoggedToTheLandingAndTheSurveyCheckStaysSilentOnThem) {
   // WHEN the protocol cuts one flight at 10 s
-  const test::CliResult r = test::runCli("protocol --data " + test::dataDir().string() +
-                                         " --only 0425-traj2 --no-sim --cuts 10 --json");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const nlohmann::json j = nlohmann::json::parse(r.out);
+  const nlohmann::json j = run("--cuts 10");
   // THEN the whole flight and the cut ending mid-air are rows, the cut logged on to the end (landing included) is
   // counted, and no run warns of a survey misfit
   ASSERT_EQ(j.at("rows").size(), 2u);
