@@ -38,6 +38,7 @@ struct ProtocolArgs {
   std::vector<std::string> sets;
   bool json_out = false, no_real = false, no_sim = false, no_cuts = false, faults = false, checks = false;
   std::string only;
+  std::string write_sims;  ///< folder for the simulated runs' flight CSV and survey (empty: none written)
 };
 
 struct RealFlight {
@@ -523,7 +524,14 @@ void runProtocol(const ProtocolArgs& a) {
   }
   if (!a.no_sim) {
     const std::string data = a.data_dir.empty() ? uwb::app::defaultDataDir() : a.data_dir;
+    if (!a.write_sims.empty()) fs::create_directories(a.write_sims);
     for (const uwb::SimScenarioRun& s : uwb::protocolSimulations(data, {11, 12, 13}, a.only)) {
+      if (!a.write_sims.empty()) {
+        // the run as the filter sees it, to re-run with `localize` (both files written atomically)
+        uwb::writeFlightCsv(s.flight, (fs::path(a.write_sims) / (s.name + ".csv")).string());
+        uwb::writeAnchorSurvey(s.survey, (fs::path(a.write_sims) / (s.name + "-survey.txt")).string());
+        if (s.cut) uwb::writeFlightCsv(s.whole, (fs::path(a.write_sims) / (s.name + "-whole.csv")).string());
+      }
       uwb::EstimateCheckParams cp;
       cp.floor_z_m = params.ground_z_m;
       cp.ceiling_z_m = -1e300;
@@ -630,6 +638,10 @@ const bool kRegistered = uwb::app::registerCommand(
                     "the statistics of the checks after a run on every real flight, clean and with the faults they "
                     "find (anchor 1 m off, TDoA clock 0.5 s late, survey shifted or of another arena)");
        sub.add_flag("--json", a->json_out, "print one JSON object instead of tables");
+       sub.add_option("--write-sims", a->write_sims,
+                      "write each simulated run as the filter sees it to this folder (NAME.csv in the UTIL layout, "
+                      "NAME-survey.txt; a run cut in the air also as logged from the ground, NAME-whole.csv), to "
+                      "re-run it with `localize`");
        sub.callback([a] { runProtocol(*a); });
      }});
 

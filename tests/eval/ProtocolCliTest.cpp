@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <unistd.h>
 
 #include "support/TestSupport.h"
 
@@ -64,6 +65,30 @@ TEST_F(ProtocolCli, TheCutsAreAlsoLoggedToTheLandingAndTheSurveyCheckStaysSilent
   for (const nlohmann::json& row : j.at("rows")) EXPECT_FALSE(row.at("survey_fit_warning").get<bool>());
   EXPECT_EQ(j.at("landed_cuts").at("n").get<int>(), 1);
   EXPECT_TRUE(j.at("landed_cuts").at("survey_fit_warnings").empty()) << j.at("landed_cuts").dump();
+}
+
+TEST(ProtocolCliSims, AWrittenSimulatedRunGivesTheSameResultWithLocalize) {
+  if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("uwb_protocol_sims_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  // WHEN the protocol writes the one simulated hover start it runs (built-in layout: no data folder needed)
+  const test::CliResult r =
+      test::runCli("protocol --no-real --only hover-start-paper-s11 --json --write-sims " + dir.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j.at("rows").size(), 1u);
+  const std::string name = "hover-start-paper-s11";
+  for (const char* suffix : {".csv", "-survey.txt", "-whole.csv"})
+    EXPECT_TRUE(std::filesystem::exists(dir / (name + suffix))) << suffix;
+  // THEN `localize` on the written files gives the protocol's airborne RMSE (the run as the filter saw it)
+  const test::CliResult l = test::runCli("localize " + (dir / (name + ".csv")).string() + " --anchors " +
+                                         (dir / (name + "-survey.txt")).string() + " --json --no-diagnostics");
+  ASSERT_EQ(l.exit_code, 0) << l.err;
+  const double protocol_rmse = j.at("rows").at(0).at("rmse_airborne_m").get<double>();
+  EXPECT_GT(protocol_rmse, 0.05);
+  EXPECT_NEAR(nlohmann::json::parse(l.out).at("rmse_airborne_m").get<double>(), protocol_rmse, 1e-9);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
