@@ -187,6 +187,9 @@ py::dict summaryDict(const LocalizerSummary& s) {
   d["n_predictions"] = s.n_predictions, d["n_covariance_propagations"] = s.n_covariance_propagations;
   d["n_reacquisitions"] = s.n_reacquisitions, d["n_rejection_faults"] = s.n_rejection_faults;
   d["n_reverted_motion"] = s.n_reverted_motion, d["start_replayed"] = s.start_replayed;
+  d["n_heading_alignments"] = s.n_heading_alignments;
+  d["heading_alignment_t_s"] = s.heading_alignment_t_s;
+  d["heading_alignment_change_rad"] = s.heading_alignment_change_rad;
   d["bias_level_m"] = s.bias_level_m, d["n_bias_level_windows"] = s.n_bias_level_windows;
   d["raw_bias_level_m"] = s.raw_bias_level_m, d["bias_model_mean_scale"] = s.bias_model_mean_scale;
   d["min_bias_model_mean_scale"] = s.min_bias_model_mean_scale, d["model_mean_level_m"] = s.model_mean_level_m;

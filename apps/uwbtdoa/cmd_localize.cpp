@@ -210,6 +210,9 @@ void runLocalize(const LocalizeArgs& a) {
   j["n_rejection_faults"] = s.n_rejection_faults;
   j["n_reverted_motion"] = s.n_reverted_motion;
   j["start_replayed"] = s.start_replayed;
+  j["n_heading_alignments"] = s.n_heading_alignments;
+  j["heading_alignment_t_s"] = s.heading_alignment_t_s;
+  j["heading_alignment_change_rad"] = s.heading_alignment_change_rad;
   j["bias_level_m"] = std::isnan(s.bias_level_m) ? json(nullptr) : json(s.bias_level_m);
   j["n_bias_level_windows"] = s.n_bias_level_windows;
   j["raw_bias_level_m"] = std::isnan(s.raw_bias_level_m) ? json(nullptr) : json(s.raw_bias_level_m);

@@ -16,6 +16,7 @@
 #include "uwb/filter/EkfParams.h"
 #include "uwb/filter/Estimator.h"
 #include "uwb/filter/FloorLevelAnchors.h"
+#include "uwb/filter/InMotionAlignment.h"
 #include "uwb/filter/Multilateration.h"
 #include "uwb/filter/NavState.h"
 #include "uwb/filter/OutlierGate.h"

@@ -4,6 +4,8 @@
  */
 #include "uwb/filter/Ekf.h"
 
+#include "uwb/filter/InMotionAlignment.h"
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -436,6 +438,24 @@ void Ekf::resetPositionVelocity(const Vec3& w_p_b, const Vec3& w_v_b, const Eige
   P_.middleCols<6>(kPos).setZero();
   P_.block<6, 6>(kPos, kPos) = 0.5 * (cov + cov.transpose());
   if (range_bias_) range_bias_->biasRows().middleCols<6>(kPos).setZero();
+}
+
+void Ekf::headingUpdate(double heading_rad, double sigma_rad) {
+  // (F28) y = ψ_meas − ψ(q), wrapped; a = ∂ψ/∂δθ_b = R₂ (the world z row of R)
+  ScalarLinearMessage<kDim> m;
+  m.a.setZero();
+  m.a.segment<3>(kAtt) = x_.w_q_b.toRotationMatrix().row(2).transpose();
+  m.y = wrapAngle(heading_rad - headingOf(x_.w_q_b));
+  m.var = sigma_rad * sigma_rad;
+  correct(m);
+}
+
+void Ekf::resetAttitude(const Quat& w_q_b, const Mat3& cov) {
+  x_.w_q_b = w_q_b.normalized();
+  P_.middleRows<3>(kAtt).setZero();
+  P_.middleCols<3>(kAtt).setZero();
+  P_.block<3, 3>(kAtt, kAtt) = 0.5 * (cov + cov.transpose());
+  if (range_bias_) range_bias_->biasRows().middleCols<3>(kAtt).setZero();
 }
 
 void Ekf::inflateThrustBias(double sigma_mps2) { P_(kAccBias + 2, kAccBias + 2) += sigma_mps2 * sigma_mps2; }

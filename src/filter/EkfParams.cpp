@@ -75,6 +75,7 @@ void EkfParams::validate() const {
   requirePositive(moving_start_vel_sigma_mps, "moving_start_vel_sigma_mps");
   requirePositive(moving_start_att_sigma_rad, "moving_start_att_sigma_rad");
   requirePositive(moving_start_yaw_sigma_rad, "moving_start_yaw_sigma_rad");
+  requirePositive(heading_alignment_window_s, "heading_alignment_window_s");
   requireNonNegative(output_bias_sigma_m, "output_bias_sigma_m");
   requireNonNegative(output_bias_memory_s, "output_bias_memory_s");
   requireNonNegative(bias_model_level_exponent, "bias_model_level_exponent");

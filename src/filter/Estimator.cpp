@@ -49,6 +49,10 @@ constexpr double kRevertMaxAge_s = 1.2;
 /// Events listed in the summary (re-acquisitions, ground periods): the first this many, reserved at construction so
 /// that no event allocates
 constexpr std::size_t kMaxListedEvents = 100;
+// (F28) the heading alignment acts on a fit whose heading std is below this, when the change exceeds 3σ and this
+constexpr double kMaxAlignedHeadingSigma_rad = 0.35;
+constexpr double kMinHeadingChange_rad = 0.15;
+constexpr double kMinAlignedTiltSigma_rad = 0.01;  ///< floor of the attitude std written with an alignment
 /// (F16e) The horizontal motion relaxed towards rest over Δt from (p0, v0): v = v0 e^{−Δt/τ},
 /// p = p0 + v0 τ (1 − e^{−Δt/τ}); writes x and y of *p and *v, leaves z.
 void relaxHorizontal(const Vec3& p0, const Vec3& v0, double dt, double tau, Vec3* p, Vec3* v) {
@@ -119,14 +123,16 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
       ekf_(params),
       start_(anchors_, params.b_t_tag,
              StartUpParams{params.start_window_s, 40, 3.0, 0.2, params.init_pos_sigma_m, 0.15, 1.0}),
-      replay_(params) {
+      replay_(params),
+      heading_align_(params.heading_alignment_window_s) {
   params_.validate();
   if (anchors_.size() < 4) throw std::invalid_argument("Estimator: at least 4 anchors are needed");
   floor_anchors_ = FloorLevelAnchors(anchors_, params_.ground_z_m, params_.floor_anchor_height_m);
   if (floor_anchors_.any()) start_.setFloorLevelAnchors(floor_anchors_.mask());
   summary_.process_model = params_.process_model;
   for (std::vector<double>* list : {&summary_.reacquisition_t_s, &summary_.reacquired_t_s,
-                                    &summary_.ground_entered_t_s, &summary_.ground_left_t_s})
+                                    &summary_.ground_entered_t_s, &summary_.ground_left_t_s,
+                                    &summary_.heading_alignment_t_s, &summary_.heading_alignment_change_rad})
     list->reserve(kMaxListedEvents);
   const AnchorBox box = anchorBox(anchors_);
   box_min_ = box.min;
@@ -547,6 +553,7 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
     predictTo(t_s);
     propagate(false);
   }
+  alignHeading(t_s, imu, dt_imu);
   if (on_ground_ && t_s - t_last_zupt_ >= kZuptPeriod_s) {
     predictTo(t_s);
     propagate(true);
@@ -818,6 +825,48 @@ void Estimator::revertToHealthyMotion(double t_s) {
   relaxHorizontal(best->w_p_b, best->w_v_b, dt, tau, &p, &v);
   ekf_.resetPositionVelocity(p, v, cov);
   ++summary_.n_reverted_motion;
+}
+
+void Estimator::alignHeading(double t_s, const ImuReading& imu, double dt_s) {
+  // (F28) windows run while tracking in flight only: on the ground the heading is the convention's (F15), and a
+  // start or re-acquisition changes the velocity the increments count from
+  const bool tracking = params_.heading_alignment && imu_mode_ && ready_ && !on_ground_ &&
+                        phase_ == FlightPhase::kTracking && !start_.active();
+  if (!tracking) {
+    heading_align_.reset();
+    return;
+  }
+  const NavState& x = ekf_.state();
+  // the thrust axis only, as the flight's accelerometer model (F3): the x/y readings carry drag and vibration
+  Vec3 f = imu.b_acc_mps2 - x.b_acc_bias;
+  f.head<2>().setZero();
+  heading_align_.add(t_s, f, imu.b_gyro_radps - x.b_gyro_bias, dt_s, x.w_v_b);
+  if (!heading_align_.complete()) return;
+  const std::optional<InMotionAlignment::Result> r = heading_align_.solve();
+  heading_align_.reset();
+  if (!r) return;
+  const double change = wrapAngle(headingOf(r->w_q_b) - headingOf(x.w_q_b));
+  if (!(r->heading_sigma_rad < kMaxAlignedHeadingSigma_rad)) return;
+  predictTo(t_s);
+  propagate(true);
+  // the filter's own heading std: the heading row R₂ of the body-frame attitude covariance
+  const Vec3 row = ekf_.state().w_q_b.toRotationMatrix().row(2).transpose();
+  const double filter_var = row.dot(ekf_.covariance().block<3, 3>(kAtt, kAtt) * row);
+  const double sigma = std::sqrt(r->heading_sigma_rad * r->heading_sigma_rad + filter_var);
+  if (std::abs(change) < std::max(3.0 * sigma, kMinHeadingChange_rad)) {
+    // consistent with the filter: a heading measurement (F28)
+    ekf_.headingUpdate(headingOf(r->w_q_b), r->heading_sigma_rad);
+    return;
+  }
+  // the window's evidence contradicts the filter's heading: its attitude, with the fit's uncertainty
+  const double tilt = std::max(r->tilt_sigma_rad, kMinAlignedTiltSigma_rad);
+  const double heading = std::max(r->heading_sigma_rad, kMinAlignedTiltSigma_rad);
+  ekf_.resetAttitude(r->w_q_b, Vec3(tilt * tilt, tilt * tilt, heading * heading).asDiagonal());
+  ++summary_.n_heading_alignments;
+  if (summary_.heading_alignment_t_s.size() < kMaxListedEvents) {
+    summary_.heading_alignment_t_s.push_back(t_s);
+    summary_.heading_alignment_change_rad.push_back(change);
+  }
 }
 
 Mat3 Estimator::reportedPositionCovariance() const {

@@ -34,6 +34,7 @@
 #include "uwb/filter/EkfParams.h"
 #include "uwb/filter/RestDetector.h"
 #include "uwb/filter/SensorEvents.h"
+#include "uwb/filter/InMotionAlignment.h"
 #include "uwb/filter/StartReplay.h"
 #include "uwb/filter/StartUp.h"
 #include "uwb/filter/TdoaUpdate.h"
@@ -95,6 +96,9 @@ struct LocalizerSummary {
   std::size_t n_rejection_faults = 0; ///< re-acquisitions because most TDoA were rejected (F16d)
   std::size_t n_reverted_motion = 0;  ///< of them, with the state put back to the motion before the fault (F16d)
   bool start_replayed = false;         ///< the first start in motion ran the filter again from its fix (F16g)
+  /// (F28) attitude resets by the heading alignment: their times (the first 100) and heading changes [rad]
+  std::size_t n_heading_alignments = 0;
+  std::vector<double> heading_alignment_t_s, heading_alignment_change_rad;
   /// The pair-bias level measured in flight (F23c), √(2σ̂_a²) with the prior's share, at the last window counted;
   /// NaN before the first (or with output_bias_memory_s = 0)
   double bias_level_m = std::numeric_limits<double>::quiet_NaN();
@@ -185,6 +189,8 @@ class Estimator {
   void applyFloorConstraint(bool on_ground);
   /// F26: the height bounded from above by the IMU's dead-reckoned descent while landing.
   void applyDescentBound(double t_s);
+  /// (F28) one IMU sample into the heading alignment while tracking in flight; resets the attitude on its evidence
+  void alignHeading(double t_s, const ImuReading& imu, double dt_s);
   bool diverged() const;
   /// Reported position covariance: the filter's plus the bias floor (F23).
   Mat3 reportedPositionCovariance() const;
@@ -208,6 +214,7 @@ class Estimator {
   RestDetector rest_;
   StartUp start_;
   StartReplay replay_;  ///< the first start in motion, run again from the fix (F16g)
+  InMotionAlignment heading_align_;  ///< (F28) the attitude from the gyro-tracked specific force and the velocity
   FloorLevelAnchors floor_anchors_;  ///< floor-level anchors and their delays on the floor (F16f)
   ClimbFromFloor climb_;             ///< height since leaving the ground without a detected climb (F16f)
   TdoaUpdateOptions track_opt_, acq_opt_, rest_opt_;

@@ -1,0 +1,169 @@
+/** @file InMotionAlignment.cpp
+ *  @brief docs/math/filter.md F28.
+ */
+#include "uwb/filter/InMotionAlignment.h"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+
+#include "uwb/filter/QuadImuProcess.h"
+#include "uwb/model/TdoaModel.h"
+
+namespace uwb {
+
+double headingOf(const Quat& w_q_b) {
+  const Mat3 R = w_q_b.toRotationMatrix();
+  return std::atan2(R(1, 0), R(0, 0));
+}
+
+double wrapAngle(double a_rad) { return std::remainder(a_rad, 2.0 * M_PI); }
+
+InMotionAlignment::InMotionAlignment(double window_s, double sample_period_s, double correlation_s)
+    : window_s_(window_s), sample_period_s_(sample_period_s), correlation_s_(correlation_s) {}
+
+void InMotionAlignment::reset() { n_ = 0; }
+
+void InMotionAlignment::add(double t_s, const Vec3& f_b, const Vec3& omega_b, double dt_s, const Vec3& w_v) {
+  if (n_ == 0) {
+    // (F28) a new window: body(t₀) is the frame of this sample, the velocity increments count from here
+    t0_ = t_last_ = t_s;
+    t_next_sample_ = t_s + sample_period_s_;
+    dq_ = Quat::Identity();
+    beta_.setZero();
+    phi_.setZero();
+    jg_.setZero();
+    ja_.setZero();
+    v0_ = w_v;
+    tau_[0] = 0.0;
+    alpha_[0].setZero();
+    beta_k_[0].setZero();
+    jg_k_[0].setZero();
+    ja_k_[0].setZero();
+    n_ = 1;
+    return;
+  }
+  if (!(dt_s > 0.0)) return;
+  // (F28) β += ΔR f dt, then ΔR ← ΔR exp(ω dt) (the rotation over the sample, as in the prediction F7); with them
+  // the first-order effect of a bias change δb_g, δb_a (ΔR(δb) ≈ ΔR Exp(Φ δb_g), f → f − δb_a):
+  // ∂β/∂b_g += −ΔR [f]× Φ dt, ∂β/∂b_a += −ΔR dt, Φ ← Exp(ω dt)ᵀ Φ − J_r dt with J_r ≈ I (|ω dt| ≪ 1)
+  const Mat3 dR = dq_.toRotationMatrix();
+  jg_.noalias() -= dR * skew(f_b) * phi_ * dt_s;
+  ja_.noalias() -= dR * dt_s;
+  beta_ += dR * f_b * dt_s;
+  const Quat step = expQuat(omega_b * dt_s);
+  phi_ = (step.conjugate().toRotationMatrix() * phi_).eval() - Mat3::Identity() * dt_s;
+  dq_ = (dq_ * step).normalized();
+  t_last_ = t_s;
+  if (t_s + 1e-9 >= t_next_sample_ && n_ < kCapacity) {
+    const double tau = t_s - t0_;
+    tau_[n_] = tau;
+    // α = v − v₀ − g_w τ with g_w = (0, 0, −g)
+    alpha_[n_] = w_v - v0_ + Vec3(0.0, 0.0, kGravity_mps2 * tau);
+    beta_k_[n_] = beta_;
+    jg_k_[n_] = jg_;
+    ja_k_[n_] = ja_;
+    ++n_;
+    t_next_sample_ += sample_period_s_;
+  }
+}
+
+namespace {
+
+/// Wahba's problem: the rotation R minimising Σ |a_k − R b_k|², from B = Σ a_k b_kᵀ = U S Vᵀ as
+/// R = U diag(1, 1, det(U) det(V)) Vᵀ (Markley 1988).
+Mat3 wahba(const Mat3& B) {
+  const Eigen::JacobiSVD<Mat3> svd(B, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3 D = Mat3::Identity();
+  D(2, 2) = (svd.matrixU().determinant() * svd.matrixV().determinant()) < 0.0 ? -1.0 : 1.0;
+  return svd.matrixU() * D * svd.matrixV().transpose();
+}
+
+// (F28) prior std of the bias changes over a window, and the velocity error the prior is weighed against
+constexpr double kGyroBiasPrior_radps = 0.02;
+constexpr double kAccBiasPrior_mps2 = 0.2;
+constexpr double kPriorVelocitySigma_mps = 0.1;
+
+}  // namespace
+
+std::optional<InMotionAlignment::Result> InMotionAlignment::solve() const {
+  if (n_ < 5) return std::nullopt;
+  // (F28) R₀ and the bias changes δb = (δb_g, δb_a) minimise Σ |α_k − R₀ (β_k + J_k δb)|², J_k = [∂β/∂b_g, ∂β/∂b_a],
+  // with a weak prior on δb
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  using Mat36 = Eigen::Matrix<double, 3, 6>;
+  const auto jac = [&](std::size_t k) {
+    Mat36 J;
+    J << jg_k_[k], ja_k_[k];
+    return J;
+  };
+  Vec6 prior_info;
+  const double wg = kPriorVelocitySigma_mps / kGyroBiasPrior_radps, wa = kPriorVelocitySigma_mps / kAccBiasPrior_mps2;
+  prior_info << wg * wg, wg * wg, wg * wg, wa * wa, wa * wa, wa * wa;
+  // start from Wahba without bias changes, then Gauss-Newton on (δθ, δb) jointly (the tilt at t₀ and a gyro drift are
+  // strongly coupled, which alternating the two would follow only slowly): Exp(δθ) x ≈ x − [x]× δθ, so
+  // r_k(δθ, Δb) ≈ r_k + [R₀β̃_k]× δθ − R₀ J_k Δb
+  Vec6 db = Vec6::Zero();
+  Mat3 B = Mat3::Zero();
+  for (std::size_t k = 1; k < n_; ++k) B.noalias() += alpha_[k] * beta_k_[k].transpose();
+  Mat3 R0 = wahba(B);
+  using Mat9 = Eigen::Matrix<double, 9, 9>;
+  using Vec9 = Eigen::Matrix<double, 9, 1>;
+  for (int it = 0; it < 6; ++it) {
+    Mat9 A = Mat9::Zero();
+    Vec9 g = Vec9::Zero();
+    A.bottomRightCorner<6, 6>().diagonal() = prior_info;
+    g.tail<6>() = -prior_info.cwiseProduct(db);
+    for (std::size_t k = 1; k < n_; ++k) {
+      const Mat36 J = jac(k);
+      const Vec3 rb = R0 * (beta_k_[k] + J * db);
+      const Vec3 r = alpha_[k] - rb;
+      Eigen::Matrix<double, 3, 9> H;
+      H << skew(rb), -R0 * J;
+      A.noalias() += H.transpose() * H;
+      g.noalias() -= H.transpose() * r;
+    }
+    const Vec9 step = A.ldlt().solve(g);
+    R0 = (expQuat(step.head<3>()).toRotationMatrix() * R0).eval();
+    db += step.tail<6>();
+    if (step.norm() < 1e-12) break;
+  }
+  // residuals and the information of (δθ about world axes, δb): ∂r/∂δθ = [R₀β̃]×, ∂r/∂δb = −R₀ J
+  Mat9 F = Mat9::Zero();
+  double r2 = 0.0, h2 = 0.0;
+  for (std::size_t k = 1; k < n_; ++k) {
+    const Mat36 J = jac(k);
+    const Vec3 rb = R0 * (beta_k_[k] + J * db);
+    r2 += (alpha_[k] - rb).squaredNorm();
+    h2 += alpha_[k].head<2>().squaredNorm();
+    Eigen::Matrix<double, 3, 9> H;
+    H << skew(rb), -R0 * J;
+    F.noalias() += H.transpose() * H;
+  }
+  const double m = static_cast<double>(n_ - 1);
+  Result res;
+  res.rms_residual_mps = std::sqrt(r2 / (3.0 * m));
+  res.horizontal_excitation_mps = std::sqrt(h2 / m);
+  res.gyro_bias_change_radps = db.head<3>();
+  res.acc_bias_change_mps2 = db.tail<3>();
+  // the attitude now: R₀ ΔR Exp(Φ δb_g)
+  res.w_q_b = (Quat(R0) * dq_ * expQuat(phi_ * db.head<3>())).normalized();
+  // (F28) covariance σ_r² F⁻¹ with the bias prior, the residuals counted once per correlation time (they are velocity
+  // errors, correlated): a small rotation δ about world z moves R₀β̃_k by δ e_z × R₀β̃_k
+  const double samples_per_independent = std::max(1.0, correlation_s_ / sample_period_s_);
+  const double s2 = std::max(r2 / (3.0 * m), 1e-12) * samples_per_independent;
+  Mat9 info = F / s2;
+  info.bottomRightCorner<6, 6>().diagonal() += prior_info / (kPriorVelocitySigma_mps * kPriorVelocitySigma_mps);
+  const Mat9 cov = info.ldlt().solve(Mat9::Identity());
+  // the attitude now, R₀ ΔR Exp(Φ δb_g), moves about the world axes by δθ + R₀ ΔR Φ δb_g
+  Eigen::Matrix<double, 3, 9> G = Eigen::Matrix<double, 3, 9>::Zero();
+  G.leftCols<3>() = Mat3::Identity();
+  G.block<3, 3>(0, 3) = R0 * dq_.toRotationMatrix() * phi_;
+  const Mat3 cov_now = G * cov * G.transpose();
+  res.heading_sigma_rad = std::sqrt(std::max(cov_now(2, 2), 0.0));
+  res.tilt_sigma_rad = std::sqrt(std::max(std::max(cov_now(0, 0), cov_now(1, 1)), 0.0));
+  return res;
+}
+
+}  // namespace uwb
