@@ -441,10 +441,10 @@ void Ekf::resetPositionVelocity(const Vec3& w_p_b, const Vec3& w_v_b, const Eige
 }
 
 void Ekf::headingUpdate(double heading_rad, double sigma_rad) {
-  // (F28) y = ψ_meas − ψ(q), wrapped; a = ∂ψ/∂δθ_b = R₂ (the world z row of R)
+  // (F28) y = ψ_meas − ψ(q), wrapped; a = ∂ψ/∂δθ_b
   ScalarLinearMessage<kDim> m;
   m.a.setZero();
-  m.a.segment<3>(kAtt) = x_.w_q_b.toRotationMatrix().row(2).transpose();
+  m.a.segment<3>(kAtt) = headingJacobian(x_.w_q_b);
   m.y = wrapAngle(heading_rad - headingOf(x_.w_q_b));
   m.var = sigma_rad * sigma_rad;
   correct(m);

@@ -849,9 +849,9 @@ void Estimator::alignHeading(double t_s, const ImuReading& imu, double dt_s) {
   if (!(r->heading_sigma_rad < kMaxAlignedHeadingSigma_rad)) return;
   predictTo(t_s);
   propagate(true);
-  // the filter's own heading std: the heading row R₂ of the body-frame attitude covariance
-  const Vec3 row = ekf_.state().w_q_b.toRotationMatrix().row(2).transpose();
-  const double filter_var = row.dot(ekf_.covariance().block<3, 3>(kAtt, kAtt) * row);
+  // the filter's own heading variance: the heading's row on the body-frame attitude covariance
+  const Eigen::RowVector3d row = headingJacobian(ekf_.state().w_q_b);
+  const double filter_var = (row * ekf_.covariance().block<3, 3>(kAtt, kAtt) * row.transpose())(0, 0);
   const double sigma = std::sqrt(r->heading_sigma_rad * r->heading_sigma_rad + filter_var);
   if (std::abs(change) < std::max(3.0 * sigma, kMinHeadingChange_rad)) {
     // consistent with the filter: a heading measurement (F28)

@@ -17,6 +17,13 @@ double headingOf(const Quat& w_q_b) {
   return std::atan2(R(1, 0), R(0, 0));
 }
 
+Eigen::RowVector3d headingJacobian(const Quat& w_q_b) {
+  const Mat3 R = w_q_b.toRotationMatrix();
+  const Vec3 c = R.col(0);
+  const Mat3 dc = -R * skew(Vec3::UnitX());
+  return (c(0) * dc.row(1) - c(1) * dc.row(0)) / (c(0) * c(0) + c(1) * c(1));
+}
+
 double wrapAngle(double a_rad) { return std::remainder(a_rad, 2.0 * M_PI); }
 
 InMotionAlignment::InMotionAlignment(double window_s, double sample_period_s, double correlation_s)
@@ -90,7 +97,6 @@ std::optional<InMotionAlignment::Result> InMotionAlignment::solve() const {
   if (n_ < 5) return std::nullopt;
   // (F28) R₀ and the bias changes δb = (δb_g, δb_a) minimise Σ |α_k − R₀ (β_k + J_k δb)|², J_k = [∂β/∂b_g, ∂β/∂b_a],
   // with a weak prior on δb
-  using Mat6 = Eigen::Matrix<double, 6, 6>;
   using Vec6 = Eigen::Matrix<double, 6, 1>;
   using Mat36 = Eigen::Matrix<double, 3, 6>;
   const auto jac = [&](std::size_t k) {

@@ -138,6 +138,22 @@ TEST(InMotionAlignment, WithoutHorizontalVelocityChangesTheHeadingIsUnknown) {
   EXPECT_GT(r->heading_sigma_rad, 0.3);
 }
 
+TEST(InMotionAlignment, HeadingJacobianMatchesFiniteDifferences) {
+  // GIVEN tilted attitudes at several headings
+  for (const Vec3& rpy : {Vec3(0.0, 0.0, 0.4), Vec3(0.3, -0.2, 2.8), Vec3(-0.5, 0.4, -1.9)}) {
+    const Quat q(Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
+                 Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()));
+    const Eigen::RowVector3d J = headingJacobian(q);
+    for (int i = 0; i < 3; ++i) {
+      const double h = 1e-6;
+      const double fd = wrapAngle(headingOf(q * expQuat(Vec3::Unit(i) * h)) - headingOf(q * expQuat(-Vec3::Unit(i) * h))) /
+                        (2.0 * h);
+      // THEN the analytic row is the central difference
+      EXPECT_NEAR(J(i), fd, 1e-7) << rpy.transpose() << " axis " << i;
+    }
+  }
+}
+
 TEST(InMotionAlignment, HeadingOfAndWrapAngle) {
   EXPECT_NEAR(headingOf(Quat(Eigen::AngleAxisd(2.5, Vec3::UnitZ()))), 2.5, 1e-12);
   EXPECT_NEAR(wrapAngle(3.0 * M_PI / 2.0), -M_PI / 2.0, 1e-12);

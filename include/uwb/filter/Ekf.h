@@ -119,8 +119,8 @@ class Ekf {
   /// Overwrites position and velocity with a joint Gaussian (mean w_p_b, w_v_b; covariance Σ over (δp, δv)); keeps the
   /// other states and clears the position/velocity correlations with them (F16b).
   void resetPositionVelocity(const Vec3& w_p_b, const Vec3& w_v_b, const Eigen::Matrix<double, 6, 6>& cov);
-  /// Scalar measurement of the heading (the yaw of the z-y-x angles) = heading_rad ± sigma_rad: a rotation δθ_b of
-  /// the body-frame attitude error turns the world by R δθ_b, whose z part is the heading's change (row R₂, F28).
+  /// Scalar measurement of the heading (the yaw of the z-y-x angles) = heading_rad ± sigma_rad, row headingJacobian
+  /// on the attitude error (F28).
   void headingUpdate(double heading_rad, double sigma_rad);
   /// Overwrites the attitude (world ← body) with covariance `cov` of the body-frame attitude error (F8); keeps the
   /// other states and clears the attitude's correlations with them (F28).

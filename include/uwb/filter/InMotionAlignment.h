@@ -23,6 +23,9 @@ namespace uwb {
 
 /// Heading of the body's x axis in the world's horizontal plane, atan2(R₁₀, R₀₀) (the yaw of the z-y-x angles) [rad].
 double headingOf(const Quat& w_q_b);
+/// ∂ headingOf(q ⊗ Exp(δθ)) / ∂δθ at δθ = 0 (body-frame attitude error, F8): with c = R e_x, ∂c/∂δθ = −R [e_x]×, and
+/// ∂ atan2(c₁, c₀) = (c₀ ∂c₁ − c₁ ∂c₀) / (c₀² + c₁²). (≈ the world-z row of R for a level body.)
+Eigen::RowVector3d headingJacobian(const Quat& w_q_b);
 /// The angle wrapped to (−π, π].
 double wrapAngle(double a_rad);
 
