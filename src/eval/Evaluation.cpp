@@ -16,6 +16,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "uwb/core/Angle.h"
 #include "uwb/core/Error.h"
 #include "uwb/eval/BiasCalibration.h"
 #include "uwb/io/FileAccess.h"
@@ -94,7 +95,7 @@ BiasAngleFigure angleFigure(const BiasModel& model, const BiasDataset& train, co
   }
   MatX sum = MatX::Zero(kGrid, kGrid), count = MatX::Zero(kGrid, kGrid);
   const auto cell = [&](double a) {
-    const double wrapped = std::remainder(a, 2.0 * kPi);  // (−π, π]
+    const double wrapped = wrapAngle(a);
     return std::clamp(static_cast<int>(std::lround((wrapped + kPi) / step)), 0, kGrid - 1);
   };
   for (const auto& s : train.samples) {

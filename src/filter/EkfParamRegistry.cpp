@@ -10,6 +10,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "uwb/filter/InMotionAlignment.h"
+
 namespace uwb {
 
 namespace {
@@ -220,7 +222,8 @@ std::vector<EkfParamInfo> makeRegistry() {
            "Yaw std when the IMU starts while moving (yaw 0 assumed, F15)"),
       boolean("heading_alignment", &P::heading_alignment,
               "In flight, the heading from the gyro-tracked thrust against the velocity: a measurement, or a reset where it contradicts the filter (F28)"),
-      real("heading_alignment_window_s", &P::heading_alignment_window_s, "s", kPositive,
+      real("heading_alignment_window_s", &P::heading_alignment_window_s, "s",
+           EkfParamRange{0.0, InMotionAlignment::kMaxWindow_s, true, false},
            "Window of the heading alignment (F28)"),
       real("output_bias_sigma_m", &P::output_bias_sigma_m, "m", kNonNegative,
            "Slow TDoA bias std mapped into the reported position covariance (F23)"),

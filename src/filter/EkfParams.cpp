@@ -3,8 +3,12 @@
  */
 #include "uwb/filter/EkfParams.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <stdexcept>
+
+#include "uwb/filter/InMotionAlignment.h"
 
 namespace uwb {
 namespace {
@@ -76,6 +80,9 @@ void EkfParams::validate() const {
   requirePositive(moving_start_att_sigma_rad, "moving_start_att_sigma_rad");
   requirePositive(moving_start_yaw_sigma_rad, "moving_start_yaw_sigma_rad");
   requirePositive(heading_alignment_window_s, "heading_alignment_window_s");
+  if (heading_alignment_window_s > InMotionAlignment::kMaxWindow_s)
+    throw std::invalid_argument(fmt::format("EkfParams.heading_alignment_window_s must be ≤ {} s (got {})",
+                                            InMotionAlignment::kMaxWindow_s, heading_alignment_window_s));
   requireNonNegative(output_bias_sigma_m, "output_bias_sigma_m");
   requireNonNegative(output_bias_memory_s, "output_bias_memory_s");
   requireNonNegative(bias_model_level_exponent, "bias_model_level_exponent");

@@ -4,8 +4,10 @@
 #include "uwb/filter/InMotionAlignment.h"
 
 #include <Eigen/SVD>
+#include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "uwb/filter/QuadImuProcess.h"
 #include "uwb/model/TdoaModel.h"
@@ -24,10 +26,17 @@ Eigen::RowVector3d headingJacobian(const Quat& w_q_b) {
   return (c(0) * dc.row(1) - c(1) * dc.row(0)) / (c(0) * c(0) + c(1) * c(1));
 }
 
-double wrapAngle(double a_rad) { return std::remainder(a_rad, 2.0 * M_PI); }
-
 InMotionAlignment::InMotionAlignment(double window_s, double sample_period_s, double correlation_s)
-    : window_s_(window_s), sample_period_s_(sample_period_s), correlation_s_(correlation_s) {}
+    : window_s_(window_s), sample_period_s_(sample_period_s), correlation_s_(correlation_s) {
+  if (!(window_s > 0.0) || !(sample_period_s > 0.0) || !(correlation_s > 0.0))
+    throw std::invalid_argument(fmt::format("heading alignment: window {} s, sample period {} s, correlation {} s must be > 0",
+                                            window_s, sample_period_s, correlation_s));
+  // the first increment is the window's start, one more per sample period
+  if (window_s / sample_period_s + 1.0 > static_cast<double>(kCapacity))
+    throw std::invalid_argument(fmt::format(
+        "heading alignment window {} s holds more than {} increments of {} s (at most {} s)", window_s, kCapacity,
+        sample_period_s, static_cast<double>(kCapacity - 1) * sample_period_s));
+}
 
 void InMotionAlignment::reset() { n_ = 0; }
 
@@ -42,7 +51,6 @@ void InMotionAlignment::add(double t_s, const Vec3& f_b, const Vec3& omega_b, do
     jg_.setZero();
     ja_.setZero();
     v0_ = w_v;
-    tau_[0] = 0.0;
     alpha_[0].setZero();
     beta_k_[0].setZero();
     jg_k_[0].setZero();
@@ -64,7 +72,6 @@ void InMotionAlignment::add(double t_s, const Vec3& f_b, const Vec3& omega_b, do
   t_last_ = t_s;
   if (t_s + 1e-9 >= t_next_sample_ && n_ < kCapacity) {
     const double tau = t_s - t0_;
-    tau_[n_] = tau;
     // α = v − v₀ − g_w τ with g_w = (0, 0, −g)
     alpha_[n_] = w_v - v0_ + Vec3(0.0, 0.0, kGravity_mps2 * tau);
     beta_k_[n_] = beta_;

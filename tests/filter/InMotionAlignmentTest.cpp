@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
 
 #include "uwb/filter/QuadImuProcess.h"
 
@@ -152,6 +153,23 @@ TEST(InMotionAlignment, HeadingJacobianMatchesFiniteDifferences) {
       EXPECT_NEAR(J(i), fd, 1e-7) << rpy.transpose() << " axis " << i;
     }
   }
+}
+
+TEST(InMotionAlignment, TheLongestWindowFitsItsIncrementsAndALongerOneIsRejected) {
+  // GIVEN the longest window the bounded memory holds, THEN exact samples over it give the attitude
+  const Motion m;
+  const InMotionAlignment a = feed(m, 0.0, InMotionAlignment::kMaxWindow_s);
+  ASSERT_TRUE(a.complete());
+  const std::optional<InMotionAlignment::Result> r = a.solve();
+  ASSERT_TRUE(r.has_value());
+  EXPECT_LT(r->rms_residual_mps, 1e-3);
+  EXPECT_NEAR(wrapAngle(headingOf(r->w_q_b) - headingOf(m.attitude(InMotionAlignment::kMaxWindow_s))), 0.0, 4e-3);
+  // WHEN the window is longer than the increments it could store, or not positive, THEN it is an error, not a window
+  // that silently ends early
+  EXPECT_THROW(InMotionAlignment(InMotionAlignment::kMaxWindow_s + 0.11), std::invalid_argument);
+  EXPECT_THROW(InMotionAlignment(30.0), std::invalid_argument);
+  EXPECT_THROW(InMotionAlignment(0.0), std::invalid_argument);
+  EXPECT_THROW(InMotionAlignment(4.0, 0.0), std::invalid_argument);
 }
 
 TEST(InMotionAlignment, HeadingOfAndWrapAngle) {

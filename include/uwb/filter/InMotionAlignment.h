@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <optional>
 
+#include "uwb/core/Angle.h"
 #include "uwb/core/Types.h"
 
 namespace uwb {
@@ -26,8 +27,6 @@ double headingOf(const Quat& w_q_b);
 /// ∂ headingOf(q ⊗ Exp(δθ)) / ∂δθ at δθ = 0 (body-frame attitude error, F8): with c = R e_x, ∂c/∂δθ = −R [e_x]×, and
 /// ∂ atan2(c₁, c₀) = (c₀ ∂c₁ − c₁ ∂c₀) / (c₀² + c₁²). (≈ the world-z row of R for a level body.)
 Eigen::RowVector3d headingJacobian(const Quat& w_q_b);
-/// The angle wrapped to (−π, π].
-double wrapAngle(double a_rad);
 
 class InMotionAlignment {
  public:
@@ -42,9 +41,17 @@ class InMotionAlignment {
     Vec3 acc_bias_change_mps2 = Vec3::Zero();    ///< accelerometer bias beyond the one subtracted
   };
 
+  /// The most increments a window stores (bounded memory): window_s / sample_period_s may not exceed it.
+  static constexpr std::size_t kCapacity = 256;
+  /// The spacing of the stored increments the estimator uses, and the longest window it then fits [s].
+  static constexpr double kDefaultSamplePeriod_s = 0.1;
+  static constexpr double kMaxWindow_s = static_cast<double>(kCapacity - 1) * kDefaultSamplePeriod_s;
+
   /// window_s: the window's length; sample_period_s: spacing of the stored increments; correlation_s: the time over
-  /// which the velocity's errors are taken as correlated (the residuals count once per correlation_s).
-  explicit InMotionAlignment(double window_s = 4.0, double sample_period_s = 0.1, double correlation_s = 1.0);
+  /// which the velocity's errors are taken as correlated (the residuals count once per correlation_s). Throws
+  /// std::invalid_argument for a window that does not fit kCapacity increments or a non-positive length.
+  explicit InMotionAlignment(double window_s = 4.0, double sample_period_s = kDefaultSamplePeriod_s,
+                             double correlation_s = 1.0);
 
   /// Forgets the window; the next add() starts a new one.
   void reset();
@@ -66,7 +73,6 @@ class InMotionAlignment {
   const Mat3& accBiasJacobian() const { return ja_; }
 
  private:
-  static constexpr std::size_t kCapacity = 256;
   double window_s_, sample_period_s_, correlation_s_;
   std::size_t n_ = 0;
   double t0_ = 0.0, t_last_ = 0.0, t_next_sample_ = 0.0;
@@ -75,7 +81,6 @@ class InMotionAlignment {
   Mat3 phi_ = Mat3::Zero();     ///< ∂ rotation vector of ΔR (right perturbation) / ∂ gyro bias
   Mat3 jg_ = Mat3::Zero(), ja_ = Mat3::Zero();  ///< ∂β / ∂ gyro bias, ∂β / ∂ accelerometer bias
   Vec3 v0_ = Vec3::Zero();
-  std::array<double, kCapacity> tau_{};
   std::array<Vec3, kCapacity> alpha_{}, beta_k_{};
   std::array<Mat3, kCapacity> jg_k_{}, ja_k_{};
 };
