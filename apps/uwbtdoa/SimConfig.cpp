@@ -103,8 +103,17 @@ void applySimConfig(const nlohmann::json& j, SimParams* sp, TrajectoryParams* tp
       } catch (const std::invalid_argument& e) {
         throw ConfigKeyError(key, e.what());
       }
+    } else if (key == "rotor_drag_per_s") {
+      try {
+        sp->rotor_drag_per_s = jsonDouble(value, "rotor_drag_per_s");
+      } catch (const std::invalid_argument& e) {
+        throw ConfigKeyError(key, e.what());
+      }
+      if (!(sp->rotor_drag_per_s >= 0.0 && sp->rotor_drag_per_s < 10.0))
+        throw ConfigKeyError(key, "'rotor_drag_per_s' must be in [0, 10) 1/s, got " + value.dump());
     } else {
-      throw ConfigKeyError(key, "unknown section '" + key + "' (known: trajectory, imu, pose, tdoa, bias, b_t_tag)");
+      throw ConfigKeyError(key, "unknown section '" + key +
+                                    "' (known: trajectory, imu, pose, tdoa, bias, b_t_tag, rotor_drag_per_s)");
     }
   }
 }

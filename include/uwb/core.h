@@ -4,6 +4,7 @@
  */
 #pragma once
 
+#include "uwb/core/Angle.h"
 #include "uwb/core/Error.h"
 #include "uwb/core/Smoothstep.h"
 #include "uwb/core/Types.h"

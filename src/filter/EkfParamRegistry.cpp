@@ -225,6 +225,8 @@ std::vector<EkfParamInfo> makeRegistry() {
       real("heading_alignment_window_s", &P::heading_alignment_window_s, "s",
            EkfParamRange{0.0, InMotionAlignment::kMaxWindow_s, true, false},
            "Window of the heading alignment (F28)"),
+      real("heading_alignment_drag_per_s", &P::heading_alignment_drag_per_s, "1/s", kNonNegative,
+           "Rotor drag per unit horizontal velocity in the heading alignment's model (F28a')"),
       real("output_bias_sigma_m", &P::output_bias_sigma_m, "m", kNonNegative,
            "Slow TDoA bias std mapped into the reported position covariance (F23)"),
       real("output_bias_memory_s", &P::output_bias_memory_s, "s", kNonNegative,

@@ -124,7 +124,8 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
       start_(anchors_, params.b_t_tag,
              StartUpParams{params.start_window_s, 40, 3.0, 0.2, params.init_pos_sigma_m, 0.15, 1.0}),
       replay_(params),
-      heading_align_(params.heading_alignment_window_s) {
+      heading_align_(params.heading_alignment_window_s, InMotionAlignment::kDefaultSamplePeriod_s,
+                     InMotionAlignment::kDefaultCorrelation_s, params.heading_alignment_drag_per_s) {
   params_.validate();
   if (anchors_.size() < 4) throw std::invalid_argument("Estimator: at least 4 anchors are needed");
   floor_anchors_ = FloorLevelAnchors(anchors_, params_.ground_z_m, params_.floor_anchor_height_m);
@@ -837,7 +838,8 @@ void Estimator::alignHeading(double t_s, const ImuReading& imu, double dt_s) {
     return;
   }
   const NavState& x = ekf_.state();
-  // the thrust axis only, as the flight's accelerometer model (F3): the x/y readings carry drag and vibration
+  // the thrust axis only, as the flight's accelerometer model (F3): the x/y readings carry vibration, and the drag
+  // they also carry is modelled from the velocity (F28a′)
   Vec3 f = imu.b_acc_mps2 - x.b_acc_bias;
   f.head<2>().setZero();
   heading_align_.add(t_s, f, imu.b_gyro_radps - x.b_gyro_bias, dt_s, x.w_v_b);

@@ -86,7 +86,7 @@ SimResult simulateFlight(const Scenario& scenario, const SimParams& params, std:
     out.imu_truth.reserve(n);
     for (std::size_t k = 0; k < n; ++k) {
       const double t = static_cast<double>(k) * dt;
-      const KinematicState s = kinematicState(trajectory, t);
+      const KinematicState s = kinematicState(trajectory, t, params.rotor_drag_per_s);
       // (S10) rotor vibration only while flying; the draws are the same either way (one rng sequence)
       const Vec3 acc_noise = (s.on_ground ? ip.rest_acc_noise_std_mps2 : ip.acc_noise_std_mps2) * randn3();
       const Vec3 gyro_noise = (s.on_ground ? ip.rest_gyro_noise_std_rps : ip.gyro_noise_std_rps) * randn3();
@@ -106,7 +106,7 @@ SimResult simulateFlight(const Scenario& scenario, const SimParams& params, std:
     out.pose_exact.reserve(n);
     for (std::size_t k = 0; k < n; ++k) {
       const double t = static_cast<double>(k) / pp.rate_hz;
-      const KinematicState s = kinematicState(trajectory, t);
+      const KinematicState s = kinematicState(trajectory, t, params.rotor_drag_per_s);
       out.pose_exact.push_back({t, s.w_p, s.w_q_b});
       PoseSample q{t, s.w_p, s.w_q_b};
       for (int i = 0; i < 3; ++i) q.w_p_b[i] = quantize(q.w_p_b[i], pp.position_quantum_m);
@@ -141,7 +141,7 @@ SimResult simulateFlight(const Scenario& scenario, const SimParams& params, std:
       }
       const Anchor& anchor_a = survey.anchors[i_a];
       const Anchor& anchor_b = survey.anchors[i_b];
-      const KinematicState s = kinematicState(trajectory, t);
+      const KinematicState s = kinematicState(trajectory, t, params.rotor_drag_per_s);
       const Vec3 w_p_tag = tagPosition(s.w_p, s.w_q_b, params.b_t_tag);
       TdoaTruth truth;
       truth.tdoa_true_m = range(w_p_tag, anchor_b.w_p) - range(w_p_tag, anchor_a.w_p);  // (S20)

@@ -32,27 +32,36 @@ Quat attitudeFromAcceleration(const Vec3& w_a, double yaw_rad) {
   return q;
 }
 
-KinematicState kinematicState(const Trajectory& trajectory, double t_s) {
+namespace {
+/// (S7′) the acceleration the thrust alone gives: a + k v_h (the drag −k v_h is the rest)
+Vec3 thrustAcceleration(const FlatState& flat, double drag_per_s) {
+  Vec3 a = flat.w_a;
+  a.head<2>() += drag_per_s * flat.w_v.head<2>();
+  return a;
+}
+}  // namespace
+
+KinematicState kinematicState(const Trajectory& trajectory, double t_s, double drag_per_s) {
   const FlatState flat = trajectory.evaluate(t_s);
   KinematicState out;
   out.w_p = flat.w_p;
   out.w_v = flat.w_v;
   out.w_a = flat.w_a;
   out.on_ground = flat.on_ground;
-  out.w_q_b = attitudeFromAcceleration(flat.w_a, flat.yaw_rad);
+  out.w_q_b = attitudeFromAcceleration(thrustAcceleration(flat, drag_per_s), flat.yaw_rad);
   // (S9) body rates ω = vee(Rᵀ Ṙ), evaluated as Log(R(t−h)ᵀ R(t+h)) / 2h: O(h²) accurate; the attitude is C1
   // (a is C1 because the trajectory is C3), so the rates are continuous.
   constexpr double h = 1e-4;
   const FlatState before = trajectory.evaluate(t_s - h);
   const FlatState after = trajectory.evaluate(t_s + h);
-  const Quat q0 = attitudeFromAcceleration(before.w_a, before.yaw_rad);
-  const Quat q1 = attitudeFromAcceleration(after.w_a, after.yaw_rad);
+  const Quat q0 = attitudeFromAcceleration(thrustAcceleration(before, drag_per_s), before.yaw_rad);
+  const Quat q1 = attitudeFromAcceleration(thrustAcceleration(after, drag_per_s), after.yaw_rad);
   const double span = std::min(t_s + h, trajectory.duration_s()) - std::max(t_s - h, 0.0);
   if (span > 0.0) {
     const Eigen::AngleAxisd rel(q0.conjugate() * q1);
     out.b_omega = rel.axis() * rel.angle() / span;
   }
-  // (S10) accelerometer truth: specific force in the body frame.
+  // (S10) accelerometer truth: specific force in the body frame (with drag its x/y read −k Rᵀ v_h, S7′).
   out.b_specific_force = out.w_q_b.conjugate() * (flat.w_a + Vec3(0.0, 0.0, kGravity_mps2));
   return out;
 }

@@ -44,6 +44,8 @@ void SimParams::validate() const {
   tdoa.validate();
   bias.validate();
   require(b_t_tag.allFinite() && b_t_tag.norm() < 1.0, "b_t_tag must be finite and shorter than 1 m");
+  require(std::isfinite(rotor_drag_per_s) && rotor_drag_per_s >= 0.0 && rotor_drag_per_s < 10.0,
+          "rotor_drag_per_s must be in [0, 10) 1/s");
 }
 
 SimParams SimParams::noiseFree() {
@@ -59,6 +61,7 @@ SimParams SimParams::noiseFree() {
   p.pose.position_quantum_m = 0.0;
   p.pose.quat_quantum = 0.0;
   p.bias.enabled = false;
+  p.rotor_drag_per_s = 0.0;  // the vehicle of the filter's thrust model (F3)
   return p;
 }
 

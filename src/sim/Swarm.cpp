@@ -156,7 +156,7 @@ SwarmSimResult simulateSwarm(const SwarmScenario& scenario, const SimParams& par
   std::vector<char> chosen(static_cast<std::size_t>(n * n));
   std::vector<std::pair<double, int>> by_distance;
   const auto tagAt = [&](int k, double t) {
-    const KinematicState s = kinematicState(traj[static_cast<std::size_t>(k)], t);
+    const KinematicState s = kinematicState(traj[static_cast<std::size_t>(k)], t, params.rotor_drag_per_s);
     return tagPosition(s.w_p, s.w_q_b, params.b_t_tag);
   };
   for (long round = 0;; ++round) {

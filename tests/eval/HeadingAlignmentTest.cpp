@@ -36,10 +36,11 @@ TEST(HeadingAlignment, AYawingStartInTheAirFindsItsHeading) {
   const SimScenarioRun& sc = runs.front();
   const double t_from = sc.flight.timeSpan().first + 15.0;
   LocalizationOptions off;
+  off.params.heading_alignment = false;
   const LocalizationRun base = localizeFlight(sc.flight, sc.survey, off);
   LocalizationOptions on;
   on.params.heading_alignment = true;
-  // WHEN the filter runs with the heading alignment on
+  // WHEN the filter runs with the heading alignment on (the default)
   const LocalizationRun aligned = localizeFlight(sc.flight, sc.survey, on);
   // THEN without it the heading stays wrong; with it, it is found within 20° after 15 s, and the position holds
   EXPECT_EQ(base.summary.n_heading_alignments, 0u);

@@ -194,6 +194,12 @@ TEST_F(RobustCli, ConfigErrorsNameTheFileAndTheKey) {
   expectFailure(test::runCli("simulate --config " + sim + " --out " + (dir_ / "x.csv").string() + " --survey-out " +
                              (dir_ / "x.txt").string()),
                 2, {"sim.json (bias.multipath_features)", "must be an integer"});
+  for (const char* drag : {"-0.1", "\"fast\""}) {
+    const std::string d = write("drag.json", std::string(R"({"rotor_drag_per_s": )") + drag + "}");
+    expectFailure(test::runCli("simulate --config " + d + " --out " + (dir_ / "x.csv").string() + " --survey-out " +
+                               (dir_ / "x.txt").string()),
+                  2, {"drag.json (rotor_drag_per_s)", "'rotor_drag_per_s' must be"});
+  }
 }
 
 // ------------------------------------------------------------------------------------------------ bias models

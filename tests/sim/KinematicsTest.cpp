@@ -42,6 +42,30 @@ TEST(Kinematics, SpecificForceAtRestIsOneGUp) {
   EXPECT_LT(s.b_omega.norm(), 1e-9);
 }
 
+TEST(Kinematics, RotorDragTiltsTheThrustAndShowsOnTheAccelerometersXY) {
+  // GIVEN a vehicle with rotor drag k in flight on the default trajectory
+  const Trajectory traj(TrajectoryParams{});
+  const double k = 0.36;
+  int moving = 0;
+  for (double t = 8.0; t < 30.0; t += 0.37) {
+    const KinematicState s = kinematicState(traj, t, k);
+    const KinematicState s0 = kinematicState(traj, t);
+    const Mat3 R = s.w_q_b.toRotationMatrix();
+    const Vec3 v_h(s.w_v.x(), s.w_v.y(), 0.0);
+    if (v_h.norm() > 0.3) ++moving;
+    // THEN the thrust axis is parallel to a + g e_z + k v_h (S7′), the specific force is still Rᵀ (a + g e_z) (S10),
+    // and what the thrust does not give, −k Rᵀ v_h, is what the accelerometer's x/y read
+    const Vec3 thrust = (s.w_a + Vec3(0.0, 0.0, kGravity_mps2) + k * v_h).normalized();
+    EXPECT_LT((R.col(2) - thrust).norm(), 1e-12) << t;
+    EXPECT_LT((s.b_specific_force - R.transpose() * (s.w_a + Vec3(0.0, 0.0, kGravity_mps2))).norm(), 1e-12) << t;
+    const Vec3 thrust_only = s.b_specific_force + k * (R.transpose() * v_h);
+    EXPECT_LT(thrust_only.head<2>().norm(), 1e-12) << t;
+    // AND the position and velocity are the trajectory's, with or without drag
+    EXPECT_LT((s.w_p - s0.w_p).norm(), 1e-15);
+  }
+  EXPECT_GT(moving, 10);
+}
+
 class EveryShapeImu : public ::testing::TestWithParam<TrajectoryShape> {};
 
 TEST_P(EveryShapeImu, AccelerometerEqualsSecondDifferenceOfPoseRotatedIntoBody) {

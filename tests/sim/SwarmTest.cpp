@@ -25,8 +25,10 @@ TEST(Swarm, RangesMatchTheTruthModel) {
   std::vector<int> per_round_partners;
   for (const TwrObservation& z : r.twr) {
     // THEN the true range is the tag-to-tag distance of the two trajectories at the stamp (S22, M3)
-    const KinematicState a = kinematicState(Trajectory(sc.agents[static_cast<std::size_t>(z.agent_i)].trajectory), z.t_s);
-    const KinematicState b = kinematicState(Trajectory(sc.agents[static_cast<std::size_t>(z.agent_j)].trajectory), z.t_s);
+    const KinematicState a = kinematicState(
+        Trajectory(sc.agents[static_cast<std::size_t>(z.agent_i)].trajectory), z.t_s, params.rotor_drag_per_s);
+    const KinematicState b = kinematicState(
+        Trajectory(sc.agents[static_cast<std::size_t>(z.agent_j)].trajectory), z.t_s, params.rotor_drag_per_s);
     const double d = (tagPosition(a.w_p, a.w_q_b, params.b_t_tag) - tagPosition(b.w_p, b.w_q_b, params.b_t_tag)).norm();
     ASSERT_NEAR(z.range_true_m, d, 1e-12);
     ASSERT_LT(z.agent_i, z.agent_j);

@@ -46,17 +46,20 @@ class InMotionAlignment {
   /// The spacing of the stored increments the estimator uses, and the longest window it then fits [s].
   static constexpr double kDefaultSamplePeriod_s = 0.1;
   static constexpr double kMaxWindow_s = static_cast<double>(kCapacity - 1) * kDefaultSamplePeriod_s;
+  /// The time over which the filter's velocity errors are taken as correlated [s].
+  static constexpr double kDefaultCorrelation_s = 1.0;
 
   /// window_s: the window's length; sample_period_s: spacing of the stored increments; correlation_s: the time over
-  /// which the velocity's errors are taken as correlated (the residuals count once per correlation_s). Throws
-  /// std::invalid_argument for a window that does not fit kCapacity increments or a non-positive length.
+  /// which the velocity's errors are taken as correlated (the residuals count once per correlation_s); drag_per_s:
+  /// the rotor drag k of the model a = R f + g_w − k v_h (F28a′), 0 for none. Throws std::invalid_argument for a
+  /// window that does not fit kCapacity increments, a non-positive length or a negative drag.
   explicit InMotionAlignment(double window_s = 4.0, double sample_period_s = kDefaultSamplePeriod_s,
-                             double correlation_s = 1.0);
+                             double correlation_s = kDefaultCorrelation_s, double drag_per_s = 0.0);
 
   /// Forgets the window; the next add() starts a new one.
   void reset();
   /// One IMU sample (bias-corrected specific force f_b [m/s²] and rate ω_b [rad/s], held over the dt_s before t_s)
-  /// and the world velocity at t_s.
+  /// and the world velocity at t_s (which also carries the drag's integral, F28a′).
   void add(double t_s, const Vec3& f_b, const Vec3& omega_b, double dt_s, const Vec3& w_v);
   /// The window spans window_s.
   bool complete() const { return n_ > 0 && t_last_ - t0_ >= window_s_ - 1e-9; }
@@ -73,7 +76,7 @@ class InMotionAlignment {
   const Mat3& accBiasJacobian() const { return ja_; }
 
  private:
-  double window_s_, sample_period_s_, correlation_s_;
+  double window_s_, sample_period_s_, correlation_s_, drag_per_s_;
   std::size_t n_ = 0;
   double t0_ = 0.0, t_last_ = 0.0, t_next_sample_ = 0.0;
   Quat dq_ = Quat::Identity();  ///< ΔR: body(t₀) ← body(t)
@@ -81,6 +84,7 @@ class InMotionAlignment {
   Mat3 phi_ = Mat3::Zero();     ///< ∂ rotation vector of ΔR (right perturbation) / ∂ gyro bias
   Mat3 jg_ = Mat3::Zero(), ja_ = Mat3::Zero();  ///< ∂β / ∂ gyro bias, ∂β / ∂ accelerometer bias
   Vec3 v0_ = Vec3::Zero();
+  Vec3 displacement_ = Vec3::Zero();  ///< ∫ v dτ since t₀ (the drag's integral, F28a′)
   std::array<Vec3, kCapacity> alpha_{}, beta_k_{};
   std::array<Mat3, kCapacity> jg_k_{}, ja_k_{};
 };

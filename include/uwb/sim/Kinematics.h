@@ -24,7 +24,8 @@ struct KinematicState {
   bool on_ground = false;
 };
 
-/// Evaluates the trajectory and derives attitude, body rates and specific force at t_s.
-KinematicState kinematicState(const Trajectory& trajectory, double t_s);
+/// Evaluates the trajectory and derives attitude, body rates and specific force at t_s, for a vehicle with rotor drag
+/// drag_per_s (S7′): its thrust is parallel to a + g e_z + k v_h.
+KinematicState kinematicState(const Trajectory& trajectory, double t_s, double drag_per_s = 0.0);
 
 }  // namespace uwb::sim

@@ -52,6 +52,10 @@ struct SimParams {
   TdoaScheduleParams tdoa;
   BiasParams bias;
   Vec3 b_t_tag = kUtilTagOffset_b;  ///< tag (antenna) lever arm in the body frame [m]
+  /// Rotor drag per unit horizontal velocity, a = T z_b / m + g_w − k v_h (S7′) [1/s]: the thrust tilts further than
+  /// the acceleration alone asks, and the accelerometer's x/y read −k Rᵀ v_h. Measured on the util-pilot 0426 flights
+  /// against Vicon (0.33–0.39 /s; docs/math/simulation.md S7′).
+  double rotor_drag_per_s = 0.36;
   bool write_full_util_header = true;  ///< Flight::columns = all 27 UTIL columns (tof/flow/baro left empty)
 
   /// Noise-free, bias-free sensors: for tests of kinematics and the measurement model.
