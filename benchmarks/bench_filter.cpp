@@ -192,7 +192,8 @@ void BM_WholeFlightReal0425Traj2(benchmark::State& state) {
   const Flight f = readFlightCsv(flight.string());
   const SensorLog log = sensorLogFromFlight(f);
   // arg 0: defaults; 1: the tag antenna pattern learned in flight (F25, degree 3); 2: the bias guard (F24) with a
-  // zero-mean bias model, i.e. two filters side by side; 3: without the range-bias states (F27)
+  // zero-mean bias model, i.e. two filters side by side; 3: without the range-bias states (F27); 4: without the
+  // in-motion heading alignment (F28)
   EkfParams p;
   BiasPredictor bias;
   if (state.range(0) == 1) p.antenna_bias_degree = 3;
@@ -200,6 +201,7 @@ void BM_WholeFlightReal0425Traj2(benchmark::State& state) {
     p.range_bias_sigma_m = 0.0;
     p.tdoa_sigma_m = 0.35;
   }
+  if (state.range(0) == 4) p.heading_alignment = false;
   if (state.range(0) == 2) {
     p.bias_guard = true;
     bias = [](const TdoaFeature&) { return BiasPrediction{}; };
@@ -208,7 +210,7 @@ void BM_WholeFlightReal0425Traj2(benchmark::State& state) {
   const double duration = f.timeSpan().second - f.timeSpan().first;
   runFlightBenchmark(state, localizer, log, duration);
 }
-BENCHMARK(BM_WholeFlightReal0425Traj2)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WholeFlightReal0425Traj2)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Arg(4)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace uwb
