@@ -32,8 +32,9 @@ InMotionAlignment::InMotionAlignment(double window_s, double sample_period_s, do
   if (!(drag_per_s >= 0.0) || !std::isfinite(drag_per_s))
     throw std::invalid_argument(fmt::format("heading alignment: drag {} /s must be finite and ≥ 0", drag_per_s));
   if (!(window_s > 0.0) || !(sample_period_s > 0.0) || !(correlation_s > 0.0))
-    throw std::invalid_argument(fmt::format("heading alignment: window {} s, sample period {} s, correlation {} s must be > 0",
-                                            window_s, sample_period_s, correlation_s));
+    throw std::invalid_argument(
+        fmt::format("heading alignment: window {} s, sample period {} s, correlation {} s must be > 0", window_s,
+                    sample_period_s, correlation_s));
   // the first increment is the window's start, one more per sample period
   if (window_s / sample_period_s + 1.0 > static_cast<double>(kCapacity))
     throw std::invalid_argument(fmt::format(
