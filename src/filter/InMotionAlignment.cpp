@@ -56,6 +56,9 @@ void InMotionAlignment::add(double t_s, const Vec3& f_b, const Vec3& omega_b, do
     ja_.setZero();
     v0_ = w_v;
     displacement_.setZero();
+    step_f_dt_.setZero();
+    step_w_dt_.setZero();
+    step_dt_ = 0.0;
     alpha_[0].setZero();
     beta_k_[0].setZero();
     jg_k_[0].setZero();
@@ -64,19 +67,15 @@ void InMotionAlignment::add(double t_s, const Vec3& f_b, const Vec3& omega_b, do
     return;
   }
   if (!(dt_s > 0.0)) return;
-  // (F28) β += ΔR f dt, then ΔR ← ΔR exp(ω dt) (the rotation over the sample, as in the prediction F7); with them
-  // the first-order effect of a bias change δb_g, δb_a (ΔR(δb) ≈ ΔR Exp(Φ δb_g), f → f − δb_a):
-  // ∂β/∂b_g += −ΔR [f]× Φ dt, ∂β/∂b_a += −ΔR dt, Φ ← Exp(ω dt)ᵀ Φ − J_r dt with J_r ≈ I (|ω dt| ≪ 1)
-  const Mat3 dR = dq_.toRotationMatrix();
-  jg_.noalias() -= dR * skew(f_b) * phi_ * dt_s;
-  ja_.noalias() -= dR * dt_s;
-  beta_ += dR * f_b * dt_s;
-  const Quat step = expQuat(omega_b * dt_s);
-  phi_ = (step.conjugate().toRotationMatrix() * phi_).eval() - Mat3::Identity() * dt_s;
-  dq_ = (dq_ * step).normalized();
+  // (F28a) the samples are summed over a step and integrated with their means: the sums cost three additions
+  step_f_dt_ += f_b * dt_s;
+  step_w_dt_ += omega_b * dt_s;
+  step_dt_ += dt_s;
   displacement_ += w_v * dt_s;
   t_last_ = t_s;
-  if (t_s + 1e-9 >= t_next_sample_ && n_ < kCapacity) {
+  const bool store = t_s + 1e-9 >= t_next_sample_ && n_ < kCapacity;
+  if (store || step_dt_ >= kIntegrationStep_s - 1e-9) integrateStep();
+  if (store) {
     const double tau = t_s - t0_;
     // α = v − v₀ − g_w τ + k ∫ v_h dτ with g_w = (0, 0, −g) (F28a, F28a′)
     alpha_[n_] = w_v - v0_ + Vec3(0.0, 0.0, kGravity_mps2 * tau);
@@ -87,6 +86,30 @@ void InMotionAlignment::add(double t_s, const Vec3& f_b, const Vec3& omega_b, do
     ++n_;
     t_next_sample_ += sample_period_s_;
   }
+}
+
+void InMotionAlignment::integrateStep() {
+  if (!(step_dt_ > 0.0)) return;
+  const double dt = step_dt_;
+  const Vec3 f = step_f_dt_ / dt, w = step_w_dt_ / dt;
+  step_f_dt_.setZero();
+  step_w_dt_.setZero();
+  step_dt_ = 0.0;
+  // (F28a, F28b) β += ΔR_mid f dt with the rotation at the step's middle, ΔR_mid ≈ ΔR (I + [ω dt/2]×), then
+  // ΔR ← ΔR exp(ω dt) (the rotation over the step, as in the prediction F7); with them the first-order effect of a
+  // bias change δb_g, δb_a (ΔR(δb) ≈ ΔR Exp(Φ δb_g), ω → ω − δb_g, f → f − δb_a):
+  // ∂β/∂b_g += −ΔR [f_mid]× Φ dt + ΔR [f]× dt²/2, ∂β/∂b_a += −ΔR (I + [ω dt/2]×) dt,
+  // Φ ← Exp(ω dt)ᵀ Φ − J_r dt with the right Jacobian of Exp to first order, J_r ≈ I − [ω dt]×/2 (|ω dt| ≪ 1)
+  const Mat3 dR = dq_.toRotationMatrix();
+  const Vec3 half_turn = 0.5 * dt * w;
+  const Vec3 f_mid = f + half_turn.cross(f);
+  const Mat3 dR_mid = dR * (Mat3::Identity() + skew(half_turn));
+  jg_.noalias() -= dR * (skew(f_mid) * phi_ * dt - skew(f) * (0.5 * dt * dt));
+  ja_.noalias() -= dR_mid * dt;
+  beta_.noalias() += dR * f_mid * dt;
+  const Quat step = expQuat(w * dt);
+  phi_ = (step.conjugate().toRotationMatrix() * phi_).eval() - (Mat3::Identity() - skew(half_turn)) * dt;
+  dq_ = (dq_ * step).normalized();
 }
 
 namespace {

@@ -48,6 +48,9 @@ class InMotionAlignment {
   static constexpr double kMaxWindow_s = static_cast<double>(kCapacity - 1) * kDefaultSamplePeriod_s;
   /// The time over which the filter's velocity errors are taken as correlated [s].
   static constexpr double kDefaultCorrelation_s = 1.0;
+  /// The IMU samples are summed over steps of this length and integrated once per step with their mean rate and
+  /// specific force (F28a): the rotation over a step is small, and the sums cost little per sample [s].
+  static constexpr double kIntegrationStep_s = 0.01;
 
   /// window_s: the window's length; sample_period_s: spacing of the stored increments; correlation_s: the time over
   /// which the velocity's errors are taken as correlated (the residuals count once per correlation_s); drag_per_s:
@@ -66,7 +69,8 @@ class InMotionAlignment {
   /// The attitude now and its uncertainty (nothing with fewer than 5 stored increments).
   std::optional<Result> solve() const;
 
-  /// The running sums and their first-order bias Jacobians (tested against finite differences): β = ∫ ΔR f dτ,
+  /// The running sums, to the last integration step, and their first-order bias Jacobians (tested against finite
+  /// differences): β = ∫ ΔR f dτ,
   /// ΔR (body(t₀) ← body(t)), Φ = ∂Log(ΔR₀ᵀ ΔR)/∂b_g (right perturbation), ∂β/∂b_g, ∂β/∂b_a, for a bias b that is
   /// subtracted from the samples (ω − b_g, f − b_a).
   const Vec3& integratedSpecificForce() const { return beta_; }
@@ -76,6 +80,9 @@ class InMotionAlignment {
   const Mat3& accBiasJacobian() const { return ja_; }
 
  private:
+  /// Integrates the samples summed since the last step (F28a).
+  void integrateStep();
+
   double window_s_, sample_period_s_, correlation_s_, drag_per_s_;
   std::size_t n_ = 0;
   double t0_ = 0.0, t_last_ = 0.0, t_next_sample_ = 0.0;
@@ -85,6 +92,8 @@ class InMotionAlignment {
   Mat3 jg_ = Mat3::Zero(), ja_ = Mat3::Zero();  ///< ∂β / ∂ gyro bias, ∂β / ∂ accelerometer bias
   Vec3 v0_ = Vec3::Zero();
   Vec3 displacement_ = Vec3::Zero();  ///< ∫ v dτ since t₀ (the drag's integral, F28a′)
+  Vec3 step_f_dt_ = Vec3::Zero(), step_w_dt_ = Vec3::Zero();  ///< Σ f dt, Σ ω dt since the last integration step
+  double step_dt_ = 0.0;                                      ///< Σ dt since the last integration step
   std::array<Vec3, kCapacity> alpha_{}, beta_k_{};
   std::array<Mat3, kCapacity> jg_k_{}, ja_k_{};
 };
