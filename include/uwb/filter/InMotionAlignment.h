@@ -50,7 +50,7 @@ class InMotionAlignment {
   static constexpr double kDefaultCorrelation_s = 1.0;
   /// The IMU samples are summed over steps of this length and integrated once per step with their mean rate and
   /// specific force (F28a): the rotation over a step is small, and the sums cost little per sample [s].
-  static constexpr double kIntegrationStep_s = 0.01;
+  static constexpr double kIntegrationStep_s = 0.05;
 
   /// window_s: the window's length; sample_period_s: spacing of the stored increments; correlation_s: the time over
   /// which the velocity's errors are taken as correlated (the residuals count once per correlation_s); drag_per_s:
