@@ -25,7 +25,8 @@ struct ConfigKeyError : std::invalid_argument {
 
 /// Applies the JSON object `j` to the parameters; ConfigKeyError on an unknown key or a bad value.
 void applySimConfig(const nlohmann::json& j, sim::SimParams* sp, sim::TrajectoryParams* tp);
-/// Reads the file and applies it; InputError naming the file and the key.
+/// Reads the file, applies it and checks the ranges of the parameters it sets (their validate()); InputError naming
+/// the file and the key or section.
 void applySimConfigFile(const std::string& path, sim::SimParams* sp, sim::TrajectoryParams* tp);
 
 }  // namespace uwb::app

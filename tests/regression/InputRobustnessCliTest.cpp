@@ -194,12 +194,20 @@ TEST_F(RobustCli, ConfigErrorsNameTheFileAndTheKey) {
   expectFailure(test::runCli("simulate --config " + sim + " --out " + (dir_ / "x.csv").string() + " --survey-out " +
                              (dir_ / "x.txt").string()),
                 2, {"sim.json (bias.multipath_features)", "must be an integer"});
-  for (const char* drag : {"-0.1", "\"fast\""}) {
-    const std::string d = write("drag.json", std::string(R"({"rotor_drag_per_s": )") + drag + "}");
-    expectFailure(test::runCli("simulate --config " + d + " --out " + (dir_ / "x.csv").string() + " --survey-out " +
-                               (dir_ / "x.txt").string()),
-                  2, {"drag.json (rotor_drag_per_s)", "'rotor_drag_per_s' must be"});
-  }
+  const auto simulateWith = [&](const std::string& config) {
+    return test::runCli("simulate --config " + config + " --out " + (dir_ / "x.csv").string() + " --survey-out " +
+                        (dir_ / "x.txt").string());
+  };
+  expectFailure(simulateWith(write("drag.json", R"({"rotor_drag_per_s": "fast"})")), 2,
+                {"drag.json (rotor_drag_per_s)", "must be a number"});
+  // a value of the right type out of its range: the parameters' own check, with the file and the section
+  expectFailure(simulateWith(write("drag.json", R"({"rotor_drag_per_s": -0.1})")), 2,
+                {"drag.json", "rotor_drag_per_s must be in [0, 10)"});
+  expectFailure(simulateWith(write("imu.json", R"({"imu": {"rate_hz": 5}})")), 2,
+                {"imu.json (imu)", "imu.rate_hz must be in [10, 10000]"});
+  expectFailure(simulateWith(write("path.json", R"({"trajectory": {"radius_m": -1}})")), 2,
+                {"path.json (trajectory)", "radius_m > 0"});
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "x.csv"));
 }
 
 // ------------------------------------------------------------------------------------------------ bias models
