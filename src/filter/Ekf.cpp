@@ -15,16 +15,22 @@ void AccumulatedTransition::accumulate(const ImuStepJacobian& J) {
   // docs/math/filter.md (F7): Φ ← F Φ with F from (F4); only the non-trivial blocks change.
   // F_pθ = ½dt F_vθ and F_pba = ½dt F_vba (F4), so the position rows reuse the velocity rows' products
   // F_vθ Φ_θθ and F_vθ Φ_θbg: four 3×3 products per step instead of six.
+  // F_pv and F_vv are diagonal (F2a): the velocity rows are scaled per axis before they are added to the position
+  // rows (old velocity rows) and to themselves.
   const double dt = J.dt_s;
   const double half_dt = 0.5 * dt;
+  const auto Fpv = J.F_p_v_diag.asDiagonal();
+  const auto Fvv = J.F_v_v_diag.asDiagonal();
   const Mat3 Fva_att_att = J.F_v_att * att_att;
   const Mat3 Fva_att_gyrobias = J.F_v_att * att_gyrobias;
-  pos_att += dt * vel_att + half_dt * Fva_att_att;
-  pos_accbias += dt * vel_accbias + half_dt * J.F_v_accbias;
-  pos_gyrobias += dt * vel_gyrobias + half_dt * Fva_att_gyrobias;
-  vel_att += Fva_att_att;
-  vel_accbias += J.F_v_accbias;
-  vel_gyrobias += Fva_att_gyrobias;
+  pos_vel += J.F_p_v_diag.cwiseProduct(vel_vel);
+  pos_att += Fpv * vel_att + half_dt * Fva_att_att;
+  pos_accbias += Fpv * vel_accbias + half_dt * J.F_v_accbias;
+  pos_gyrobias += Fpv * vel_gyrobias + half_dt * Fva_att_gyrobias;
+  vel_vel = J.F_v_v_diag.cwiseProduct(vel_vel);
+  vel_att = (Fvv * vel_att).eval() + Fva_att_att;
+  vel_accbias = (Fvv * vel_accbias).eval() + J.F_v_accbias;
+  vel_gyrobias = (Fvv * vel_gyrobias).eval() + Fva_att_gyrobias;
   att_gyrobias = J.F_att_att * att_gyrobias + J.F_att_gyrobias;
   att_att = J.F_att_att * att_att;
   T_s += dt;
@@ -32,7 +38,8 @@ void AccumulatedTransition::accumulate(const ImuStepJacobian& J) {
 
 ErrMat AccumulatedTransition::dense() const {
   ErrMat F = ErrMat::Identity();
-  F.block<3, 3>(kPos, kVel) = T_s * Mat3::Identity();
+  F.block<3, 3>(kPos, kVel) = pos_vel.asDiagonal();
+  F.block<3, 3>(kVel, kVel) = vel_vel.asDiagonal();
   F.block<3, 3>(kPos, kAtt) = pos_att;
   F.block<3, 3>(kPos, kAccBias) = pos_accbias;
   F.block<3, 3>(kPos, kGyroBias) = pos_gyrobias;
@@ -47,7 +54,8 @@ ErrMat AccumulatedTransition::dense() const {
 ErrMat AccumulatedTransition::leftMultiply(const ErrMat& M) const {
   // Row blocks of Φ M; bias rows of Φ are identity rows.
   ErrMat out = M;
-  out.middleRows<3>(kPos).noalias() += T_s * M.middleRows<3>(kVel);
+  out.middleRows<3>(kPos).noalias() += pos_vel.asDiagonal() * M.middleRows<3>(kVel);
+  out.middleRows<3>(kVel) = vel_vel.asDiagonal() * M.middleRows<3>(kVel);
   out.middleRows<3>(kPos).noalias() += pos_att * M.middleRows<3>(kAtt);
   out.middleRows<3>(kPos).noalias() += pos_accbias * M.middleRows<3>(kAccBias);
   out.middleRows<3>(kPos).noalias() += pos_gyrobias * M.middleRows<3>(kGyroBias);
@@ -87,9 +95,11 @@ template <int Rows, class Matrix>
 void rightMultiplyTransposedTopRows(const AccumulatedTransition& phi, Matrix& M) {
   // Column blocks of M Φᵀ = (Φ Mᵀ)ᵀ: column block j of the result is Σ_k M_{:,k} Φ_jkᵀ; bias columns are unchanged.
   // Written in the order position, velocity, attitude: each block reads only blocks that are still unchanged, except
-  // the attitude block, which reads its own old value (kept in a copy).
+  // the velocity block, scaled in place per column (Φ_vv is diagonal), and the attitude block, which reads its own old
+  // value (kept in a copy).
   auto top = [&M](int j) { return M.template block<Rows, 3>(0, j); };
-  top(kPos) += phi.T_s * top(kVel);
+  top(kPos) += top(kVel) * phi.pos_vel.asDiagonal();
+  top(kVel) = top(kVel) * phi.vel_vel.asDiagonal();
   addColumnBlockTimesTransposed<Rows>(M, kPos, top(kAtt), phi.pos_att);
   addColumnBlockTimesTransposed<Rows>(M, kPos, top(kAccBias), phi.pos_accbias);
   addColumnBlockTimesTransposed<Rows>(M, kPos, top(kGyroBias), phi.pos_gyrobias);
@@ -151,7 +161,7 @@ void Ekf::initialize(const NavState& x0, const ErrMat& P0) {
 
 void Ekf::predict(const ImuReading& imu, double dt_s) {
   if (!(dt_s > 0.0)) return;
-  const ProcessStep step = quadImuProcess(x_, imu, dt_s, params_.accel_model);  // (F2–F4)
+  const ProcessStep step = quadImuProcess(x_, imu, dt_s, params_.accel_model, params_.rotor_drag_per_s);  // (F2–F4)
   x_ = step.next;
   phi_.accumulate(step.J);  // (F7)
   // velocity process noise per world axis (F7 Q): vertical/isotropic accelerometer noise, plus lateral

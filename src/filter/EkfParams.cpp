@@ -80,7 +80,7 @@ void EkfParams::validate() const {
   requirePositive(moving_start_att_sigma_rad, "moving_start_att_sigma_rad");
   requirePositive(moving_start_yaw_sigma_rad, "moving_start_yaw_sigma_rad");
   requirePositive(heading_alignment_window_s, "heading_alignment_window_s");
-  requireNonNegative(heading_alignment_drag_per_s, "heading_alignment_drag_per_s");
+  requireNonNegative(rotor_drag_per_s, "rotor_drag_per_s");
   if (heading_alignment_window_s > InMotionAlignment::kMaxWindow_s)
     throw std::invalid_argument(fmt::format("EkfParams.heading_alignment_window_s must be ≤ {} s (got {})",
                                             InMotionAlignment::kMaxWindow_s, heading_alignment_window_s));

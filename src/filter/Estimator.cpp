@@ -125,7 +125,7 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
              StartUpParams{params.start_window_s, 40, 3.0, 0.2, params.init_pos_sigma_m, 0.15, 1.0}),
       replay_(params),
       heading_align_(params.heading_alignment_window_s, InMotionAlignment::kDefaultSamplePeriod_s,
-                     InMotionAlignment::kDefaultCorrelation_s, params.heading_alignment_drag_per_s) {
+                     InMotionAlignment::kDefaultCorrelation_s, params.rotor_drag_per_s) {
   params_.validate();
   if (anchors_.size() < 4) throw std::invalid_argument("Estimator: at least 4 anchors are needed");
   floor_anchors_ = FloorLevelAnchors(anchors_, params_.ground_z_m, params_.floor_anchor_height_m);

@@ -66,7 +66,8 @@ Mat3 rightJacobianSo3(const Vec3& phi) {
   return Mat3::Identity() - a * S + b * (S * S);
 }
 
-ProcessStep quadImuProcess(const NavState& x, const ImuReading& imu, double dt_s, AccelModel accel_model) {
+ProcessStep quadImuProcess(const NavState& x, const ImuReading& imu, double dt_s, AccelModel accel_model,
+                           double drag_per_s) {
   ProcessStep out;
   const Mat3 w_R_b = x.w_q_b.toRotationMatrix();
   // (F2) specific force after bias removal; S selects the axes that are integrated (F3)
@@ -78,7 +79,10 @@ ProcessStep quadImuProcess(const NavState& x, const ImuReading& imu, double dt_s
     S.diagonal() << 0.0, 0.0, 1.0;
   }
   const Vec3 b_omega = imu.b_gyro_radps - x.b_gyro_bias;
-  const Vec3 w_a = w_R_b * b_f + kWorldGravity_mps2;
+  Vec3 w_a = w_R_b * b_f + kWorldGravity_mps2;
+  // (F2a) rotor drag, −k v_h: the thrust-axis model leaves the x/y readings out, and with them the drag they carry
+  const double k = accel_model == AccelModel::kThrustOnly ? drag_per_s : 0.0;
+  w_a.head<2>() -= k * x.w_v_b.head<2>();
   const Vec3 phi = b_omega * dt_s;
   const Quat dq = expQuat(phi);  // one Exp for the nominal step and F_θθ
 
@@ -90,6 +94,8 @@ ProcessStep quadImuProcess(const NavState& x, const ImuReading& imu, double dt_s
 
   // (F4) error-state Jacobian blocks
   out.J.dt_s = dt_s;
+  out.J.F_p_v_diag << dt_s * (1.0 - 0.5 * k * dt_s), dt_s * (1.0 - 0.5 * k * dt_s), dt_s;
+  out.J.F_v_v_diag << 1.0 - k * dt_s, 1.0 - k * dt_s, 1.0;
   out.J.F_v_att = -(w_R_b * skew(b_f)) * dt_s;
   out.J.G_v_acc = w_R_b * S * dt_s;
   out.J.F_v_accbias = -out.J.G_v_acc;
@@ -101,7 +107,8 @@ ProcessStep quadImuProcess(const NavState& x, const ImuReading& imu, double dt_s
 ErrMat ProcessStep::F() const {
   ErrMat F = ErrMat::Identity();
   const double dt = J.dt_s;
-  F.block<3, 3>(kPos, kVel) = dt * Mat3::Identity();
+  F.block<3, 3>(kPos, kVel) = J.F_p_v_diag.asDiagonal();
+  F.block<3, 3>(kVel, kVel) = J.F_v_v_diag.asDiagonal();
   F.block<3, 3>(kPos, kAtt) = 0.5 * dt * J.F_v_att;
   F.block<3, 3>(kPos, kAccBias) = 0.5 * dt * J.F_v_accbias;
   F.block<3, 3>(kVel, kAtt) = J.F_v_att;

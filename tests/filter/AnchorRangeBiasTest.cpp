@@ -188,7 +188,7 @@ TEST(EkfRangeBias, ImuPropagationIsTheAugmentedTransition) {
   for (int k = 0; k < steps; ++k) {
     ekf.predict(imu, dt);
     plain.predict(imu, dt);
-    const ProcessStep s = quadImuProcess(x, imu, dt, params.accel_model);
+    const ProcessStep s = quadImuProcess(x, imu, dt, params.accel_model, params.rotor_drag_per_s);
     x = s.next;
     phi.accumulate(s.J);
   }

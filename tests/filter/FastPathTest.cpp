@@ -80,7 +80,9 @@ TEST(CovarianceFold, ColumnBlockProductEqualsDenseProduct) {
     ImuReading imu;
     imu.b_acc_mps2 = Vec3(n(rng), n(rng), kGravity_mps2 + n(rng));
     imu.b_gyro_radps = Vec3(n(rng), n(rng), n(rng));
-    const ProcessStep step = quadImuProcess(x, imu, 0.003, AccelModel::kFull);
+    // the thrust model with rotor drag on every other step (F2a: diagonal F_pv, F_vv)
+    const ProcessStep step = k % 2 == 0 ? quadImuProcess(x, imu, 0.003, AccelModel::kFull)
+                                        : quadImuProcess(x, imu, 0.05, AccelModel::kThrustOnly, 0.8);
     phi.accumulate(step.J);
     x = step.next;
   }

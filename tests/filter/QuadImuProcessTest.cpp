@@ -32,23 +32,25 @@ ImuReading randomImu(std::mt19937& rng) {
   return imu;
 }
 
-class QuadImuProcessJacobian : public ::testing::TestWithParam<std::tuple<AccelModel, int>> {};
+/// (accelerometer model, seed, rotor drag k [1/s]; F2a: the drag enters the thrust model only)
+class QuadImuProcessJacobian : public ::testing::TestWithParam<std::tuple<AccelModel, int, double>> {};
 
 TEST_P(QuadImuProcessJacobian, FMatchesCentralDifferences) {
   // GIVEN a random state, IMU reading and step
   // std::get, not a structured binding: lambdas below capture `model` (clang 14 rejects capturing a binding)
   const auto model = std::get<0>(GetParam());
   const auto seed = std::get<1>(GetParam());
-  SCOPED_TRACE("seed " + std::to_string(seed));
+  const double drag = std::get<2>(GetParam());
+  SCOPED_TRACE("seed " + std::to_string(seed) + ", drag " + std::to_string(drag));
   std::mt19937 rng(seed);
   const NavState x = randomState(rng);
   const ImuReading imu = randomImu(rng);
   const double dt = 0.01;
   // WHEN we differentiate x' ⊟ f(x) with respect to the error state
-  const ProcessStep ref = quadImuProcess(x, imu, dt, model);
+  const ProcessStep ref = quadImuProcess(x, imu, dt, model, drag);
   const auto f = [&](const VecX& dx) -> VecX {
     const ErrVec d = dx;
-    return boxMinus(quadImuProcess(boxPlus(x, d), imu, dt, model).next, ref.next);
+    return boxMinus(quadImuProcess(boxPlus(x, d), imu, dt, model, drag).next, ref.next);
   };
   const test::JacobianCheck c = test::checkJacobian(f, VecX::Zero(kDim), ref.F());
   // THEN the analytic F agrees
@@ -60,17 +62,18 @@ TEST_P(QuadImuProcessJacobian, GMatchesCentralDifferences) {
   // std::get, not a structured binding: lambdas below capture `model` (clang 14 rejects capturing a binding)
   const auto model = std::get<0>(GetParam());
   const auto seed = std::get<1>(GetParam());
+  const double drag = std::get<2>(GetParam());
   std::mt19937 rng(seed + 100);
   const NavState x = randomState(rng);
   const ImuReading imu = randomImu(rng);
   const double dt = 0.01;
-  const ProcessStep ref = quadImuProcess(x, imu, dt, model);
+  const ProcessStep ref = quadImuProcess(x, imu, dt, model, drag);
   // WHEN we perturb the reading noise n_a, n_g and the bias increments
   const auto f = [&](const VecX& n) -> VecX {
     ImuReading m = imu;
     m.b_acc_mps2 += n.segment<3>(kNoiseAcc);
     m.b_gyro_radps += n.segment<3>(kNoiseGyro);
-    NavState next = quadImuProcess(x, m, dt, model).next;
+    NavState next = quadImuProcess(x, m, dt, model, drag).next;
     next.b_acc_bias += n.segment<3>(kNoiseAccBias);
     next.b_gyro_bias += n.segment<3>(kNoiseGyroBias);
     return boxMinus(next, ref.next);
@@ -82,7 +85,26 @@ TEST_P(QuadImuProcessJacobian, GMatchesCentralDifferences) {
 
 INSTANTIATE_TEST_SUITE_P(BothAccelModels, QuadImuProcessJacobian,
                          ::testing::Combine(::testing::Values(AccelModel::kFull, AccelModel::kThrustOnly),
-                                            ::testing::Values(1, 2, 3)));
+                                            ::testing::Values(1, 2, 3), ::testing::Values(0.0, 0.5)));
+
+TEST(QuadImuProcess, RotorDragSlowsTheHorizontalVelocityOfTheThrustModelOnly) {
+  // GIVEN a level body moving at 1 m/s along x, reading exactly gravity on its thrust axis
+  NavState x;
+  x.w_v_b = Vec3(1.0, 0.0, 0.0);
+  ImuReading imu;
+  // WHEN predicting one second in 1 ms steps with drag k = 0.5 /s (F2a)
+  NavState thrust = x, full = x;
+  for (int i = 0; i < 1000; ++i) {
+    thrust = quadImuProcess(thrust, imu, 0.001, AccelModel::kThrustOnly, 0.5).next;
+    full = quadImuProcess(full, imu, 0.001, AccelModel::kFull, 0.5).next;
+  }
+  // THEN the thrust model's velocity decays as exp(−k t) and its path as (1 − exp(−k t)) / k; the full model's x/y
+  // readings carry the drag, so it adds none
+  EXPECT_NEAR(thrust.w_v_b.x(), std::exp(-0.5), 1e-3);
+  EXPECT_NEAR(thrust.w_p_b.x(), (1.0 - std::exp(-0.5)) / 0.5, 1e-3);
+  EXPECT_NEAR(full.w_v_b.x(), 1.0, 1e-12);
+  EXPECT_NEAR(thrust.w_v_b.z(), 0.0, 1e-12);
+}
 
 TEST(QuadImuProcess, HoverAtRestStaysPut) {
   // GIVEN a level body at rest reading exactly gravity
@@ -111,7 +133,9 @@ TEST(AccumulatedTransition, BlockProductEqualsDenseProduct) {
   AccumulatedTransition phi;
   ErrMat dense = ErrMat::Identity();
   for (int k = 0; k < 7; ++k) {
-    const ProcessStep s = quadImuProcess(x, randomImu(rng), 0.003, AccelModel::kFull);
+    // the thrust model with rotor drag on every other step (F2a: diagonal F_pv, F_vv)
+    const ProcessStep s = k % 2 == 0 ? quadImuProcess(x, randomImu(rng), 0.003, AccelModel::kFull)
+                                     : quadImuProcess(x, randomImu(rng), 0.05, AccelModel::kThrustOnly, 0.8);
     // WHEN accumulating in block form and densely
     phi.accumulate(s.J);
     dense = s.F() * dense;
@@ -180,8 +204,8 @@ TEST(ImuPropagation, BlockFoldEqualsDensePhiPPhiT) {
   for (int k = 0; k < 5; ++k) {
     const ImuReading imu = randomImu(rng);
     ekf.predict(imu, 0.002);
-    phi.accumulate(quadImuProcess(x, imu, 0.002, params.accel_model).J);
-    x = quadImuProcess(x, imu, 0.002, params.accel_model).next;
+    phi.accumulate(quadImuProcess(x, imu, 0.002, params.accel_model, params.rotor_drag_per_s).J);
+    x = quadImuProcess(x, imu, 0.002, params.accel_model, params.rotor_drag_per_s).next;
   }
   // WHEN folding Φ into P (F7)
   ekf.propagateCovariance();

@@ -22,7 +22,9 @@ namespace uwb {
 
 /// Accumulated error-state transition Φ in block form (F7); the identity when empty.
 struct AccumulatedTransition {
-  double T_s = 0.0;                      ///< accumulated time = Φ_pv / I
+  double T_s = 0.0;                      ///< accumulated time
+  Vec3 pos_vel = Vec3::Zero();           ///< diagonal of Φ_pv (T_s I without rotor drag, F2a)
+  Vec3 vel_vel = Vec3::Ones();           ///< diagonal of Φ_vv (I without rotor drag)
   Mat3 pos_att = Mat3::Zero();
   Mat3 pos_accbias = Mat3::Zero();
   Mat3 pos_gyrobias = Mat3::Zero();

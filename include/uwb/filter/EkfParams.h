@@ -56,6 +56,10 @@ struct EkfParams {
   double cv_acc_noise_mps2_sqrthz = 2.0;      ///< TDoA-only constant-velocity model: white acceleration
   double ca_jerk_noise_mps3_sqrthz = 8.0;     ///< TDoA-only constant-acceleration model: white jerk
   AccelModel accel_model = AccelModel::kThrustOnly;
+  /// (F2a) Rotor drag per unit horizontal world velocity, a = R f + g_w − k v_h [1/s], in the thrust-axis model (F3;
+  /// with kFull the x/y readings carry the drag themselves) and in the heading alignment's (F28a′). Measured on the
+  /// util-pilot flights against Vicon: 0.33–0.39 /s on 0426, 0.36–0.45 on 0425 (filter.md F28a′); 0 leaves it out.
+  double rotor_drag_per_s = 0.36;
   /// Accelerometer model on the ground (zero-velocity updates before take-off and after landing, F14–F15).
   /// kFull (default) levels the attitude from all three axes. On the 0425 logs the motors' spin-up adds
   /// −0.3…−0.5 g to acc_x while the drone still sits level (Vicon pitch within 1°), so kFull takes off with a 4–9°
@@ -192,9 +196,6 @@ struct EkfParams {
   /// airborne RMSE by more than 1 mm (filter.md F28).
   bool heading_alignment = true;
   double heading_alignment_window_s = 8.0;  ///< window of the heading alignment [s] (F28)
-  /// (F28a′) Rotor drag per unit horizontal velocity in the heading alignment's model, a = R f + g_w − k v_h [1/s]:
-  /// the thrust-axis accelerometer model (F3) leaves it out, and on a circle it turns the fitted heading.
-  double heading_alignment_drag_per_s = 0.36;
   /// Std of one pair's slowly varying TDoA bias (F23; each anchor's range bias σ_b/√2): the reported position
   /// covariance is the filter's plus this bias mapped through the anchors in view. 0 reports the filter's P alone.
   double output_bias_sigma_m = 0.2;
