@@ -98,8 +98,10 @@ void rightMultiplyTransposedTopRows(const AccumulatedTransition& phi, Matrix& M)
   // the velocity block, scaled in place per column (Φ_vv is diagonal), and the attitude block, which reads its own old
   // value (kept in a copy).
   auto top = [&M](int j) { return M.template block<Rows, 3>(0, j); };
-  top(kPos) += top(kVel) * phi.pos_vel.asDiagonal();
-  top(kVel) = top(kVel) * phi.vel_vel.asDiagonal();
+  for (int c = 0; c < 3; ++c)
+    M.col(kPos + c).template head<Rows>() += phi.pos_vel(c) * M.col(kVel + c).template head<Rows>();
+  if (phi.vel_vel(0) != 1.0 || phi.vel_vel(1) != 1.0 || phi.vel_vel(2) != 1.0)
+    for (int c = 0; c < 3; ++c) M.col(kVel + c).template head<Rows>() *= phi.vel_vel(c);
   addColumnBlockTimesTransposed<Rows>(M, kPos, top(kAtt), phi.pos_att);
   addColumnBlockTimesTransposed<Rows>(M, kPos, top(kAccBias), phi.pos_accbias);
   addColumnBlockTimesTransposed<Rows>(M, kPos, top(kGyroBias), phi.pos_gyrobias);
