@@ -74,7 +74,8 @@ void InMotionAlignment::add(double t_s, const Vec3& f_b, const Vec3& omega_b, do
   displacement_ += w_v * dt_s;
   t_last_ = t_s;
   const bool store = t_s + 1e-9 >= t_next_sample_ && n_ < kCapacity;
-  if (store || step_dt_ >= kIntegrationStep_s - 1e-9) integrateStep();
+  // a complete window is solved now: its attitude (ΔR, Φ) must include every sample
+  if (store || complete() || step_dt_ >= kIntegrationStep_s - 1e-9) integrateStep();
   if (store) {
     const double tau = t_s - t0_;
     // α = v − v₀ − g_w τ + k ∫ v_h dτ with g_w = (0, 0, −g) (F28a, F28a′)

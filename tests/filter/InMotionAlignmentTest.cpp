@@ -120,6 +120,20 @@ TEST(InMotionAlignment, FindsTheAttitudeAtAnyHeading) {
   }
 }
 
+TEST(InMotionAlignment, AWindowEndingBetweenIntegrationStepsGivesTheAttitudeAtItsLastSample) {
+  // GIVEN a window of 4.03 s: it completes 30 ms after its last stored increment and between two integration steps
+  Motion m;
+  m.psi_rate = 1.0;
+  const InMotionAlignment a = feed(m, 3.0, 4.03);
+  ASSERT_TRUE(a.complete());
+  const auto r = a.solve();
+  ASSERT_TRUE(r);
+  // THEN the attitude is the one at the last sample (30 ms of yaw at 1 rad/s would be 0.03 rad)
+  const Quat truth = m.attitude(7.03);
+  EXPECT_LT(r->w_q_b.angularDistance(truth), 4e-3);
+  EXPECT_NEAR(wrapAngle(headingOf(r->w_q_b) - headingOf(truth)), 0.0, 4e-3);
+}
+
 TEST(InMotionAlignment, BiasJacobiansMatchFiniteDifferences) {
   // GIVEN the same 3 s of samples with a bias subtracted, b and b + ε e_i
   Motion m;
