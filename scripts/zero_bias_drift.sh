@@ -21,7 +21,7 @@ cat > "$WORK/cfg.json" <<'JSON'
           "multipath_std_m": 0, "outlier_probability": 0, "burst_probability": 0, "ground_effect": false}}
 JSON
 rmse() { "$CLI" localize "$1" --anchors "$2" --json --no-diagnostics "${@:3}" |
-  "$PY" -c 'import json, sys; print("%.4f" % json.load(sys.stdin)["rmse_airborne_m"])'; }
+  "$PY" -c 'import json, sys; print("%.5f" % json.load(sys.stdin)["rmse_airborne_m"])'; }
 echo "| flight | on [m] | off 0.2 [m] | off 0.35 [m] |"
 echo "|---|---:|---:|---:|"
 for tr in circle figure8 zigzag circle-sine; do

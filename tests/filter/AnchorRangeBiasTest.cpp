@@ -377,7 +377,7 @@ TEST(EkfRangeBias, TheAdaptedStdShrinksWithoutBiasAndGrowsBackWhenABiasAppears) 
     return r;
   };
   // WHEN localizing with the defaults, the prior std fixed and adapted (F27e)
-  const Run fixed = run(0.0), adapted = run(0.3);
+  const Run fixed = run(0.0), adapted = run(EkfParams{}.range_bias_adapt_s);
   // THEN without bias the adapted prior shrank (to its floor, 0.2 σ₀); once the bias appeared it grew back (the EM
   // fixed point: about the RMS of the anchors' biases), and the bias and the position are as with the fixed prior
   const double sigma0 = EkfParams{}.range_bias_sigma_m;

@@ -84,22 +84,30 @@ TEST(Generalization, RealStartOnTheFloorSeesTheFloorLevelAnchorsLate) {
 }
 
 TEST(Generalization, SimulatedLiftOffFromRestKeepsTheFloorLevelDelaysUntilTheBodyHasRisen) {
-  // GIVEN a simulated flight from the ground whose rotors spin up without floor shaking (the simulated IMU: rest, then
-  // flight vibration) while the floor-level anchors are seen 2–3.6 m late (S18)
-  const std::vector<SimScenarioRun> runs = protocolSimulations("", {11}, "fast-paper");
-  const SimScenarioRun& s = scenario(runs, "fast-paper-s11");
-  // WHEN localizing with the defaults, and with the floor-level delays not modelled (F16f off)
-  const LocalizationRun run = localizeFlight(s.flight, s.survey);
+  // GIVEN simulated flights from the ground whose rotors spin up without floor shaking (the simulated IMU: rest, then
+  // flight vibration) while the floor-level anchors are seen 2–3.6 m late (S18); three drones and rooms (seeds)
+  const std::vector<SimScenarioRun> runs = protocolSimulations("", {11, 12, 13}, "fast-paper");
   LocalizationOptions off;
   off.params.floor_anchor_height_m = 0.0;
-  const LocalizationRun run_off = localizeFlight(s.flight, s.survey, off);
-  // THEN on the floor and through the lift-off the estimate stays within 0.6 m of the body (without: 2.5 m), and the
-  // flight is no worse (within 4 %: 0.160 against 0.155 m with the range-bias prior adapted, F27e)
-  ASSERT_TRUE(run.metrics && run_off.metrics);
-  const EstimateChecks c = checks(run, s.flight, s.survey), c_off = checks(run_off, s.flight, s.survey);
-  EXPECT_LT(c.max_error_before_takeoff_m, 0.6);
-  EXPECT_GT(c_off.max_error_before_takeoff_m, 1.5);
-  EXPECT_LT(run.metrics->airborne.rmse_m, 1.04 * run_off.metrics->airborne.rmse_m);
+  double sum_ratio = 0.0;
+  for (const char* name : {"fast-paper-s11", "fast-paper-s12", "fast-paper-s13"}) {
+    SCOPED_TRACE(name);
+    const SimScenarioRun& s = scenario(runs, name);
+    // WHEN localizing with the defaults, and with the floor-level delays not modelled (F16f off)
+    const LocalizationRun run = localizeFlight(s.flight, s.survey);
+    const LocalizationRun run_off = localizeFlight(s.flight, s.survey, off);
+    // THEN on the floor and through the lift-off the estimate stays within 0.6 m of the body (without: 1.4–2.4 m)
+    ASSERT_TRUE(run.metrics && run_off.metrics);
+    const EstimateChecks c = checks(run, s.flight, s.survey), c_off = checks(run_off, s.flight, s.survey);
+    EXPECT_LT(c.max_error_before_takeoff_m, 0.6);
+    EXPECT_GT(c_off.max_error_before_takeoff_m, 1.2);
+    // and no flight is more than 5 % worse airborne (s11 0.162 against 0.156 m, s12 and s13 the same or better)
+    const double ratio = run.metrics->airborne.rmse_m / run_off.metrics->airborne.rmse_m;
+    EXPECT_LT(ratio, 1.05);
+    sum_ratio += ratio;
+  }
+  // AND over the three the airborne error is no worse (within 1 %)
+  EXPECT_LT(sum_ratio / 3.0, 1.01);
 }
 
 TEST(Generalization, SimulatedStartInHover) {

@@ -113,7 +113,7 @@ struct EkfParams {
   /// (F27e) The stationary std adapted to the flight by online EM with this time constant [s]; 0 keeps
   /// range_bias_sigma_m. The adapted std stays within [range_bias_min_fraction, 1] × range_bias_sigma_m. Chosen on
   /// simulated flights with and without bias; the real flights do not move (docs/math/filter.md F27e).
-  double range_bias_adapt_s = 0.3;
+  double range_bias_adapt_s = 0.1;
   double range_bias_min_fraction = 0.2;
   /// Tag antenna-pattern bias learned in flight from the innovations (F25): spherical harmonics of degrees
   /// 2…antenna_bias_degree (2–4) of the anchor's body-frame direction; 0 off.
