@@ -39,6 +39,7 @@ struct ProtocolArgs {
   bool json_out = false, no_real = false, no_sim = false, no_cuts = false, faults = false, checks = false;
   std::string only;
   std::string write_sims;  ///< folder for the simulated runs' flight CSV and survey (empty: none written)
+  std::string write_cuts;  ///< folder for the real flights' mid-air cuts as flight CSV, with their survey
 };
 
 struct RealFlight {
@@ -150,6 +151,13 @@ std::string fmt3(double v) {
   std::snprintf(b, sizeof b, "%.3f", v);
   return b;
 }
+/// A cut's start time as written in labels and file names: 10 → "10", 7.5 → "7.5".
+std::string cutTime(double t0) {
+  std::ostringstream os;
+  os << t0;
+  return os.str();
+}
+
 std::string fmt2(double v) {
   if (!std::isfinite(v)) return "–";
   char b[32];
@@ -476,6 +484,7 @@ void runProtocol(const ProtocolArgs& a) {
     const std::string data = a.data_dir.empty() ? uwb::app::defaultDataDir() : a.data_dir;
     if (!fs::is_directory(data + "/real"))
       throw uwb::FileError("protocol: no real data under '" + data + "/real' (set --data or $UWBTDOA_DATA)");
+    if (!a.write_cuts.empty()) fs::create_directories(a.write_cuts);
     for (const RealFlight& f : realFlights(data)) {
       if (!a.only.empty() && f.name.find(a.only) == std::string::npos) continue;
       if (!fs::is_regular_file(f.path)) {
@@ -504,7 +513,12 @@ void runProtocol(const ProtocolArgs& a) {
         if (!(t1 > t0 + 5.0)) continue;
         const uwb::Flight cut = uwb::sliceFlight(flight, t0, t1);
         const uwb::LocalizationRun run = uwb::localizeFlight(cut, survey, opt);
-        Row r = evaluateRun(run, f.name, f.session, "cut at " + fmt2(t0).substr(0, fmt2(t0).size() - 3) + " s", cp, cut, survey, opt);
+        if (!a.write_cuts.empty()) {
+          // the cut as the filter sees it, to re-run with `localize` (written atomically)
+          uwb::writeFlightCsv(cut, (fs::path(a.write_cuts) / (f.name + "-cut" + cutTime(t0) + ".csv")).string());
+          uwb::writeAnchorSurvey(survey, (fs::path(a.write_cuts) / (f.name + "-survey.txt")).string());
+        }
+        Row r = evaluateRun(run, f.name, f.session, "cut at " + cutTime(t0) + " s", cp, cut, survey, opt);
         r.t0 = t0;
         r.t1 = t1;
         if (run.metrics) r.rmse_air = uwb::airborneRmseInWindow(*run.metrics, t0, t1);
@@ -642,6 +656,9 @@ const bool kRegistered = uwb::app::registerCommand(
                       "write each simulated run as the filter sees it to this folder (NAME.csv in the UTIL layout, "
                       "NAME-survey.txt; a run cut in the air also as logged from the ground, NAME-whole.csv), to "
                       "re-run it with `localize`");
+       sub.add_option("--write-cuts", a->write_cuts,
+                      "write each real flight's mid-air cut as the filter sees it to this folder "
+                      "(FLIGHT-cutT0.csv in the UTIL layout, FLIGHT-survey.txt), to re-run it with `localize`");
        sub.callback([a] { runProtocol(*a); });
      }});
 

@@ -67,6 +67,28 @@ TEST_F(ProtocolCli, TheCutsAreAlsoLoggedToTheLandingAndTheSurveyCheckStaysSilent
   EXPECT_TRUE(j.at("landed_cuts").at("survey_fit_warnings").empty()) << j.at("landed_cuts").dump();
 }
 
+TEST_F(ProtocolCli, AWrittenCutGivesTheSameResultWithLocalize) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("uwb_protocol_cuts_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  // WHEN the protocol cuts one flight at 7.5 s and writes the cut
+  const nlohmann::json j = run("--cuts 7.5 --write-cuts " + dir.string());
+  ASSERT_EQ(j.at("rows").size(), 2u);
+  const nlohmann::json& cut = j.at("rows").at(1);
+  EXPECT_EQ(cut.at("kind").get<std::string>(), "cut at 7.5 s");
+  const std::filesystem::path csv = dir / "0425-traj2-cut7.5.csv", survey = dir / "0425-traj2-survey.txt";
+  ASSERT_TRUE(std::filesystem::exists(csv));
+  ASSERT_TRUE(std::filesystem::exists(survey));
+  // THEN `localize` on the written cut gives the protocol's airborne RMSE of the cut (the log as the filter saw it)
+  const test::CliResult l =
+      test::runCli("localize " + csv.string() + " --anchors " + survey.string() + " --json --no-diagnostics");
+  ASSERT_EQ(l.exit_code, 0) << l.err;
+  const double protocol_rmse = cut.at("rmse_airborne_m").get<double>();
+  EXPECT_GT(protocol_rmse, 0.05);
+  EXPECT_NEAR(nlohmann::json::parse(l.out).at("rmse_airborne_m").get<double>(), protocol_rmse, 1e-9);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(ProtocolCliSims, AWrittenSimulatedRunGivesTheSameResultWithLocalize) {
   if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
   const std::filesystem::path dir =
