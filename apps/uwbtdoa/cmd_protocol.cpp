@@ -508,15 +508,18 @@ void runProtocol(const ProtocolArgs& a) {
       double t_air_end = -1.0;
       for (const uwb::PositionErrorSample& s : full.metrics->samples)
         if (s.airborne) t_air_end = s.t_s;
+      bool survey_written = false;
       for (double t0 : a.cuts) {
         const double t1 = t_air_end - 1.0;
         if (!(t1 > t0 + 5.0)) continue;
         const uwb::Flight cut = uwb::sliceFlight(flight, t0, t1);
         const uwb::LocalizationRun run = uwb::localizeFlight(cut, survey, opt);
         if (!a.write_cuts.empty()) {
-          // the cut as the filter sees it, to re-run with `localize` (written atomically)
+          // the cut as the filter sees it, to re-run with `localize`, and once per flight its survey (both atomically)
           uwb::writeFlightCsv(cut, (fs::path(a.write_cuts) / (f.name + "-cut" + cutTime(t0) + ".csv")).string());
-          uwb::writeAnchorSurvey(survey, (fs::path(a.write_cuts) / (f.name + "-survey.txt")).string());
+          if (!survey_written)
+            uwb::writeAnchorSurvey(survey, (fs::path(a.write_cuts) / (f.name + "-survey.txt")).string());
+          survey_written = true;
         }
         Row r = evaluateRun(run, f.name, f.session, "cut at " + cutTime(t0) + " s", cp, cut, survey, opt);
         r.t0 = t0;
