@@ -466,7 +466,8 @@ void bindEval(py::module_& m) {
       py::arg("airborne_min_z_m") = kAirborneMinZ_m,
       "Runs the localization filter on a flight, with the GP correction when bias_model is given (paper III-B:\n"
       "z − mean, variance added). preset: 'defaults' | 'crazyflie' | 'tdoa-only'; params: EkfParams overrides\n"
-      "(field names of uwb/filter/EkfParams.h, enums as strings). Returns {trajectory {t, p, q, sigma_p, v},\n"
+      "(field names of uwb/filter/EkfParams.h, enums as strings). Returns {trajectory {t, p, q, sigma_p, v, acc_bias,\n"
+      "gyro_bias (NaN without IMU)},\n"
       "summary {...}, metrics (None without ground truth) {whole, airborne: {n, rmse_m, rmse_axis_m, mean_m,\n"
       "p50_m, p90_m, p99_m, max_m}, samples {t, p_true, p_est, error, error_norm, airborne}}, duration_s}.");
   m.def(

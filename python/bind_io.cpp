@@ -323,17 +323,19 @@ py::dict poseSamplesToDict(const std::vector<PoseSample>& samples) { return pose
 
 py::dict trajectoryToDict(const Trajectory& v) {
   const auto n = static_cast<Eigen::Index>(v.size());
-  RowMat t(n, 1), p(n, 3), q(n, 4), s(n, 3), vel(n, 3);
+  RowMat t(n, 1), p(n, 3), q(n, 4), s(n, 3), vel(n, 3), ba(n, 3), bg(n, 3);
   for (Eigen::Index i = 0; i < n; ++i) {
     t(i, 0) = v[i].t_s;
     p.row(i) = v[i].w_p_b.transpose();
     q.row(i) << v[i].w_q_b.x(), v[i].w_q_b.y(), v[i].w_q_b.z(), v[i].w_q_b.w();
     s.row(i) = v[i].sigma_p_m.transpose();
     vel.row(i) = v[i].w_v_b.transpose();
+    ba.row(i) = v[i].b_acc_bias.transpose();
+    bg.row(i) = v[i].b_gyro_bias.transpose();
   }
   py::dict d;
   d["t"] = toNumpy(t, true), d["p"] = toNumpy(p), d["q"] = toNumpy(q), d["sigma_p"] = toNumpy(s);
-  d["v"] = toNumpy(vel);
+  d["v"] = toNumpy(vel), d["acc_bias"] = toNumpy(ba), d["gyro_bias"] = toNumpy(bg);
   return d;
 }
 
@@ -344,6 +346,8 @@ Trajectory trajectoryFromDict(const py::dict& d) {
   const RowMat q = d.contains("q") ? block(d, "q", "trajectory", 4, n) : RowMat();
   const RowMat s = d.contains("sigma_p") ? block(d, "sigma_p", "trajectory", 3, n) : RowMat();
   const RowMat vel = d.contains("v") ? block(d, "v", "trajectory", 3, n) : RowMat();
+  const RowMat ba = d.contains("acc_bias") ? block(d, "acc_bias", "trajectory", 3, n) : RowMat();
+  const RowMat bg = d.contains("gyro_bias") ? block(d, "gyro_bias", "trajectory", 3, n) : RowMat();
   Trajectory out(static_cast<std::size_t>(n));
   for (Eigen::Index i = 0; i < n; ++i) {
     out[i].t_s = t(i);
@@ -351,6 +355,8 @@ Trajectory trajectoryFromDict(const py::dict& d) {
     if (q.size()) out[i].w_q_b = rowQuat(q, i);
     if (s.size()) out[i].sigma_p_m = row3(s, i);
     if (vel.size()) out[i].w_v_b = row3(vel, i);
+    if (ba.size()) out[i].b_acc_bias = row3(ba, i);
+    if (bg.size()) out[i].b_gyro_bias = row3(bg, i);
   }
   return out;
 }

@@ -135,6 +135,10 @@ if "t_pose" in idx:
         traj.append(",".join([c[idx["t_pose"]], c[idx["pose_x"]], c[idx["pose_y"]], c[idx["pose_z"]], *q,
                               "0.05", "0.05", "0.08", "0", "0", "0"]))
 put("trajectory_csv", "seed_traj.csv", "\n".join(traj) + "\n")
+# the same with the IMU-driven filter's bias columns
+bias_cols = ",acc_bias_x,acc_bias_y,acc_bias_z,gyro_bias_x,gyro_bias_y,gyro_bias_z"
+put("trajectory_csv", "seed_traj_bias.csv",
+    "\n".join([traj[0] + bias_cols] + [r + ",0.01,-0.02,-0.108,0.001,0,-0.0004" for r in traj[1:]]) + "\n")
 
 
 def svgp(m_points, dims, l):

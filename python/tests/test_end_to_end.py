@@ -68,6 +68,9 @@ def test_train_localize_and_compare(flights, trained, tmp_path):
         traj = run["trajectory"]
         assert traj["p"].shape[0] == traj["t"].size > 1000 and traj["sigma_p"].shape == traj["p"].shape
         assert np.all(traj["sigma_p"] > 0)
+        # the IMU biases the filter estimated, per sample (body frame), finite with the IMU-driven filter
+        assert traj["acc_bias"].shape == traj["gyro_bias"].shape == traj["p"].shape
+        assert np.all(np.isfinite(traj["acc_bias"])) and np.all(np.isfinite(traj["gyro_bias"]))
         air = run["metrics"]["airborne"]
         assert 0 < air["rmse_m"] < 1.5 and air["n"] > 100
         s = run["metrics"]["samples"]

@@ -32,7 +32,7 @@ AnchorTable anchorTableFromSurvey(const AnchorSurvey& survey, double anchor_sigm
   return table;
 }
 
-Trajectory toTrajectory(const std::vector<LocalizerEstimate>& estimates) {
+Trajectory toTrajectory(const std::vector<LocalizerEstimate>& estimates, bool imu_biases) {
   Trajectory out;
   out.reserve(estimates.size());
   for (const LocalizerEstimate& e : estimates) {
@@ -42,6 +42,10 @@ Trajectory toTrajectory(const std::vector<LocalizerEstimate>& estimates) {
     s.w_q_b = e.x.w_q_b;
     s.sigma_p_m = e.sigma_p_m;
     s.w_v_b = e.x.w_v_b;
+    if (imu_biases) {
+      s.b_acc_bias = e.x.b_acc_bias;
+      s.b_gyro_bias = e.x.b_gyro_bias;
+    }
     out.push_back(s);
   }
   return out;
@@ -58,7 +62,7 @@ LocalizationRun localizeFlight(const Flight& flight, const AnchorSurvey& survey,
   LocalizerResult res = localizer.run(std::move(log), options.output_period_s);
   res.summary.merge.n_imu_unpaired = pair_report.n_imu_unpaired;
   LocalizationRun run;
-  run.trajectory = toTrajectory(res.estimates);
+  run.trajectory = toTrajectory(res.estimates, res.summary.process_model == ProcessModel::kImu);
   run.summary = res.summary;
   run.duration_s = res.summary.end_t_s - res.summary.start_t_s;
   if (flight.hasGroundTruth()) {

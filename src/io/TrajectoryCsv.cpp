@@ -1,10 +1,12 @@
 /** @file TrajectoryCsv.cpp
- *  @brief Estimated-trajectory CSV (t,x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz), exact round trip.
+ *  @brief Estimated-trajectory CSV (t,x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz[,acc_bias_*,gyro_bias_*]), exact
+ *         round trip.
  */
 #include "uwb/io/TrajectoryCsv.h"
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <string_view>
@@ -14,23 +16,32 @@
 namespace uwb {
 
 namespace {
-constexpr std::array<const char*, 14> kTrajectoryColumns{"t",  "x",     "y",     "z",     "qx", "qy", "qz",
-                                                         "qw", "std_x", "std_y", "std_z", "vx", "vy", "vz"};
+constexpr std::size_t kRequired = 14;  // the columns every trajectory file has; the bias columns are optional together
+constexpr std::size_t kAll = 20;
+constexpr std::array<const char*, kAll> kTrajectoryColumns{
+    "t",     "x",     "y",          "z",          "qx",         "qy",          "qz",          "qw",
+    "std_x", "std_y", "std_z",      "vx",         "vy",         "vz",          "acc_bias_x",  "acc_bias_y",
+    "acc_bias_z",     "gyro_bias_x", "gyro_bias_y", "gyro_bias_z"};
 }  // namespace
 
 void writeTrajectoryCsv(const Trajectory& trajectory, const std::string& path) {
+  // the bias columns only when every sample has its biases (a column is never partly empty)
+  const bool with_bias = !trajectory.empty() && std::all_of(trajectory.begin(), trajectory.end(),
+                                                            [](const TrajectorySample& s) { return s.hasImuBias(); });
+  const std::size_t n_cols = with_bias ? kAll : kRequired;
   std::string out;
-  out.reserve(trajectory.size() * 14 * 12 + 128);
-  for (std::size_t i = 0; i < kTrajectoryColumns.size(); ++i) {
+  out.reserve(trajectory.size() * n_cols * 12 + 256);
+  for (std::size_t i = 0; i < n_cols; ++i) {
     if (i > 0) out.push_back(',');
     out += kTrajectoryColumns[i];
   }
   out.push_back('\n');
   for (const TrajectorySample& s : trajectory) {
-    const double v[14] = {s.t_s,         s.w_p_b.x(),     s.w_p_b.y(),     s.w_p_b.z(),     s.w_q_b.x(),
-                          s.w_q_b.y(),   s.w_q_b.z(),     s.w_q_b.w(),     s.sigma_p_m.x(), s.sigma_p_m.y(),
-                          s.sigma_p_m.z(), s.w_v_b.x(),   s.w_v_b.y(),     s.w_v_b.z()};
-    for (int k = 0; k < 14; ++k) {
+    const double v[kAll] = {s.t_s,          s.w_p_b.x(),      s.w_p_b.y(),      s.w_p_b.z(),       s.w_q_b.x(),
+                            s.w_q_b.y(),    s.w_q_b.z(),      s.w_q_b.w(),      s.sigma_p_m.x(),   s.sigma_p_m.y(),
+                            s.sigma_p_m.z(), s.w_v_b.x(),     s.w_v_b.y(),      s.w_v_b.z(),       s.b_acc_bias.x(),
+                            s.b_acc_bias.y(), s.b_acc_bias.z(), s.b_gyro_bias.x(), s.b_gyro_bias.y(), s.b_gyro_bias.z()};
+    for (std::size_t k = 0; k < n_cols; ++k) {
       if (k > 0) out.push_back(',');
       io_detail::appendDouble(out, v[k]);
     }
@@ -48,9 +59,10 @@ Trajectory parseTrajectoryCsv(std::string_view text, const std::string& path) {
     throw InputError(SourceLocation{path, line, column, field}, msg);
   };
   io_detail::LineCursor lines(text);
-  std::array<int, 14> col{};  // file column of each trajectory field
+  std::array<int, kAll> col{};  // file column of each trajectory field
   col.fill(-1);
   std::size_t n_cols = 0;
+  bool with_bias = false;
   std::vector<std::string> names;
   Trajectory out;
   std::vector<std::string_view> cells;
@@ -74,7 +86,9 @@ Trajectory parseTrajectoryCsv(std::string_view text, const std::string& path) {
         }
         if (!known) fail(line, i + 1, names.back(), fmt::format("unknown column '{}'", names.back()));
       }
-      for (std::size_t f = 0; f < kTrajectoryColumns.size(); ++f) {
+      // the bias columns are all there or none (a file of the 14 columns reads as NaN biases)
+      with_bias = std::any_of(col.begin() + kRequired, col.end(), [](int c) { return c >= 0; });
+      for (std::size_t f = 0; f < (with_bias ? kAll : kRequired); ++f) {
         if (col[f] < 0) fail(line, 0, "", fmt::format("missing column '{}' in the header", kTrajectoryColumns[f]));
       }
       n_cols = cells.size();
@@ -83,8 +97,8 @@ Trajectory parseTrajectoryCsv(std::string_view text, const std::string& path) {
     if (cells.size() != n_cols) {
       fail(line, 0, "", fmt::format("row has {} fields, the header has {}", cells.size(), n_cols));
     }
-    double v[14];
-    for (std::size_t f = 0; f < 14; ++f) {
+    double v[kAll];
+    for (std::size_t f = 0; f < (with_bias ? kAll : kRequired); ++f) {
       const std::string_view cell = cells[static_cast<std::size_t>(col[f])];
       const auto st = io_detail::parseDouble(cell.data(), cell.data() + cell.size(), v[f]);
       if (st != io_detail::NumberStatus::kOk) {
@@ -102,6 +116,10 @@ Trajectory parseTrajectoryCsv(std::string_view text, const std::string& path) {
     s.w_q_b = Quat(v[7], v[4], v[5], v[6]);
     s.sigma_p_m = Vec3(v[8], v[9], v[10]);
     s.w_v_b = Vec3(v[11], v[12], v[13]);
+    if (with_bias) {
+      s.b_acc_bias = Vec3(v[14], v[15], v[16]);
+      s.b_gyro_bias = Vec3(v[17], v[18], v[19]);
+    }
     out.push_back(s);
   }
   if (names.empty()) fail(1, 0, "", "empty file: missing header line");

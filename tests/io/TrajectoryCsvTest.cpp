@@ -6,6 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "IoTestHelpers.h"
@@ -42,6 +43,39 @@ TEST(TrajectoryCsv, RoundTripIsExact) {
     EXPECT_TRUE(test::sameBits(back[i].w_q_b, traj[i].w_q_b));
     EXPECT_TRUE(test::sameBits(back[i].sigma_p_m, traj[i].sigma_p_m));
     EXPECT_TRUE(test::sameBits(back[i].w_v_b, traj[i].w_v_b));
+  }
+}
+
+TEST(TrajectoryCsv, TheImuBiasesRoundTripAndAFileWithoutThemReadsAsNotEstimated) {
+  // GIVEN a trajectory whose samples carry the IMU biases
+  Trajectory traj(3);
+  for (std::size_t i = 0; i < traj.size(); ++i) {
+    traj[i].t_s = 0.1 * static_cast<double>(i);
+    traj[i].b_acc_bias = Vec3(-0.108, 0.02, 1.0 / 3.0) * static_cast<double>(i + 1);
+    traj[i].b_gyro_bias = Vec3(1e-3, -2e-4, 1.0 / 7.0);
+  }
+  TempDir dir;
+  // WHEN written and read back, THEN the biases are bit-identical and the header names the six columns
+  writeTrajectoryCsv(traj, dir.file("b.csv"));
+  const Trajectory back = readTrajectoryCsv(dir.file("b.csv"));
+  ASSERT_EQ(back.size(), traj.size());
+  for (std::size_t i = 0; i < traj.size(); ++i) {
+    EXPECT_TRUE(test::sameBits(back[i].b_acc_bias, traj[i].b_acc_bias));
+    EXPECT_TRUE(test::sameBits(back[i].b_gyro_bias, traj[i].b_gyro_bias));
+  }
+  // GIVEN one sample without biases (not estimated): WHEN written, THEN no bias column (never partly empty)
+  traj[1].b_acc_bias = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+  writeTrajectoryCsv(traj, dir.file("n.csv"));
+  const Trajectory none = readTrajectoryCsv(dir.file("n.csv"));
+  ASSERT_EQ(none.size(), traj.size());
+  for (const TrajectorySample& s : none) EXPECT_FALSE(s.hasImuBias());
+  // a partial set of bias columns is an error naming the first one missing
+  const std::string head = "t,x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz,acc_bias_x,acc_bias_y,acc_bias_z";
+  try {
+    (void)readTrajectoryCsv(dir.write("p.csv", head + "\n0,1,2,3,0,0,0,1,0.1,0.1,0.1,0,0,0,0,0,0\n"));
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr("missing column 'gyro_bias_x'"));
   }
 }
 

@@ -44,8 +44,9 @@ struct LocalizationRun {
 SensorLog sensorLogFromFlight(const Flight& flight, MergeReport* report = nullptr, bool with_tof = false);
 /// Anchor beliefs from a survey; every coordinate with std anchor_sigma_m.
 AnchorTable anchorTableFromSurvey(const AnchorSurvey& survey, double anchor_sigma_m = 0.0);
-/// Filter output → trajectory samples (position, attitude, velocity, position std).
-Trajectory toTrajectory(const std::vector<LocalizerEstimate>& estimates);
+/// Filter output → trajectory samples (position, attitude, velocity, position std; with imu_biases the IMU biases
+/// the filter estimated, otherwise NaN: the TDoA-only models have no bias states).
+Trajectory toTrajectory(const std::vector<LocalizerEstimate>& estimates, bool imu_biases);
 
 /// Localizes a flight; without IMU (or with options.tdoa_only) the TDoA-only model runs. When the flight has
 /// ground truth, metrics are computed against its glitch-free pose track.

@@ -1,10 +1,13 @@
 /** @file TrajectoryCsv.h
  *  @brief Estimated trajectories: the filter's output, written as CSV for users and plots.
  *
- *  Columns: t,x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz  (SI units; quaternion body→world).
+ *  Columns: t,x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz  (SI units; quaternion body→world), then, when every
+ *  sample has them, the IMU biases the filter estimated: acc_bias_x,acc_bias_y,acc_bias_z [m/s²],
+ *  gyro_bias_x,gyro_bias_y,gyro_bias_z [rad/s] (body frame). A file without them reads as NaN biases.
  */
 #pragma once
 
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -20,6 +23,11 @@ struct TrajectorySample {
   Quat w_q_b = Quat::Identity();  ///< body→world rotation
   Vec3 sigma_p_m = Vec3::Zero();  ///< 1σ of the position per world axis [m]
   Vec3 w_v_b = Vec3::Zero();      ///< velocity in the world frame [m/s]
+  /// Accelerometer and gyroscope bias, body frame [m/s²], [rad/s]; NaN where not estimated (TDoA-only models).
+  Vec3 b_acc_bias = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+  Vec3 b_gyro_bias = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+
+  bool hasImuBias() const { return b_acc_bias.allFinite() && b_gyro_bias.allFinite(); }
 };
 
 using Trajectory = std::vector<TrajectorySample>;
