@@ -19,9 +19,10 @@ namespace {
 constexpr std::size_t kRequired = 14;  // the columns every trajectory file has; the bias columns are optional together
 constexpr std::size_t kAll = 20;
 constexpr std::array<const char*, kAll> kTrajectoryColumns{
-    "t",     "x",     "y",          "z",          "qx",         "qy",          "qz",          "qw",
-    "std_x", "std_y", "std_z",      "vx",         "vy",         "vz",          "acc_bias_x",  "acc_bias_y",
-    "acc_bias_z",     "gyro_bias_x", "gyro_bias_y", "gyro_bias_z"};
+    "t",     "x",     "y",     "z",  "qx", "qy", "qz", "qw",
+    "std_x", "std_y", "std_z", "vx", "vy", "vz",
+    "acc_bias_x",  "acc_bias_y",  "acc_bias_z",
+    "gyro_bias_x", "gyro_bias_y", "gyro_bias_z"};
 }  // namespace
 
 void writeTrajectoryCsv(const Trajectory& trajectory, const std::string& path) {
@@ -37,10 +38,12 @@ void writeTrajectoryCsv(const Trajectory& trajectory, const std::string& path) {
   }
   out.push_back('\n');
   for (const TrajectorySample& s : trajectory) {
-    const double v[kAll] = {s.t_s,          s.w_p_b.x(),      s.w_p_b.y(),      s.w_p_b.z(),       s.w_q_b.x(),
-                            s.w_q_b.y(),    s.w_q_b.z(),      s.w_q_b.w(),      s.sigma_p_m.x(),   s.sigma_p_m.y(),
-                            s.sigma_p_m.z(), s.w_v_b.x(),     s.w_v_b.y(),      s.w_v_b.z(),       s.b_acc_bias.x(),
-                            s.b_acc_bias.y(), s.b_acc_bias.z(), s.b_gyro_bias.x(), s.b_gyro_bias.y(), s.b_gyro_bias.z()};
+    const double v[kAll] = {s.t_s,           s.w_p_b.x(),      s.w_p_b.y(),      s.w_p_b.z(),
+                            s.w_q_b.x(),     s.w_q_b.y(),      s.w_q_b.z(),      s.w_q_b.w(),
+                            s.sigma_p_m.x(), s.sigma_p_m.y(),  s.sigma_p_m.z(),
+                            s.w_v_b.x(),     s.w_v_b.y(),      s.w_v_b.z(),
+                            s.b_acc_bias.x(), s.b_acc_bias.y(), s.b_acc_bias.z(),
+                            s.b_gyro_bias.x(), s.b_gyro_bias.y(), s.b_gyro_bias.z()};
     for (std::size_t k = 0; k < n_cols; ++k) {
       if (k > 0) out.push_back(',');
       io_detail::appendDouble(out, v[k]);
