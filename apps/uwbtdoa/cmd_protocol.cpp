@@ -517,9 +517,10 @@ void runProtocol(const ProtocolArgs& a) {
         if (!a.write_cuts.empty()) {
           // the cut as the filter sees it, to re-run with `localize`, and once per flight its survey (both atomically)
           uwb::writeFlightCsv(cut, (fs::path(a.write_cuts) / (f.name + "-cut" + cutTime(t0) + ".csv")).string());
-          if (!survey_written)
+          if (!survey_written) {
             uwb::writeAnchorSurvey(survey, (fs::path(a.write_cuts) / (f.name + "-survey.txt")).string());
-          survey_written = true;
+            survey_written = true;
+          }
         }
         Row r = evaluateRun(run, f.name, f.session, "cut at " + cutTime(t0) + " s", cp, cut, survey, opt);
         r.t0 = t0;
