@@ -170,7 +170,8 @@ ClockOffsetCheck checkClockOffset(const Flight& flight, const AnchorSurvey& surv
       p.clock_lags_s.empty())
     return c;
   c.done = true;
-  const auto [t0, t1] = movingWindow(run);
+  const auto window = movingWindow(run);
+  const double t0 = window.first, t1 = window.second;  // plain names: the lambda below captures them
   std::map<double, double> power;  // lag → residual power (rms²)
   const auto tryLag = [&](double lag) {
     if (power.count(lag)) return;
