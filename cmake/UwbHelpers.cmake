@@ -7,6 +7,7 @@ if(UWB_DEV_WARNINGS)
 else()
   set(UWB_WARNINGS -w)
   add_compile_options(-w)
+  add_link_options(-w)  # link-time optimization compiles again at the link
 endif()
 if(UWB_SANITIZE AND UWB_TSAN)
   message(FATAL_ERROR "UWB_SANITIZE (ASan/UBSan) and UWB_TSAN cannot be combined; use two build folders")

@@ -83,7 +83,7 @@ std::vector<SimScenarioRun> protocolSimulations(const std::string& data_dir, con
         sim::Scenario sc = sim::makeScenario(layout.survey, sim::TrajectoryShape::kHover, 4.0 + 3.0 + 16.0 + 3.0 + 4.0);
         sc.trajectory.yaw_mode = sim::YawMode::kConstant;
         const sim::SimResult r = sim::simulateFlight(sc, sp, seed);
-        out.push_back({"still-hover-" + tag, "still-hover", "full", r.flight, r.survey, false});
+        out.push_back({"still-hover-" + tag, "still-hover", "full", r.flight, r.survey, false, {}});
       }
       if (want("two-takeoffs")) {
         // two take-offs: a circle, landing, then a hover flight from where it landed
@@ -99,14 +99,14 @@ std::vector<SimScenarioRun> protocolSimulations(const std::string& data_dir, con
         Flight f = ra.flight;
         shiftFlight(rb.flight, ra.flight.acc.back().t_s + 1e-3);
         append(f, rb.flight);
-        out.push_back({"two-takeoffs-" + tag, "two-takeoffs", "full", f, ra.survey, false});
+        out.push_back({"two-takeoffs-" + tag, "two-takeoffs", "full", f, ra.survey, false, {}});
       }
       if (want("fast")) {
         // fast: a circle at 2.25 m/s, yawing
         sim::Scenario sc = sim::makeScenario(layout.survey, sim::TrajectoryShape::kCircle, 40.0);
         sc.trajectory.omega_rps = 2.25 / sc.trajectory.radius_m;
         const sim::SimResult r = sim::simulateFlight(sc, sp, seed);
-        out.push_back({"fast-" + tag, "fast", "full", r.flight, r.survey, false});
+        out.push_back({"fast-" + tag, "fast", "full", r.flight, r.survey, false, {}});
       }
       if (want("tdoa3")) {
         // TDoA3 (S19b): random anchor pairs at 200 Hz instead of the neighbour round robin, a circle with a vertical
@@ -116,7 +116,7 @@ std::vector<SimScenarioRun> protocolSimulations(const std::string& data_dir, con
         sp3.tdoa.rate_hz = 200.0;
         const sim::SimResult r =
             sim::simulateFlight(sim::makeScenario(layout.survey, sim::TrajectoryShape::kCircleSine, 40.0), sp3, seed);
-        out.push_back({"tdoa3-" + tag, "tdoa3", "full", r.flight, r.survey, false});
+        out.push_back({"tdoa3-" + tag, "tdoa3", "full", r.flight, r.survey, false, {}});
       }
       // a yawing figure eight started in the air (unknown yaw at the log's start)
       if (want("yawing-start")) cutInAir("yawing-start", sim::TrajectoryShape::kFigureEight, 50.0, 6.0);

@@ -51,13 +51,14 @@ class StartReplay {
               double cov_period_s, Update&& update);
 
  private:
+  struct Prediction {
+    double acc[3], gyro[3], dt_s;
+  };
   /// A prediction (imu, dt_s) or a TDoA (z), 64 bytes either way.
   struct Entry {
     bool is_tdoa = false;
     union {
-      struct {
-        double acc[3], gyro[3], dt_s;
-      } predict;
+      Prediction predict;
       TdoaObservation z;
     };
     Entry() : predict{} {}
