@@ -233,6 +233,8 @@ std::vector<EkfParamInfo> makeRegistry() {
            "Memory of the flight's bias level measured in flight, which scales output_bias_sigma_m (F23c); 0 off"),
       real("output_bias_level_m", &P::output_bias_level_m, "m", kPositive,
            "Measured pair-bias level above which the reported pair-bias std grows with it (F23c)"),
+      real("output_bias_vertical_scale", &P::output_bias_vertical_scale, "–", kPositive,
+           "Factor on the vertical part of the bias term of the reported covariance in flight (F23d)"),
       // --- downward ToF range (Flow deck VL53L1x, F21) ---
       boolean("fuse_tof", &P::fuse_tof, "Fuse the downward ToF range as a height update (F21)"),
       real("tof_sigma_m", &P::tof_sigma_m, "m", kPositive, "ToF range noise std"),

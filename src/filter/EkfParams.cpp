@@ -90,6 +90,7 @@ void EkfParams::validate() const {
   requireNonNegative(bias_model_training_level_m, "bias_model_training_level_m");
   requireNonNegative(bias_model_training_mean_level_m, "bias_model_training_mean_level_m");
   requirePositive(output_bias_level_m, "output_bias_level_m");
+  requirePositive(output_bias_vertical_scale, "output_bias_vertical_scale");
   requirePositive(tof_sigma_m, "tof_sigma_m");
   if (!std::isfinite(tof_offset_m)) throw std::invalid_argument("EkfParams.tof_offset_m must be finite");
   if (!std::isfinite(floor_z_m)) throw std::invalid_argument("EkfParams.floor_z_m must be finite");

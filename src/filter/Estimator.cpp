@@ -897,7 +897,12 @@ Mat3 Estimator::biasFloor() const {
     C(2, 2) = kGroundHeightSigma_m * kGroundHeightSigma_m;  // the body's height on the floor, not the repeated updates'
     return C;
   }
-  return g.covariance(outputBiasSigma());
+  // (F23d) in flight, the vertical part of the bias-induced position error scaled: C ← S C S, S = diag(1, 1, s)
+  Mat3 C = g.covariance(outputBiasSigma());
+  const double s = params_.output_bias_vertical_scale;
+  C.row(2) *= s;
+  C.col(2) *= s;
+  return C;
 }
 
 void Estimator::updateModelMeanScale() {

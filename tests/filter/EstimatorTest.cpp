@@ -285,6 +285,36 @@ TEST(Estimator, ReportedCovarianceAddsTheBiasFloor) {
   EXPECT_DOUBLE_EQ(std::sqrt(ea.cov_pose(2, 2)), ea.sigma_p_m.z());
 }
 
+TEST(Estimator, TheVerticalScaleActsOnTheBiasTermsHeightAlone) {
+  // GIVEN the circle flight in the air, run without the bias term, with it as derived (s = 1) and with its vertical
+  // part halved (s = 0.5, F23d)
+  const SensorLog log = circleLog(0.0, 8.0, 2);
+  EkfParams derived = lateralFullParams();
+  derived.output_bias_sigma_m = 0.2;
+  derived.output_bias_vertical_scale = 1.0;
+  EkfParams halved = derived;
+  halved.output_bias_vertical_scale = 0.5;
+  EkfParams none = derived;
+  none.output_bias_sigma_m = 0.0;
+  const LocalizerResult a = TdoaLocalizer(derived, arenaAnchors()).run(log, 0.1);
+  const LocalizerResult b = TdoaLocalizer(halved, arenaAnchors()).run(log, 0.1);
+  const LocalizerResult c = TdoaLocalizer(none, arenaAnchors()).run(log, 0.1);
+  ASSERT_EQ(a.estimates.size(), b.estimates.size());
+  ASSERT_EQ(a.estimates.size(), c.estimates.size());
+  // THEN the estimate and the horizontal σ are unchanged, the bias term's vertical variance is s² of the derived one
+  // (C ← S C S) and its horizontal–vertical covariance s of it
+  const LocalizerEstimate &ea = a.estimates.back(), &eb = b.estimates.back(), &ec = c.estimates.back();
+  EXPECT_EQ(ea.x.w_p_b, eb.x.w_p_b);
+  EXPECT_DOUBLE_EQ(ea.sigma_p_m.x(), eb.sigma_p_m.x());
+  EXPECT_DOUBLE_EQ(ea.sigma_p_m.y(), eb.sigma_p_m.y());
+  const double bias_zz_derived = ea.cov_pose(2, 2) - ec.cov_pose(2, 2);
+  const double bias_zz_halved = eb.cov_pose(2, 2) - ec.cov_pose(2, 2);
+  ASSERT_GT(bias_zz_derived, 1e-4);
+  EXPECT_NEAR(bias_zz_halved, 0.25 * bias_zz_derived, 1e-12);
+  EXPECT_NEAR(eb.cov_pose(0, 2) - ec.cov_pose(0, 2), 0.5 * (ea.cov_pose(0, 2) - ec.cov_pose(0, 2)), 1e-12);
+  EXPECT_LT(eb.sigma_p_m.z(), ea.sigma_p_m.z());
+}
+
 TEST(Estimator, ABiasModelOfAMoreBiasedFlightIsScaledDownByThisFlightsLevel) {
   // GIVEN a flight without TDoA bias (white noise 5 cm) and a bias model that does not fit it: ±0.3 m per pair, as a
   // model trained on flights whose measured bias level was 0.5 m might predict

@@ -206,6 +206,10 @@ struct EkfParams {
   /// forgotten with output_bias_memory_s; 0 keeps output_bias_sigma_m fixed.
   double output_bias_memory_s = 30.0;
   double output_bias_level_m = 0.24;
+  /// (F23d) The vertical part of the bias term scaled by this factor, C ← S C S with S = diag(1, 1, s), in flight (the
+  /// floor's F23′ is left alone): the per-anchor count of F23 over-states the height error that the TDoA2 neighbour
+  /// cycle's bias causes. 1 leaves F23 as derived; 0.8 was chosen on the 0425 flights and their cuts (filter.md F23d).
+  double output_bias_vertical_scale = 0.8;
 
   // --- downward ToF range (Flow deck VL53L1x), docs/math/filter.md F21 ---
   /// Fuse the ToF range as a height update while airborne (off by default: the published numbers are without).
