@@ -377,6 +377,9 @@ void Estimator::leaveGround(double t_s, bool climbing) {
   }
   v_climb_ = 0.0;
   if (ready_ && phase_ != FlightPhase::kAcquisition) phase_ = FlightPhase::kTracking;
+  // (F16b, F16g) a take-off before the first fix: the window collected so far holds the body at rest and is not the
+  // constant-velocity motion the moving solve fits; the start begins again from here, in motion, with its replay
+  if (imu_mode_ && !ready_ && start_.active()) startAcquisition(t_s, false);
 }
 
 void Estimator::enterGround(double t_s) {
@@ -451,6 +454,7 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
     init_acc_sum_ += imu.b_acc_mps2;
     init_gyro_sum_ += imu.b_gyro_radps;
     init_acc_sq_sum_ += imu.b_acc_mps2.squaredNorm();
+    init_gyro_sq_sum_ += imu.b_gyro_radps.squaredNorm();
     ++n_init_;
     last_imu_ = imu;
     t_last_imu_ = t_s;
@@ -460,7 +464,12 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
       const bool moving = var > kLevelRestAccStd_mps2 * kLevelRestAccStd_mps2;
       rest_.reset(imu);
       // (F18) a still levelling window shows the gyro's own bias: the rest test reads against it too
-      if (!moving) rest_.setGyroReference(init_gyro_sum_ / n_init_);
+      const Vec3 gyro_mean = init_gyro_sum_ / n_init_;
+      if (!moving) rest_.setGyroReference(gyro_mean);
+      // (F18) the window's moments start the rest statistics: a body still from the first sample is on the ground
+      // before the first fix (a motors-off start), whatever its TDoA say of the height
+      const double gyro_ms = init_gyro_sq_sum_ / n_init_;
+      rest_.seed(t_s, var, gyro_ms, std::max(gyro_ms - gyro_mean.squaredNorm(), 0.0));
       g_ref_ = mean.norm();
       initialize(t_s, mean, moving);
     }

@@ -51,6 +51,18 @@ void RestDetector::reset(const ImuReading& imu) {
   still_ = at_rest_ = false;
 }
 
+void RestDetector::seed(double t_s, double acc_var_mps2sq, double gyro_ms_radps2sq, double gyro_ref_ms_radps2sq) {
+  const auto usable = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  if (!usable(acc_var_mps2sq) || !usable(gyro_ms_radps2sq)) return;
+  acc_var_ = acc_var_mps2sq;
+  gyro_ms_ = gyro_ms_radps2sq;
+  if (has_gyro_ref_ && usable(gyro_ref_ms_radps2sq)) gyro_ref_ms_ = gyro_ref_ms_radps2sq;
+  // the hold starts now: at rest min_hold_s later if the samples that follow stay still (F18)
+  still_ = stillNow();
+  t_still_since_ = t_s;
+  at_rest_ = still_ && params_.min_hold_s <= 0.0;
+}
+
 void RestDetector::update(double t_s, const ImuReading& imu, double dt_s) {
   if (dt_s > 0.0) {
     // (F18) EMA of |f|, its variance and the gyro mean square, weight 1 − exp(−Δt/τ)

@@ -15,8 +15,10 @@
 #include "uwb/sim/Kinematics.h"
 
 namespace uwb::sim {
-
 namespace {
+
+/// (S8) The least thrust, as a fraction of hover, a simulated path may ask for.
+constexpr double kMinThrustFraction = 0.05;
 
 double quantize(double v, double q) { return q > 0.0 ? std::round(v / q) * q : v; }
 
@@ -87,6 +89,15 @@ SimResult simulateFlight(const Scenario& scenario, const SimParams& params, std:
     for (std::size_t k = 0; k < n; ++k) {
       const double t = static_cast<double>(k) * dt;
       const KinematicState s = kinematicState(trajectory, t, params.rotor_drag_per_s);
+      // (S8) a quadrotor's thrust points along body z and cannot pull: a path that brakes a climb (or speeds a descent)
+      // faster than gravity would turn the simulated body over within milliseconds
+      if (s.w_a.z() + kGravity_mps2 < kMinThrustFraction * kGravity_mps2)
+        throw std::invalid_argument(
+            "simulateFlight: the " + toString(scenario.trajectory.shape) + " path asks for a vertical acceleration of " +
+            std::to_string(s.w_a.z()) + " m/s² at t = " + std::to_string(t) + " s, below " +
+            std::to_string((kMinThrustFraction - 1.0) * kGravity_mps2) +
+            " m/s² (a thrust under " + std::to_string(kMinThrustFraction) +
+            " g, which a quadrotor cannot fly): lengthen trajectory.takeoff_s / landing_s or slow the pattern");
       // (S10) rotor vibration only while flying; the draws are the same either way (one rng sequence)
       const Vec3 acc_noise = (s.on_ground ? ip.rest_acc_noise_std_mps2 : ip.acc_noise_std_mps2) * randn3();
       const Vec3 gyro_noise = (s.on_ground ? ip.rest_gyro_noise_std_rps : ip.gyro_noise_std_rps) * randn3();

@@ -21,12 +21,15 @@ double spread(int k, double phi) { return std::fmod(static_cast<double>(k) * phi
 /// Ground, take-off and landing times for a flight of duration_s (S21): the `simulate` defaults shortened for short
 /// runs so that at least half of the flight is the pattern.
 void setPhases(TrajectoryParams& p, double duration_s) {
+  // the climb to the highest agent (2.1 m) braked by the smoothstep (S2, |σ''| ≤ 7.51) keeps a positive thrust (S8)
+  // when it takes at least 1.4 s
+  constexpr double kMinClimb_s = 1.4;
   const double s = std::min(1.0, duration_s / 20.0);
   p.duration_s = duration_s;
   p.ground_before_s = 1.0 * s;
   p.ground_after_s = 0.5 * s;
-  p.takeoff_s = 2.0 * s;
-  p.landing_s = 1.5 * s;
+  p.takeoff_s = std::max(2.0 * s, kMinClimb_s);
+  p.landing_s = std::max(1.5 * s, kMinClimb_s);
   p.speed_ramp_s = 0.25 * p.patternDuration_s();
   p.speed_ramp_s = std::min(p.speed_ramp_s, 2.0);
 }

@@ -230,6 +230,81 @@ TEST(Estimator, GroundTdoaAreDownWeightedNotDropped) {
   EXPECT_FALSE(std::isnan(r.summary.takeoff_t_s));
 }
 
+TEST(Estimator, AMotorsOffStartIsOnTheGroundBeforeItsFirstFix) {
+  // GIVEN a log that begins with the motors off on the floor (a still IMU) whose floor TDoA carry a height bias of
+  // +2.5 m (floor-level anchors seen along the floor), the take-off at 2 s
+  filtertest::TakeoffLogSpec spec;
+  spec.duration_s = 10.0;
+  spec.tdoa_dz = [](double t) { return t < 2.0 ? 2.5 : 0.0; };
+  std::mt19937 rng(5);
+  SensorLog log = filtertest::takeoffLog(spec, rng);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (TimedImu& s : log.imu) {
+    if (s.t_s >= 1.95) continue;
+    s.imu.b_acc_mps2 = Vec3(0, 0, kGravity_mps2) + 0.01 * Vec3(n(rng), n(rng), n(rng));
+    s.imu.b_gyro_radps = 0.002 * Vec3(n(rng), n(rng), n(rng));
+  }
+  // WHEN localizing
+  const LocalizerResult r = TdoaLocalizer(EkfParams{}, arenaAnchors()).run(log);
+  // THEN rest is decided from the levelling window's moments (F18) before the first fix (≥ 0.6 s of TDoA), so the
+  // start is one on the floor: not a start in the air at the TDoA's 2.5 m, from which rest, far above the floor,
+  // would never have entered the ground and the take-off would never have been seen
+  ASSERT_FALSE(r.summary.ground_entered_t_s.empty());
+  EXPECT_LT(r.summary.ground_entered_t_s.front(), r.summary.ready_t_s);
+  EXPECT_LT(r.summary.ground_entered_t_s.front(), 0.4);
+  EXPECT_FALSE(r.summary.started_in_motion);
+  EXPECT_FALSE(std::isnan(r.summary.takeoff_t_s));
+  for (const LocalizerEstimate& e : r.estimates)
+    if (e.t_s > r.summary.ready_t_s && e.t_s < 1.9) EXPECT_LT(e.x.w_p_b.z(), 0.3) << e.t_s;
+  EXPECT_LT((r.estimates.back().x.w_p_b - Vec3(0.8, -0.5, 1.05)).norm(), 0.15);
+}
+
+TEST(RestDetector, AStillWindowSeedsRestWithinTheHold) {
+  // GIVEN a body still from its first sample, and the moments of its first 0.1 s
+  std::mt19937 rng(6);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const auto still = [&] {
+    ImuReading m;
+    m.b_acc_mps2 += 0.02 * Vec3(n(rng), n(rng), n(rng));
+    m.b_gyro_radps = Vec3(0.004, 0.0, -0.003) + 0.002 * Vec3(n(rng), n(rng), n(rng));
+    return m;
+  };
+  Vec3 acc_sum = Vec3::Zero(), gyro_sum = Vec3::Zero();
+  double acc_sq = 0.0, gyro_sq = 0.0;
+  for (int k = 0; k < 100; ++k) {
+    const ImuReading m = still();
+    acc_sum += m.b_acc_mps2, gyro_sum += m.b_gyro_radps;
+    acc_sq += m.b_acc_mps2.squaredNorm(), gyro_sq += m.b_gyro_radps.squaredNorm();
+  }
+  const Vec3 acc_mean = acc_sum / 100.0, gyro_mean = gyro_sum / 100.0;
+  RestDetector seeded, plain;
+  for (RestDetector* d : {&seeded, &plain}) {
+    d->reset(still());
+    EXPECT_TRUE(d->setGyroReference(gyro_mean));
+  }
+  seeded.seed(0.1, acc_sq / 100.0 - acc_mean.squaredNorm(), gyro_sq / 100.0,
+              gyro_sq / 100.0 - gyro_mean.squaredNorm());
+  // WHEN the still samples go on
+  double t_rest_seeded = -1.0, t_rest_plain = -1.0;
+  for (double t = 0.101; t < 2.0; t += 0.001) {
+    const ImuReading m = still();
+    seeded.update(t, m, 0.001);
+    plain.update(t, m, 0.001);
+    if (t_rest_seeded < 0.0 && seeded.atRest()) t_rest_seeded = t;
+    if (t_rest_plain < 0.0 && plain.atRest()) t_rest_plain = t;
+  }
+  // THEN the seeded detector reads rest when the 0.2 s hold has passed; from reset() alone the statistics first
+  // decay from 1 (≈ 0.7 s for the gyro's mean square)
+  EXPECT_NEAR(t_rest_seeded, 0.1 + RestDetectorParams{}.min_hold_s, 0.005);
+  EXPECT_GT(t_rest_plain, 0.6);
+  // AND non-finite or negative moments are ignored
+  RestDetector bad;
+  bad.reset(still());
+  bad.seed(0.1, -1.0, std::nan(""), 0.0);
+  bad.update(0.101, still(), 0.001);
+  EXPECT_FALSE(bad.stillNow());
+}
+
 TEST(Estimator, AQuietImuInAHoverHighAboveTheFloorIsNotTheGround) {
   // GIVEN a take-off to a hover at 1.05 m whose IMU reads as quiet as with the motors off for 3 s (an IMU logged at
   // 100 Hz or low-pass filtered loses the rotor vibration that tells a still hover from rest)

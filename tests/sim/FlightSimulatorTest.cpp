@@ -330,5 +330,22 @@ TEST(FlightSimulator, RejectsInvalidParameters) {
   EXPECT_THROW(simulateFlight(one, SimParams{}, 1), std::invalid_argument);
 }
 
+TEST(FlightSimulator, RejectsAPathAQuadrotorCannotFly) {
+  // GIVEN a take-off of 1.47 m in 1 s: the septic smoothstep (S2) brakes it at up to 7.5 × 1.47 m/s² = 11 m/s², more
+  // than gravity, which would take a thrust that pulls (the body would flip over in the air)
+  Scenario sc = makeScenario(paperAnchors(), TrajectoryShape::kCircle, 30.0);
+  sc.trajectory.takeoff_s = 1.0;
+  // THEN the simulator refuses it, naming the parameter to change
+  try {
+    simulateFlight(sc, SimParams{}, 1);
+    ADD_FAILURE() << "a path braking faster than gravity was simulated";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("takeoff_s"), std::string::npos) << e.what();
+  }
+  // AND 1.2 s (7.7 m/s²) is flown
+  sc.trajectory.takeoff_s = 1.2;
+  EXPECT_NO_THROW(simulateFlight(sc, SimParams{}, 1));
+}
+
 }  // namespace
 }  // namespace uwb::sim

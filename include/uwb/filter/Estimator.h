@@ -259,6 +259,7 @@ class Estimator {
   Vec3 init_acc_sum_ = Vec3::Zero();
   Vec3 init_gyro_sum_ = Vec3::Zero();
   double init_acc_sq_sum_ = 0.0;
+  double init_gyro_sq_sum_ = 0.0;
   int n_init_ = 0;
   double t_first_imu_ = std::numeric_limits<double>::quiet_NaN();
   // per-pair offsets (F19)

@@ -45,6 +45,12 @@ class RestDetector {
   bool shaking() const { return gyro_hp_ms_ > contact_ms_min_; }
   /// Restarts the statistics from a sample (moving, not at rest); a gyro reference is kept.
   void reset(const ImuReading& imu);
+  /// (F18) Starts the moving statistics from a window's sample moments instead (the levelling window of F15): the
+  /// variance of the specific force, the gyro's mean square, and its mean square about the gyro reference (used when
+  /// one is set). A body still from its first sample then reads as at rest min_hold_s after t_s, not only once the
+  /// statistics of reset() have decayed (≈ 0.7 s), so the start's first fix (after ≥ 0.6 s of TDoA) finds it on the
+  /// ground. Call after reset() and setGyroReference(). Moments that are not finite or negative are ignored.
+  void seed(double t_s, double acc_var_mps2sq, double gyro_ms_radps2sq, double gyro_ref_ms_radps2sq);
   /// (F18) The gyro's reading at rest (its bias, e.g. the mean of a still levelling window): the gyro test then passes
   /// when either the raw rate or its deviation from this reference is small, so that an uncalibrated gyro still reads
   /// as at rest and a wrong reference costs nothing. Returns false (and keeps none) above max_gyro_reference_radps.
