@@ -254,8 +254,11 @@ TEST(Estimator, AMotorsOffStartIsOnTheGroundBeforeItsFirstFix) {
   EXPECT_LT(r.summary.ground_entered_t_s.front(), 0.4);
   EXPECT_FALSE(r.summary.started_in_motion);
   EXPECT_FALSE(std::isnan(r.summary.takeoff_t_s));
-  for (const LocalizerEstimate& e : r.estimates)
-    if (e.t_s > r.summary.ready_t_s && e.t_s < 1.9) EXPECT_LT(e.x.w_p_b.z(), 0.3) << e.t_s;
+  for (const LocalizerEstimate& e : r.estimates) {
+    if (e.t_s > r.summary.ready_t_s && e.t_s < 1.9) {
+      EXPECT_LT(e.x.w_p_b.z(), 0.3) << e.t_s;
+    }
+  }
   EXPECT_LT((r.estimates.back().x.w_p_b - Vec3(0.8, -0.5, 1.05)).norm(), 0.15);
 }
 
