@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
 
 #include "uwb/eval/EvaluationTable.h"
 
@@ -9,10 +11,22 @@ namespace uwb {
 
 TEST(EvaluationTable, AggregatesMeansOverFlightsAndSpreadOverRepeats) {
   // GIVEN two repeats of one configuration on two flights
+  const auto run = [](std::string kernel, int inducing, int repeat, std::string flight, double unc, double cor,
+                      double seconds) {
+    EvaluationRun r;
+    r.kernel = std::move(kernel);
+    r.inducing = inducing;
+    r.repeat = repeat;
+    r.flight = std::move(flight);
+    r.rmse_uncorrected_m = unc;
+    r.rmse_corrected_m = cor;
+    r.train_seconds = seconds;
+    return r;
+  };
   std::vector<EvaluationRun> runs = {
-      {"tdoa", 30, 0, "a", 0.20, 0.18, 0, 0, 1.0}, {"tdoa", 30, 0, "b", 0.30, 0.24, 0, 0, 1.0},
-      {"tdoa", 30, 1, "a", 0.20, 0.16, 0, 0, 3.0}, {"tdoa", 30, 1, "b", 0.30, 0.30, 0, 0, 3.0},
-      {"z1", 10, 0, "a", 0.20, 0.25, 0, 0, 1.0},
+      run("tdoa", 30, 0, "a", 0.20, 0.18, 1.0), run("tdoa", 30, 0, "b", 0.30, 0.24, 1.0),
+      run("tdoa", 30, 1, "a", 0.20, 0.16, 3.0), run("tdoa", 30, 1, "b", 0.30, 0.30, 3.0),
+      run("z1", 10, 0, "a", 0.20, 0.25, 1.0),
   };
   // WHEN we aggregate
   const auto rows = aggregateRuns(runs);

@@ -47,7 +47,9 @@ TEST(TrainCli, DumpsNamedTrainingArraysAndIsRepeatableForASeedAndThreadCount) {
   while (std::getline(csv, line)) {
     ++rows;
     held += line.back() == '1' ? 1 : 0;
-    if (rows == 1) EXPECT_EQ(line.rfind("0425-traj3,", 0), 0u) << line;
+    if (rows == 1) {
+      EXPECT_EQ(line.rfind("0425-traj3,", 0), 0u) << line;
+    }
   }
   EXPECT_EQ(rows, summary.at("n_train").get<std::size_t>() + summary.at("n_holdout").get<std::size_t>());
   EXPECT_EQ(held, summary.at("n_holdout").get<std::size_t>());

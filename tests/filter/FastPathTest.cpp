@@ -194,8 +194,11 @@ TEST(TdoaFastPath, NodeForwardToTagEqualsFullForwardPass) {
     EXPECT_NEAR(tag.mu7.m, full.mu7.m, 1e-15);
     EXPECT_NEAR(tag.mu7.V, full.mu7.V, 1e-17);
     EXPECT_EQ(tag.B12, full.B12);
-    if (anchor_sigma == 0.0) EXPECT_EQ(tag.mu7.V, 0.1);
-    else EXPECT_GT(tag.mu7.V, 0.1);
+    if (anchor_sigma == 0.0) {
+      EXPECT_EQ(tag.mu7.V, 0.1);
+    } else {
+      EXPECT_GT(tag.mu7.V, 0.1);
+    }
   }
   EXPECT_THROW(tdoaNodeForwardToTag(TdoaLinearization{}, Moments3{}, Moments3{}, 0.0, 0.0), std::invalid_argument);
 }

@@ -65,7 +65,7 @@ TEST(SvgpTrainer, OneExtraSampleDoesNotSpoilTheTrainedModel) {
 }
 
 TEST(SvgpTrainer, BalancedBatchesCoverTheDataWithSizesDifferingByAtMostOne) {
-  for (const auto [N, B] : {std::pair<Eigen::Index, Eigen::Index>{51211, 1024}, {640, 64}, {641, 64}, {5, 10}, {1, 1}}) {
+  for (const auto& [N, B] : {std::pair<Eigen::Index, Eigen::Index>{51211, 1024}, {640, 64}, {641, 64}, {5, 10}, {1, 1}}) {
     const std::vector<Eigen::Index> sizes = balancedBatchSizes(N, B);
     EXPECT_EQ(static_cast<Eigen::Index>(sizes.size()), (N + B - 1) / B);
     EXPECT_EQ(std::accumulate(sizes.begin(), sizes.end(), Eigen::Index{0}), N);
