@@ -4,6 +4,7 @@
  *         prints the position RMSE against the flight's ground truth.
  */
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
 #include <deque>
@@ -22,6 +23,7 @@
 #include "uwb/eval/RunDiagnostics.h"
 #include "uwb/filter/EkfParamRegistry.h"
 #include "uwb/io/FileAccess.h"
+#include "uwb/io/FlightWindow.h"
 #include "uwb/io/InputChecks.h"
 #include "uwb/io/JsonFile.h"
 #include "uwb/io/TrajectoryCsv.h"
@@ -93,8 +95,25 @@ struct LocalizeArgs {
   bool json_out = false, tdoa_only = false, no_ground_detect = false;
   bool no_diagnostics = false, fix_survey = false;
   double output_period = 0.01;
+  std::vector<double> window;  ///< --window T0,T1: localize the part of the log between these stamps
   uwb::app::FilterOptionArgs filter;  ///< --config, --bias-model, one flag per filter parameter
 };
+
+/// The log between the stamps of --window (every stream, as a log started at T0 and stopped at T1 would hold it:
+/// io/FlightWindow.h); the whole log without the option.
+uwb::Flight windowed(uwb::Flight flight, const std::vector<double>& window, const std::string& path) {
+  if (window.empty()) return flight;
+  const double t0 = window.at(0), t1 = window.at(1);
+  if (!std::isfinite(t0) || !std::isfinite(t1) || !(t0 < t1))
+    throw uwb::InputError(fmt::format("--window T0,T1 needs finite stamps with T0 < T1, got {},{}", t0, t1));
+  const auto [first, last] = flight.timeSpan();
+  uwb::Flight cut = uwb::sliceFlight(flight, t0, t1);
+  if (cut.tdoa.empty()) {
+    throw uwb::InputError(fmt::format("--window {},{} holds no TDoA of {} (its streams span {:.3f} to {:.3f} s)", t0,
+                                      t1, path, first, last));
+  }
+  return cut;
+}
 
 /// Largest --output-period [s]: one sample a minute still draws a trajectory.
 constexpr double kMaxOutputPeriod_s = 60.0;
@@ -120,7 +139,7 @@ void runLocalize(const LocalizeArgs& a) {
   read_opt.required = {uwb::Stream::kTdoa};
   read_opt.survey = &survey;
   uwb::ReadReport read_report;
-  const uwb::Flight flight = uwb::readFlightCsv(a.flight, read_opt, &read_report);
+  const uwb::Flight flight = windowed(uwb::readFlightCsv(a.flight, read_opt, &read_report), a.window, a.flight);
   const bool use_imu = params.process_model == uwb::ProcessModel::kImu && !a.tdoa_only;
   if (use_imu && process_model_given && !flight.hasImu()) {
     throw uwb::InputError(uwb::SourceLocation{a.flight, 1, 0, "t_acc"},
@@ -184,6 +203,7 @@ void runLocalize(const LocalizeArgs& a) {
                  "across them");
   json j;
   j["flight"] = a.flight;
+  j["window_s"] = a.window.empty() ? json(nullptr) : json(a.window);
   j["duration_s"] = run.duration_s;
   j["process_model"] = uwb::toString(s.process_model);
   j["bias_model"] = a.filter.bias_model.empty() ? json(nullptr) : json(a.filter.bias_model);
@@ -340,6 +360,12 @@ const bool kRegistered = uwb::app::registerCommand(
                     "Use TDoA from the start (no take-off detection; = --ground-phase none)");
        uwb::app::addFilterOptions(sub, a->filter);
        sub.add_option("--output-period", a->output_period, "Trajectory sample spacing [s]");
+       sub.add_option("--window", a->window,
+                      "Localize only the part of the log from T0 to T1 [s] (every stream cut there, as a log started "
+                      "at T0, e.g. in the air, and stopped at T1)")
+           ->expected(2)
+           ->delimiter(',')
+           ->type_name("T0,T1");
        sub.add_flag("--no-diagnostics", a->no_diagnostics,
                     "Skip the checks after the run (survey fit, per-anchor survey; they re-run the filter once per "
                     "anchor)");

@@ -1,11 +1,13 @@
 /** @file LocalizeCliTest.cpp
  *  @brief `uwbtdoa localize` on a real flight through the command line: the ToF option by flag and by config file
- *         (docs/math/filter.md F21), its counters in --json, and a config key that does not exist.
+ *         (docs/math/filter.md F21), its counters in --json, a config key that does not exist, and --window (a
+ *         part of a log, started in the air).
  */
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+#include <string>
 #include <nlohmann/json.hpp>
 
 #include <unistd.h>
@@ -68,6 +70,49 @@ TEST_F(LocalizeCli, AnUnknownConfigKeyIsAClearError) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("fuse_toff"), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty());
+}
+
+TEST_F(LocalizeCli, AWindowLocalizesThePartOfTheLogAsALogStartedInTheAir) {
+  // GIVEN 0425-traj3 (take-off at about 3 s, landing at about 29.6 s)
+  const nlohmann::json whole = localize("--no-diagnostics");
+  // WHEN only 10 … 28.57 s of it is localized (the protocol's cut at 10 s, docs/results.md)
+  const std::string traj = (dir_ / "window.csv").string();
+  const nlohmann::json cut = localize("--no-diagnostics --window 10,28.57 --out " + traj);
+  // THEN the filter starts in motion from the window's first samples and holds the protocol's bound for cuts
+  EXPECT_EQ(cut["window_s"], nlohmann::json({10.0, 28.57}));
+  EXPECT_TRUE(whole["window_s"].is_null());
+  EXPECT_TRUE(cut["started_in_motion"].get<bool>());
+  EXPECT_FALSE(whole["started_in_motion"].get<bool>());
+  EXPECT_LT(cut["n_tdoa"].get<int>(), whole["n_tdoa"].get<int>() * 3 / 4);
+  EXPECT_LT(cut["rmse_airborne_m"].get<double>(), 0.30);  // 0.188 m measured
+  EXPECT_LT(cut["duration_s"].get<double>(), 18.6);
+  // AND the trajectory holds only stamps inside the window
+  std::ifstream csv(traj);
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line));
+  double first = -1.0, last = -1.0;
+  while (std::getline(csv, line)) {
+    const double t = std::stod(line.substr(0, line.find(',')));
+    if (first < 0.0) first = t;
+    last = t;
+  }
+  EXPECT_GE(first, 10.0);
+  EXPECT_LE(last, 28.57);
+  EXPECT_GT(last - first, 15.0);
+}
+
+TEST_F(LocalizeCli, AWindowThatIsReversedOrHoldsNoTdoaIsAClearError) {
+  for (const char* window : {"20,10", "500,600", "nan,5"}) {
+    const test::CliResult r = test::runCli("localize " + flight_->string() + " --anchors " +
+                                           test::pilotSurvey("0425").string() + " --json --window " + std::string(window));
+    EXPECT_NE(r.exit_code, 0) << window;
+    EXPECT_NE(r.err.find("--window"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << window;
+  }
+  // the span of the log is named where the window misses it
+  const test::CliResult r = test::runCli("localize " + flight_->string() + " --anchors " +
+                                         test::pilotSurvey("0425").string() + " --window 500,600");
+  EXPECT_NE(r.err.find("0.000 to 31.845 s"), std::string::npos) << r.err;
 }
 
 }  // namespace
