@@ -9,6 +9,7 @@
  *    pose: t, p (N, 3) [m, world], q (N, 4) body→world quaternion (x, y, z, w)
  */
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -17,6 +18,7 @@
 #include "bindings.h"
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/Flight.h"
+#include "uwb/io/FlightWindow.h"
 #include "uwb/io/PoseTrack.h"
 #include "uwb/io/UsdImport.h"
 #include "uwb/io/UtilCsv.h"
@@ -457,6 +459,16 @@ void bindIo(py::module_& m) {
                              },
                              "names of the non-empty streams")
       .def("time_span", &Flight::timeSpan, "(first, last) sample time over all streams [s]")
+      .def(
+          "window",
+          [](const Flight& f, double t0, double t1) {
+            if (!(std::isfinite(t0) && std::isfinite(t1) && t0 < t1))
+              throw py::value_error("Flight.window(t0, t1): finite stamps with t0 < t1 are needed");
+            return sliceFlight(f, t0, t1);
+          },
+          py::arg("t0"), py::arg("t1"),
+          "The flight between the stamps t0 and t1 [s], every stream cut there (stamps kept): the log as a recording "
+          "started at t0, e.g. in the air, and stopped at t1 would hold it (`uwbtdoa localize --window`).")
       .def("__repr__", [](const Flight& f) {
         std::string r = "<Flight '" + f.source + "'";
         for (const auto& s : kStreams) {

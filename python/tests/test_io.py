@@ -29,6 +29,24 @@ def test_flight_streams_are_numpy_arrays_in_si_units():
     assert set(f.streams()) == {"tdoa", "acc", "gyro", "pose"}
 
 
+def test_a_window_keeps_every_stream_between_its_stamps():
+    # GIVEN a flight whose streams span 0 … 2 s
+    f = _synthetic_flight(np.random.default_rng(3))
+    # WHEN it is cut to 0.5 … 1.5 s
+    w = f.window(0.5, 1.5)
+    # THEN each stream holds exactly its samples inside the window, stamps unchanged
+    for name in ("tdoa", "acc", "gyro", "pose"):
+        t = f.streams()[name]["t"]
+        inside = (t >= 0.5) & (t <= 1.5)
+        np.testing.assert_array_equal(w.streams()[name]["t"], t[inside], err_msg=name)
+    np.testing.assert_array_equal(w.tdoa["tdoa"], f.tdoa["tdoa"][(f.tdoa["t"] >= 0.5) & (f.tdoa["t"] <= 1.5)])
+    assert 0.5 <= w.time_span()[0] and w.time_span()[1] <= 1.5
+    # AND a reversed or non-finite window is a ValueError
+    for t0, t1 in ((1.5, 0.5), (float("nan"), 1.0)):
+        with pytest.raises(ValueError, match="t0 < t1"):
+            f.window(t0, t1)
+
+
 def test_flight_csv_round_trip_reproduces_the_arrays(tmp_path):
     # GIVEN a flight with values representable in the file's precision
     rng = np.random.default_rng(2)
