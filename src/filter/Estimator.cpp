@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "uwb/filter/BiasFloor.h"
+#include "uwb/model/TdoaModel.h"
 
 namespace uwb {
 namespace {
@@ -705,6 +706,15 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   if (floor_anchors_.hasDelays() && (on_ground_ || climb_.running())) {
     const double f = on_ground_ ? 1.0 : FloorLevelAnchors::remainingFraction(climb_.height());
     zc.tdoa_m -= f * floor_anchors_.pairDelay(z.id_a, z.id_b);
+  } else if (floor_anchors_.hasDelays() && near_floor && !acquiring && t - t_last_descent_ < kLandingWindow_s) {
+    // (F16h) near the floor after a descent (a landing): the delay or none, whichever the TDoA lies nearer to
+    const Moments3* a = anchors_.find(z.id_a);
+    const Moments3* b = anchors_.find(z.id_b);
+    if (a && b) {
+      const NavState& x = ekf_.state();
+      const double r = zc.tdoa_m - predictTdoa(x.w_p_b, x.w_q_b, params_.b_t_tag, a->m, b->m);
+      zc.tdoa_m -= floor_anchors_.nearerPairDelay(z.id_a, z.id_b, r);
+    }
   }
   if (antenna_) {
     antenna_->advance(t);

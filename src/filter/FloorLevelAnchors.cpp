@@ -41,6 +41,12 @@ double FloorLevelAnchors::delay(int id) const {
 
 double FloorLevelAnchors::remainingFraction(double h_m) { return 1.0 - smoothstep3(h_m / kFadeHeight_m); }
 
+double FloorLevelAnchors::nearerPairDelay(int id_a, int id_b, double residual_m) const {
+  const double d = pairDelay(id_a, id_b);
+  // |r − d| < |r|  ⇔  r d > d² / 2 (F16h)
+  return residual_m * d > 0.5 * d * d ? d : 0.0;
+}
+
 void ClimbFromFloor::start(double t_s) {
   running_ = true;
   t_start_s_ = t_s;

@@ -61,6 +61,24 @@ TEST(FloorLevelAnchors, GivenDelaysWhenAPairIsCorrectedThenItIsTheDelayOfBMinusT
   EXPECT_FALSE(f.hasDelays());
 }
 
+TEST(FloorLevelAnchors, GivenAResidualThenTheDelayIsTakenWhenTheResidualLiesNearerToItThanToZero) {
+  FloorLevelAnchors f(mixedRoom(), 0.0, 1.0);
+  // no delays known: nothing to take, whatever the residual
+  EXPECT_EQ(f.nearerPairDelay(0, 1, -3.0), 0.0);
+  f.setDelays({2.9});
+  // pair (0, 1): g_1 − g_0 = −2.9 m; a residual near −2.9 m is the floor's, one near 0 is a TDoA seen from the air
+  EXPECT_DOUBLE_EQ(f.nearerPairDelay(0, 1, -2.7), -2.9);
+  EXPECT_DOUBLE_EQ(f.nearerPairDelay(0, 1, -3.5), -2.9);
+  EXPECT_EQ(f.nearerPairDelay(0, 1, -0.4), 0.0);
+  EXPECT_EQ(f.nearerPairDelay(0, 1, 2.9), 0.0);  // the wrong sign is never the floor's
+  // the decision boundary is the midpoint, −1.45 m
+  EXPECT_DOUBLE_EQ(f.nearerPairDelay(0, 1, -1.46), -2.9);
+  EXPECT_EQ(f.nearerPairDelay(0, 1, -1.44), 0.0);
+  // the reversed pair has the reversed sign; a pair of two high anchors carries no delay
+  EXPECT_DOUBLE_EQ(f.nearerPairDelay(1, 0, 2.5), 2.9);
+  EXPECT_EQ(f.nearerPairDelay(1, 3, 3.0), 0.0);
+}
+
 TEST(FloorLevelAnchors, GivenAHeightThenTheRemainingFractionFadesSmoothlyOverTheFadeHeight) {
   const double h = FloorLevelAnchors::kFadeHeight_m;
   EXPECT_EQ(FloorLevelAnchors::remainingFraction(0.0), 1.0);

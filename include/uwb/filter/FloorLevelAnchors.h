@@ -7,7 +7,8 @@
  *  pair of one floor-level and one high anchor are off by 2.5–4.1 m on the floor, pairs of two high or two
  *  floor-level anchors by at most about 0.7 m; the simulator's S18 has the same form). The start on the floor solves
  *  one delay per floor-level anchor with the position (multilaterateOnFloorWithDelays); on the ground the TDoA are
- *  corrected by the delays found. The delays are nuisance parameters of the floor, never used in the air.
+ *  corrected by the delays found, and near the floor after a descent each TDoA takes them where it fits them (F16h).
+ *  The delays are nuisance parameters of the floor, never used higher in the air.
  */
 #pragma once
 
@@ -38,6 +39,11 @@ class FloorLevelAnchors {
   /// (F16f) The fraction of the delays left at a height h above the resting height: 1 − S(h / h_f), S(x) = 3x² − 2x³
   /// on [0, 1], h_f = kFadeHeight_m (the real take-offs lose the floor-level bias over the first 12 cm, S18).
   static double remainingFraction(double h_m);
+  /// (F16h) Near the floor in flight (a landing, a low pass) the tag is either within the floor-level bias or above
+  /// it, and the IMU cannot tell which before the rest: each TDoA of pair (A, B) with residual r = z − h(x̂) (no floor
+  /// correction) is taken to carry the delay g_B − g_A when r lies nearer to it than to 0, and none otherwise.
+  /// Returns the delay to subtract from that TDoA [m] (0 or pairDelay).
+  double nearerPairDelay(int id_a, int id_b, double residual_m) const;
   static constexpr double kFadeHeight_m = 0.12;
 
  private:
