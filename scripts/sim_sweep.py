@@ -14,7 +14,7 @@ util-pilot-0425/0426), a seed and a yaw rate, simulates it (`uwbtdoa simulate`) 
             the error 3-5 s after T0 is printed next to that of the same flight logged from the ground, same window
 A path the simulated quadrotor cannot fly (simulation.md S8') is refused by the simulator and counted as such.
 Prints one line per run (airborne RMSE, whole-flight RMSE, largest error, re-acquisitions, TDoA used, the draw) and a
-summary: median, worst, runs above 0.5 m airborne RMSE.
+summary: median, worst, runs above 0.5 m airborne RMSE; the whole flight's RMSE and largest error (take-off, landing).
 
 Usage: scripts/sim_sweep.py [BUILD_DIR] [--seed S] [--runs N] [--extreme | --air]   (anchor presets: $UWBTDOA_DATA
 or ../shared/data for the util-* layouts)
@@ -148,6 +148,7 @@ def main():
         sys.exit(f"sim_sweep.py: no {CLI} (build first, or pass the build directory)")
     rng = random.Random(SEED)
     rmse, refused, failed, early = [], 0, 0, []
+    whole_rmse, whole_max = [], []
     with tempfile.TemporaryDirectory() as tmp:
         flight, survey, config, traj, traj_whole = (
             os.path.join(tmp, n) for n in ("f.csv", "s.txt", "c.json", "t.csv", "w.csv"))
@@ -165,19 +166,19 @@ def main():
             extra, window = [], ""
             if AIR:
                 pose = read_pose(flight)
-                w = air_window(pose, rng)
-                if w is None:
+                span = air_window(pose, rng)
+                if span is None:
                     refused += 1
                     print(f"no air start possible (under 10 s in the air): {described}")
                     continue
-                extra = ["--window", f"{w[0]:.3f},{w[1]:.3f}", "--out", traj]
+                extra = ["--window", f"{span[0]:.3f},{span[1]:.3f}", "--out", traj]
             loc = localize(flight, survey, extra)
             if AIR and loc.returncode == 0:
                 whole = localize(flight, survey, ["--out", traj_whole])
-                e_cut = window_rmse(traj, pose, w[0] + 3.0, w[0] + 5.0)
-                e_whole = window_rmse(traj_whole, pose, w[0] + 3.0, w[0] + 5.0)
+                e_cut = window_rmse(traj, pose, span[0] + 3.0, span[0] + 5.0)
+                e_whole = window_rmse(traj_whole, pose, span[0] + 3.0, span[0] + 5.0)
                 early.append(e_cut)
-                window = (f"from {w[0]:.1f} to {w[1]:.1f} s: 3-5 s after the start {e_cut:.3f} (from the ground "
+                window = (f"from {span[0]:.1f} to {span[1]:.1f} s: 3-5 s after the start {e_cut:.3f} (from the ground "
                           f"{e_whole:.3f}) ")
             if loc.returncode != 0:
                 failed += 1
@@ -186,6 +187,8 @@ def main():
             d = json.loads(loc.stdout)
             a, w = d["airborne"], d["whole"]
             rmse.append(a["rmse_m"])
+            whole_rmse.append(w["rmse_m"])
+            whole_max.append(w["max_m"])
             print(f"{a['rmse_m']:.3f} whole {w['rmse_m']:.3f} max {w['max_m']:.2f} reacq {d['n_reacquisitions']} "
                   f"used {d['n_tdoa_used'] / max(1, d['n_tdoa']):.2f} {window}{described}", flush=True)
     if rmse:
@@ -193,6 +196,9 @@ def main():
         print(f"{len(rmse)} runs ({family} family, seed {SEED}): airborne RMSE median "
               f"{statistics.median(rmse):.3f} m, worst {max(rmse):.3f} m, above 0.5 m: {sum(r > 0.5 for r in rmse)}; "
               f"refused by the simulator: {refused}; localize failed: {failed}")
+        print(f"whole flight (take-off, landing, ground): RMSE median {statistics.median(whole_rmse):.3f} m, worst "
+              f"{max(whole_rmse):.3f} m; largest error median {statistics.median(whole_max):.2f} m, worst "
+              f"{max(whole_max):.2f} m, above 1 m: {sum(m > 1.0 for m in whole_max)}")
         if early:
             print(f"RMSE 3-5 s after the start in the air: median {statistics.median(early):.3f} m, worst "
                   f"{max(early):.3f} m, above 0.3 m: {sum(e > 0.3 for e in early)} of {len(early)}")
