@@ -96,6 +96,10 @@ constexpr double kLandingWindow_s = 3.0;
 constexpr double kContactSustained_s = 1.5;
 /// Below this estimated height above the floor TDoA are down-weighted as on the ground (F14) [m].
 constexpr double kLowFlight_m = 0.25;
+/// (F16h) a landing's TDoA are tested against the floor-level delays while the estimate is within this of the floor
+/// [m]: the low-flight band (kLowFlight_m) and the height by which the estimate trails a descent at the touchdown
+/// (0.1–0.3 m on the simulated and real landings)
+constexpr double kLandingBand_m = 0.5;
 /// Std of the height message that enforces the descent bound (F26) [m].
 constexpr double kDescentBoundSigma_m = 0.05;
 /// Constant time of the take-off detector's leaky vertical-velocity integrator [s] (F15).
@@ -706,7 +710,8 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   if (floor_anchors_.hasDelays() && (on_ground_ || climb_.running())) {
     const double f = on_ground_ ? 1.0 : FloorLevelAnchors::remainingFraction(climb_.height());
     zc.tdoa_m -= f * floor_anchors_.pairDelay(z.id_a, z.id_b);
-  } else if (floor_anchors_.hasDelays() && near_floor && !acquiring && t - t_last_descent_ < kLandingWindow_s) {
+  } else if (floor_anchors_.hasDelays() && !acquiring && t - t_last_descent_ < kLandingWindow_s &&
+             ekf_.state().w_p_b.z() - params_.ground_z_m < kLandingBand_m) {
     // (F16h) near the floor after a descent (a landing): the delay or none, whichever the TDoA lies nearer to
     const Moments3* a = anchors_.find(z.id_a);
     const Moments3* b = anchors_.find(z.id_b);
