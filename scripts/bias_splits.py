@@ -21,7 +21,9 @@ With --calibration, instead of the filters: `uwbtdoa predict-bias TEST --model M
 distribution of the bias (docs/math/gp.md P43) on each test flight; per split the 1σ and 2σ coverage (nominal 68.3 and
 95.4 %; mean, lowest, highest over the pairs) and the mean NLPD.
 
-Usage: scripts/bias_splits.py [BUILD_DIR] [--calibration | --pairs]   (data: $UWBTDOA_DATA or ../shared/data)
+With --with="FLAGS", every run with a model gets these localize flags too (e.g. --with="--bias-guard").
+
+Usage: scripts/bias_splits.py [BUILD_DIR] [--calibration | --pairs] [--with="FLAGS"]   (data: $UWBTDOA_DATA or ../shared/data)
 """
 import json
 import os
@@ -30,7 +32,9 @@ import subprocess
 import sys
 import tempfile
 
-ARGS = [a for a in sys.argv[1:] if a not in ("--calibration", "--pairs")]
+ARGS = [a for a in sys.argv[1:] if a not in ("--calibration", "--pairs") and not a.startswith("--with=")]
+# --with="FLAGS": more localize flags for every run with a model (e.g. --with="--bias-guard")
+WITH = [f for a in sys.argv[1:] if a.startswith("--with=") for f in a[len("--with="):].split()]
 CALIBRATION = "--calibration" in sys.argv[1:]
 PAIRS = "--pairs" in sys.argv[1:]
 BUILD = ARGS[0] if ARGS else "build"
@@ -125,8 +129,8 @@ def main():
                 if test not in base:
                     base[test] = (rmse(test, PLAIN), rmse(test, []))
                 plain, online = base[test]
-                offline = rmse(test, PLAIN + ["--bias-model", cache[key]])
-                run = localize(test, ["--bias-model", cache[key]])
+                offline = rmse(test, PLAIN + ["--bias-model", cache[key], *WITH])
+                run = localize(test, ["--bias-model", cache[key], *WITH])
                 both = run["rmse_airborne_m"]
                 if PAIRS:
                     trained = train_set[0] if len(train_set) == 1 else f"{len(train_set)} flights"

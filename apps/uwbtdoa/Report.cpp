@@ -38,7 +38,8 @@ void EvaluationCliOptions::addTo(CLI::App& sub) {
                "(docs/math/gp.md P45)");
   sub.add_flag("--bias-guard", bias_guard,
                "Corrected runs mix the corrected and the uncorrected filter by their TDoA predictive likelihood "
-               "(docs/math/filter.md F24)");
+               "(docs/math/filter.md F24); --bias-guard=false: the corrected filter alone")
+      ->capture_default_str();
   sub.add_flag("--json", json, "Print one JSON object (results and paths) on stdout");
 }
 

@@ -24,7 +24,7 @@ struct EvaluationCliOptions {
   std::string inputs = "estimate";  ///< GP inputs of the training data: "estimate" (filter) or "truth"
   bool no_plots = false;
   bool full_variance = false;  ///< the models ask the filter for the scaled TDoA variance (docs/math/gp.md P45)
-  bool bias_guard = false;  ///< corrected runs with the bias guard (docs/math/filter.md F24)
+  bool bias_guard = EkfParams{}.bias_guard;  ///< corrected runs with the bias guard (docs/math/filter.md F24)
   bool json = false;
   std::string out_dir;
   void addTo(CLI::App& sub);

@@ -104,10 +104,13 @@ struct LocalizeArgs {
 uwb::Flight windowed(uwb::Flight flight, const std::vector<double>& window, const std::string& path) {
   if (window.empty()) return flight;
   const double t0 = window.at(0), t1 = window.at(1);
-  if (!std::isfinite(t0) || !std::isfinite(t1) || !(t0 < t1))
-    throw uwb::InputError(fmt::format("--window T0,T1 needs finite stamps with T0 < T1, got {},{}", t0, t1));
   const auto [first, last] = flight.timeSpan();
-  uwb::Flight cut = uwb::sliceFlight(flight, t0, t1);
+  uwb::Flight cut;
+  try {
+    cut = uwb::sliceFlight(flight, t0, t1);
+  } catch (const std::invalid_argument& e) {
+    throw uwb::InputError(fmt::format("--window T0,T1: {}", e.what()));
+  }
   if (cut.tdoa.empty()) {
     throw uwb::InputError(fmt::format("--window {},{} holds no TDoA of {} (its streams span {:.3f} to {:.3f} s)", t0,
                                       t1, path, first, last));

@@ -715,7 +715,7 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     // (F16h) near the floor after a descent (a landing): the delay or none, whichever the TDoA lies nearer to
     const Moments3* a = anchors_.find(z.id_a);
     const Moments3* b = anchors_.find(z.id_b);
-    if (a && b) {
+    if (a && b && floor_anchors_.pairDelay(z.id_a, z.id_b) != 0.0) {  // a pair without floor-level anchors: no delay
       const NavState& x = ekf_.state();
       const double r = zc.tdoa_m - predictTdoa(x.w_p_b, x.w_q_b, params_.b_t_tag, a->m, b->m);
       zc.tdoa_m -= floor_anchors_.nearerPairDelay(z.id_a, z.id_b, r);

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 namespace uwb {
 namespace {
 
@@ -20,8 +22,8 @@ std::vector<T> window(const std::vector<T>& in, double t0_s, double t1_s) {
 }  // namespace
 
 Flight sliceFlight(const Flight& flight, double t0_s, double t1_s) {
-  if (!(std::isfinite(t0_s) && std::isfinite(t1_s) && t0_s <= t1_s))
-    throw std::invalid_argument("sliceFlight: the window must be finite with t0 <= t1");
+  if (!(std::isfinite(t0_s) && std::isfinite(t1_s) && t0_s < t1_s))
+    throw std::invalid_argument(fmt::format("a window needs finite stamps with t0 < t1, got {},{}", t0_s, t1_s));
   Flight out;
   out.tdoa = window(flight.tdoa, t0_s, t1_s);
   out.twr = window(flight.twr, t0_s, t1_s);

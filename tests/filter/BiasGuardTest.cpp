@@ -93,11 +93,11 @@ TEST(BiasGuard, LocalizerUsesTheGuardOnlyWithABiasModelAndWhenOn) {
   const AnchorTable anchors = filtertest::arenaAnchors();
   const Vec3& p = kHoverPosition;
   const SensorLog log = hoverLog(4);
-  EkfParams off;
-  off.ground_phase = GroundPhase::kNone;
-  EXPECT_FALSE(off.bias_guard);  // off by default (F24)
-  EkfParams on = off;
-  on.bias_guard = true;
+  EkfParams on;
+  on.ground_phase = GroundPhase::kNone;
+  EXPECT_TRUE(on.bias_guard);  // on by default (F24)
+  EkfParams off = on;
+  off.bias_guard = false;
   // WHEN localizing without a model, with the model unguarded and guarded
   const LocalizerResult plain = TdoaLocalizer(on, anchors).run(log);
   const LocalizerResult unguarded = TdoaLocalizer(off, anchors, offsetPredictor(-1.0)).run(log);

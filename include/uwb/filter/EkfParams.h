@@ -132,9 +132,11 @@ struct EkfParams {
   double descent_margin_m = 0.0;
   double max_rejection_rate = 0.7;       ///< more TDoA rejected in flight (0.3 s memory) → re-acquire (F16d); 1: off
   /// With a bias model: run the uncorrected filter beside the corrected one and output their mixture, weighted by
-  /// how well each predicted the recent TDoA (F24). Off by default: it halves the worst loss of a model that does not
-  /// transfer, but also gives up part of the gain of one that does (docs/math/filter.md F24).
-  bool bias_guard = false;
+  /// how well each predicted the recent TDoA (F24). On by default: with the range-bias states (F27) it keeps a model
+  /// that does not transfer from making the flight worse (chosen on the 0426 splits for "never worse than
+  /// uncorrected", reported on 0425), at the price of part of the gain of a model that does and of a second filter
+  /// (docs/math/filter.md F24).
+  bool bias_guard = true;
   double bias_guard_tau_s = 10.0;        ///< memory of the F24 predictive-likelihood comparison [s]
   /// With a bias model: how the pose uncertainty of µ(x̂) enters (docs/math/gp.md P47). Off by default: neither form
   /// improved the leave-one-session-out splits (P47).

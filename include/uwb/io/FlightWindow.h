@@ -9,7 +9,8 @@
 namespace uwb {
 
 /// The samples of every stream of `flight` with t0_s ≤ t ≤ t1_s; stamps are kept (not shifted). Throws
-/// std::invalid_argument when t0_s > t1_s or either is not finite.
+/// std::invalid_argument unless both are finite and t0_s < t1_s (the one check of a window, for
+/// the CLI's --window and Python's Flight.window as well).
 Flight sliceFlight(const Flight& flight, double t0_s, double t1_s);
 
 }  // namespace uwb
