@@ -224,6 +224,7 @@ void runLocalize(const LocalizeArgs& a) {
   j["n_floor_updates"] = s.n_floor_updates;
   j["n_descent_bound_updates"] = s.n_descent_bound_updates;
   j["n_rest_periods"] = s.n_rest_periods;
+  j["n_landing_fixes"] = s.n_landing_fixes;
   j["n_time_jumps"] = s.n_time_jumps;
   j["reacquisition_t_s"] = s.reacquisition_t_s;
   j["reacquired_t_s"] = s.reacquired_t_s;

@@ -100,6 +100,8 @@ constexpr double kLowFlight_m = 0.25;
 /// [m]: the low-flight band (kLowFlight_m) and the height by which the estimate trails a descent at the touchdown
 /// (0.1–0.3 m on the simulated and real landings)
 constexpr double kLandingBand_m = 0.5;
+/// (F16i) a landing's floor window ends without a fix after this long [s] (StartUp keeps 3 s of history)
+constexpr double kLandingFixMax_s = 3.0;
 /// Std of the height message that enforces the descent bound (F26) [m].
 constexpr double kDescentBoundSigma_m = 0.05;
 /// Constant time of the take-off detector's leaky vertical-velocity integrator [s] (F15).
@@ -237,6 +239,7 @@ void Estimator::initialize(double t_s, const Vec3& acc_mean_b, bool moving) {
 }
 
 void Estimator::startAcquisition(double t_s, bool reacquisition) {
+  landing_fix_ = false;  // the window begun here replaces a landing's (F16i)
   phase_ = FlightPhase::kAcquisition;
   descent_.clear();
   climb_.clear();
@@ -338,6 +341,7 @@ void Estimator::handleTimeJump(double t_s, double gap_s) {
   replay_.stop();  // (F16g) the record holds predictions and TDoA only
   descent_.clear();
   climb_.clear();
+  endLandingFix();  // (F16i) the window's stamps no longer follow
   propagate(true);
   acc_sum_.setZero();
   gyro_sum_.setZero();
@@ -353,6 +357,7 @@ void Estimator::handleTimeJump(double t_s, double gap_s) {
 
 void Estimator::leaveGround(double t_s, bool climbing) {
   on_ground_ = false;
+  endLandingFix();  // (F16i) the window holds the body at rest on the floor only
   replay_.stop();  // (F16g) the record holds predictions and TDoA only
   descent_.clear();  // (F26) the climb is not dead-reckoned from the floor: the detector's climb speed lags
   // (F16f) leaving rest (motors off) without a detected climb, the body still sits on the floor (rotors spun up
@@ -399,6 +404,34 @@ void Estimator::enterGround(double t_s) {
   if (moved_) summary_.landing_t_s = t_s;
   if (imu_mode_ && rest_.atRest()) ekf_.setAccelModel(params_.ground_accel_model);  // (F15) levelled from all axes
   if (ready_ && phase_ != FlightPhase::kAcquisition) phase_ = moved_ ? FlightPhase::kLanded : FlightPhase::kGround;
+  // (F16i) a landing of a log that has not seen the floor yet (begun in the air): the floor's delays and the
+  // position are solved from a window on the floor as at a start on the floor (F16f), and the solution is fused with
+  // the estimate. A log begun on the floor keeps the delays of its start (F16h uses them at every landing).
+  if (moved_ && ready_ && imu_mode_ && params_.floor_constraint && floor_anchors_.any() &&
+      !floor_anchors_.hasDelays() && !start_.active() &&
+      phase_ != FlightPhase::kAcquisition) {
+    start_.begin(t_s, ekf_.state(), false, true);
+    landing_fix_ = true;
+    t_landing_fix_s_ = t_s;
+  }
+}
+
+void Estimator::endLandingFix() {
+  if (landing_fix_) start_.cancel();
+  landing_fix_ = false;
+}
+
+void Estimator::finishLandingFix(const StartFix& fix) {
+  landing_fix_ = false;
+  // only a solve with the delays: the plain floor solve takes metres of floor-level delay for position (F16f)
+  if (fix.anchor_delay_m.empty()) return;
+  floor_anchors_.setDelays(fix.anchor_delay_m);
+  // the horizontal position held through the touchdown absorbed the floor-level TDoA (no delays to take them with,
+  // F16h): its variance grows as for a take-off from rest (F20) before the floor's solve corrects it
+  ekf_.inflateHorizontalPosition(params_.leave_rest_pos_sigma_m, 0.0);
+  ekf_.positionUpdate(0, fix.w_p_b.x(), std::sqrt(fix.cov(0, 0)));
+  ekf_.positionUpdate(1, fix.w_p_b.y(), std::sqrt(fix.cov(1, 1)));
+  ++summary_.n_landing_fixes;
 }
 
 void Estimator::applyFloorConstraint(bool on_ground) {
@@ -676,6 +709,8 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   // (F17) the nominal state is brought to the measurement time only when it lags by more than update_predict_dt_s
   if (!imu_mode_ || t - t_pred_ >= params_.update_predict_dt_s) predictTo(t);
 
+  // (F16i) a landing's floor window that finds no fix within kLandingFixMax_s ends: the TDoA are used again
+  if (landing_fix_ && t - t_landing_fix_s_ > kLandingFixMax_s) endLandingFix();
   if (start_.active()) {
     // (F16) collecting the multilateration batch; the displacement comes from the prediction
     ++summary_.n_tdoa_start;
@@ -685,7 +720,8 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     if (replay_.recording()) replay_.recordTdoa(z);
     if (const std::optional<StartFix> fix = start_.add(z, ekf_.state(), floor_z)) {
       propagate(true);
-      finishStart(t, *fix);
+      if (landing_fix_) finishLandingFix(*fix);
+      else finishStart(t, *fix);
     } else if (replay_.recording() && start_.referenceTime() != replay_.referenceTime()) {
       replay_.begin(ekf_, start_.referenceTime());  // (F16b) a failed solve moved the reference to now
     }

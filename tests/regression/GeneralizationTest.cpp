@@ -204,7 +204,25 @@ TEST(Generalization, SimulatedLandingsAreNotPulledAwayByTheFloorLevelAnchors) {
     ASSERT_TRUE(run.metrics);
     EXPECT_LT(run.metrics->whole.max_m, 0.8);
     EXPECT_LT(run.metrics->airborne.rmse_m, 0.2);
+    EXPECT_EQ(run.summary.n_landing_fixes, 0u);  // the start on the floor found the delays (F16i is not needed)
   }
+}
+
+TEST(Generalization, SimulatedLogBegunInTheAirLearnsTheFloorAtItsLanding) {
+  // GIVEN a simulated zigzag (paper anchors, seed 9) logged from 12 s, in the air, to its end on the floor: the log
+  // never saw the floor before, so it knows no floor-level delays, and the landing's TDoA carry them (S18, metres)
+  const sim::SimResult s = sim::simulateFlight(sim::makeScenario(sim::paperAnchors(), sim::TrajectoryShape::kZigzag, 40.0),
+                                               sim::SimParams{}, 9);
+  const Flight cut = sliceFlight(s.flight, 12.0, s.flight.timeSpan().second);
+  // WHEN localizing it with the defaults
+  const LocalizationRun run = localizeFlight(cut, s.survey);
+  // THEN at the rest after the landing the floor's delays and position are solved as at a start on the floor and fused
+  // (F16i): the whole log's RMSE stays near the airborne one (0.40 m whole, 1.8 m largest error; without F16i the
+  // position on the floor stayed where the touchdown's TDoA had pulled it: 0.87 m whole, 2.5 m largest)
+  ASSERT_TRUE(run.metrics);
+  EXPECT_EQ(run.summary.n_landing_fixes, 1u);
+  EXPECT_LT(run.metrics->whole.rmse_m, 0.55);
+  EXPECT_LT(run.metrics->airborne.rmse_m, 0.3);
 }
 
 TEST(Generalization, SimulatedImuLoggedAt100HzWithAStillHover) {

@@ -93,6 +93,7 @@ struct LocalizerSummary {
   std::size_t n_floor_updates = 0;     ///< floor constraint applied (F22)
   std::size_t n_descent_bound_updates = 0;  ///< height held down to the dead-reckoned descent while landing (F26)
   std::size_t n_rest_periods = 0;      ///< times the body came to rest
+  std::size_t n_landing_fixes = 0;     ///< floor solves at the first landing of a log begun in the air (F16i)
   std::size_t n_rejection_faults = 0; ///< re-acquisitions because most TDoA were rejected (F16d)
   std::size_t n_reverted_motion = 0;  ///< of them, with the state put back to the motion before the fault (F16d)
   bool start_replayed = false;         ///< the first start in motion ran the filter again from its fix (F16g)
@@ -184,6 +185,8 @@ class Estimator {
   void enterGround(double t_s);
   void startAcquisition(double t_s, bool reacquisition);
   void finishStart(double t_s, const StartFix& fix);
+  void finishLandingFix(const StartFix& fix);
+  void endLandingFix();
   /// F16d: position and velocity back to the recent motion recorded before a TDoA fault.
   void revertToHealthyMotion(double t_s);
   void applyFloorConstraint(bool on_ground);
@@ -233,6 +236,8 @@ class Estimator {
   std::array<double, 60> low_z_{};  ///< recent heights, one per 50 ms, the last 3 s (F18)
   std::size_t i_low_z_ = 0, n_low_z_ = 0;
   double t_low_z_sample_ = -1e300;
+  bool landing_fix_ = false;     ///< start_ collects the floor window of a landing (F16i)
+  double t_landing_fix_s_ = 0.0;  ///< when that window began
   bool moved_ = false;
   FlightPhase phase_ = FlightPhase::kAcquisition;
   double t_last_event_ = std::numeric_limits<double>::quiet_NaN();
