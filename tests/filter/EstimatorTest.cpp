@@ -405,6 +405,7 @@ TEST(Estimator, ABiasModelOfAMoreBiasedFlightIsScaledDownByThisFlightsLevel) {
   };
   EkfParams scaled = lateralFullParams();
   scaled.bias_model_training_level_m = 0.5;
+  scaled.bias_guard = false;  // the corrected filter alone: the scaling (F24b) without the guard (F24) beside it
   EkfParams off = scaled;
   off.bias_model_level_exponent = 0.0;
   EkfParams unknown = scaled;
