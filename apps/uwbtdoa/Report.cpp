@@ -37,9 +37,10 @@ void EvaluationCliOptions::addTo(CLI::App& sub) {
                "Corrected measurements get the TDoA variance scaled by (var_f + noise)/E[eps^2] instead of R + var_f "
                "(docs/math/gp.md P45)");
   sub.add_flag("--bias-guard", bias_guard,
-               "Corrected runs mix the corrected and the uncorrected filter by their TDoA predictive likelihood "
-               "(docs/math/filter.md F24); --bias-guard=false: the corrected filter alone")
-      ->capture_default_str();
+               fmt::format("Corrected runs mix the corrected and the uncorrected filter by their TDoA predictive "
+                           "likelihood (docs/math/filter.md F24); --bias-guard=false: the corrected filter alone "
+                           "(default {})",
+                           bias_guard));
   sub.add_flag("--json", json, "Print one JSON object (results and paths) on stdout");
 }
 
