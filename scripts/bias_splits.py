@@ -2,7 +2,8 @@
 """The bias-correction splits of docs/math/filter.md F24 and F27: does a GP model of other flights help the filter on a
 flight it was not trained on, with and without the range-bias states learned online (F27)?
 
-Splits (util-pilot TDoA2 flights; a model is `uwbtdoa train TRAIN... --kernel tdoa --inducing 30`):
+Splits (util-pilot TDoA2 flights; a model is `uwbtdoa train TRAIN... --kernel tdoa --inducing 30`, or the kernel and M
+given by --kernel=K --inducing=M):
   0426 1->1   a model of one 0426 flight on each other 0426 flight (12 pairs)
   0426 LOO    each 0426 flight with a model of the three others (4)
   0425->0426  a model of the 12 TDoA2 flights of 0425 on each 0426 flight (4)
@@ -23,7 +24,7 @@ distribution of the bias (docs/math/gp.md P43) on each test flight; per split th
 
 With --with="FLAGS", every run with a model gets these localize flags too (e.g. --with="--bias-guard").
 
-Usage: scripts/bias_splits.py [BUILD_DIR] [--calibration | --pairs] [--with="FLAGS"]   (data: $UWBTDOA_DATA or ../shared/data)
+Usage: scripts/bias_splits.py [BUILD_DIR] [--calibration | --pairs] [--with="FLAGS"] [--kernel=K] [--inducing=M]   (data: $UWBTDOA_DATA or ../shared/data)
 """
 import json
 import os
@@ -32,9 +33,13 @@ import subprocess
 import sys
 import tempfile
 
-ARGS = [a for a in sys.argv[1:] if a not in ("--calibration", "--pairs") and not a.startswith("--with=")]
+OPTS = ("--with=", "--kernel=", "--inducing=")
+ARGS = [a for a in sys.argv[1:] if a not in ("--calibration", "--pairs") and not a.startswith(OPTS)]
 # --with="FLAGS": more localize flags for every run with a model (e.g. --with="--bias-guard")
 WITH = [f for a in sys.argv[1:] if a.startswith("--with=") for f in a[len("--with="):].split()]
+# --kernel=K, --inducing=M: the model trained for every split (default the paper's tdoa kernel with M = 30)
+KERNEL = next((a[len("--kernel="):] for a in sys.argv[1:] if a.startswith("--kernel=")), "tdoa")
+INDUCING = next((a[len("--inducing="):] for a in sys.argv[1:] if a.startswith("--inducing=")), "30")
 CALIBRATION = "--calibration" in sys.argv[1:]
 PAIRS = "--pairs" in sys.argv[1:]
 BUILD = ARGS[0] if ARGS else "build"
@@ -56,8 +61,8 @@ def survey(session):
 
 def train(names, out):
     session = names[0][:4]
-    subprocess.run([CLI, "train", *map(path, names), "--anchors", survey(session), "--kernel", "tdoa", "--inducing",
-                    "30", "--out", out], check=True, capture_output=True)
+    subprocess.run([CLI, "train", *map(path, names), "--anchors", survey(session), "--kernel", KERNEL, "--inducing",
+                    INDUCING, "--out", out], check=True, capture_output=True)
 
 
 def localize(name, flags):
