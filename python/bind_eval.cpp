@@ -134,6 +134,9 @@ EkfParams ekfParams(const std::string& preset, const py::dict& overrides) {
 
 BiasDatasetParams datasetParams(const py::kwargs& kw) {
   BiasDatasetParams p;
+  // GP inputs from the uncorrected filter's estimate unless inputs='truth', as `uwbtdoa train` and `evaluate` do: the
+  // model then sees at training the pose error it will see at run time (eval/BiasDataset.h, BiasInputSource).
+  p.inputs = BiasInputSource::kFilterEstimate;
   for (const auto& [key, value] : kw) {
     const std::string n = py::str(key);
     if (n == "b_t_tag") p.b_t_tag = row3(toMatrix(value, 3, "b_t_tag"), 0);
@@ -298,7 +301,8 @@ void bindEval(py::module_& m) {
       py::arg("flights"), py::arg("survey"),
       "Training data from flights with ground-truth pose and orientation. Keyword arguments override\n"
       "BiasDatasetParams (min_z_m, glitch_margin_s, max_abs_error_m, neighbour_pairs_only, b_t_tag, "
-      "inputs='truth'|'estimate': GP inputs from the ground truth or from the uncorrected filter).");
+      "inputs='estimate'|'truth': GP inputs from the uncorrected filter (the default, as the CLI's train) or from the "
+      "ground truth).");
 
   m.def("bias_preset_names", &BiasPreset::names, "Bias-model presets: z1, z2, tdoa (paper) and extras.");
   m.def(

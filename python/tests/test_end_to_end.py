@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import uwbtdoa as u
+from conftest import pilot_flight, pilot_survey
 
 
 @pytest.fixture(scope="module")
@@ -183,3 +184,19 @@ def test_run_evaluation_writes_the_report_and_renders_its_figures(flights, tmp_p
                  "fig6_error_distribution.png", "trajectory_circle.png"):
         assert (tmp_path / name).is_file(), name
     assert "fig5_improvement.png" in (tmp_path / "REPORT.md").read_text()
+
+
+def test_the_default_training_pipeline_corrects_a_real_flight_it_was_not_trained_on():
+    """build_bias_dataset and train_bias_model with their defaults (GP inputs from the filter's estimate, the
+    pair-tdoa-pos preset with M = 30: what `uwbtdoa train` writes, docs/math/gp.md P26c) on the sine flights
+    0425-traj6…9; the model takes the circle flight 0425-traj2 well below the uncorrected filter, as the CLI's does."""
+    survey = u.read_anchor_survey(str(pilot_survey("0425")))
+    train = [u.read_flight_csv(str(pilot_flight(f"0425-traj{i}"))) for i in (6, 7, 8, 9)]
+    test = u.read_flight_csv(str(pilot_flight("0425-traj2")))
+    model, report = u.train_bias_model(u.build_bias_dataset(train, survey), seed=1)
+    assert model.preset == "pair-tdoa-pos" and len(model.entries) > 1
+    # the dataset carried the training flights' bias level as the filter measured it (filter.md F24b)
+    assert model.training_bias_level_m > 0.1
+    before = u.localize_flight(test, survey)["metrics"]["airborne"]["rmse_m"]
+    after = u.localize_flight(test, survey, bias_model=model)["metrics"]["airborne"]["rmse_m"]
+    assert after < 0.9 * before, (before, after)
