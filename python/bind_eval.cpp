@@ -419,7 +419,8 @@ void bindEval(py::module_& m) {
         }
         return py::make_tuple(std::move(model), trainReportDict(report));
       },
-      py::arg("dataset"), py::arg("preset") = "pair-tdoa-pos", py::arg("num_inducing") = 30, py::arg("holdout_fraction") = 0.2,
+      py::arg("dataset"), py::arg("preset") = std::string(kDefaultTrainPreset),
+      py::arg("num_inducing") = BiasTrainParams{}.num_inducing, py::arg("holdout_fraction") = 0.2,
       py::arg("holdout_block_s") = 5.0, py::arg("progress") = py::none(),
       "Trains the preset's GP(s) on the dataset (time blocks held out). Keyword arguments: SVGP training\n"
       "parameters (epochs, batch_size, seed, lr, ...). Returns (BiasModel, report {n_train, n_holdout,\n"

@@ -31,10 +31,8 @@ using nlohmann::json;
 
 struct TrainOptions {
   std::vector<std::string> flights;
-  // Defaults: the kernel and M that transferred best to flights outside the training set (docs/math/gp.md P26c:
-  // chosen on the splits tested on 0426, reported on those tested on 0425); the paper's kernels by --kernel.
-  std::string anchors, kernel = "pair-tdoa-pos", out, inputs = "estimate";
-  int inducing = 30, epochs = 20, batch = 1024, passes = 1, threads = 0;
+  std::string anchors, kernel = uwb::kDefaultTrainPreset, out, inputs = "estimate";
+  int inducing = uwb::BiasTrainParams{}.num_inducing, epochs = 20, batch = 1024, passes = 1, threads = 0;
   std::string dump_arrays;
   std::uint64_t seed = 1;
   double lr = 0.01, lr_inducing = 0.01, natgrad = 0.2, holdout = 0.2, extra_sigma = uwb::BiasTrainParams{}.extra_sigma_m;

@@ -77,6 +77,11 @@ struct PredictiveShape {
   void validate() const;
 };
 
+/// The preset the front ends (`uwbtdoa train`, Python's train_bias_model) train unless told otherwise, with
+/// BiasTrainParams::num_inducing: the model that transferred best to flights outside the training set (docs/math/
+/// gp.md P26c). BiasTrainParams itself keeps the paper's z1.
+inline constexpr const char* kDefaultTrainPreset = "pair-tdoa-pos";
+
 struct BiasTrainParams {
   std::string preset = "z1";
   int num_inducing = 30;            ///< M (per GP)
