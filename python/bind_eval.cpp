@@ -190,6 +190,7 @@ py::dict summaryDict(const LocalizerSummary& s) {
   d["n_predictions"] = s.n_predictions, d["n_covariance_propagations"] = s.n_covariance_propagations;
   d["n_reacquisitions"] = s.n_reacquisitions, d["n_rejection_faults"] = s.n_rejection_faults;
   d["n_reverted_motion"] = s.n_reverted_motion, d["start_replayed"] = s.start_replayed;
+  d["start_floor_refuted"] = s.start_floor_refuted;
   d["n_heading_alignments"] = s.n_heading_alignments;
   d["heading_alignment_t_s"] = s.heading_alignment_t_s;
   d["heading_alignment_change_rad"] = s.heading_alignment_change_rad;

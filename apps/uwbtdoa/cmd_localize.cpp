@@ -234,6 +234,8 @@ void runLocalize(const LocalizeArgs& a) {
   j["n_rejection_faults"] = s.n_rejection_faults;
   j["n_reverted_motion"] = s.n_reverted_motion;
   j["start_replayed"] = s.start_replayed;
+  j["start_floor_refuted"] = s.start_floor_refuted;
+  j["start_rms_residual_m"] = s.start_rms_residual_m;
   j["n_heading_alignments"] = s.n_heading_alignments;
   j["heading_alignment_t_s"] = s.heading_alignment_t_s;
   j["heading_alignment_change_rad"] = s.heading_alignment_change_rad;

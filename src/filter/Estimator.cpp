@@ -255,6 +255,13 @@ void Estimator::startAcquisition(double t_s, bool reacquisition) {
 }
 
 void Estimator::finishStart(double t_s, const StartFix& fix) {
+  if (fix.floor_refuted && on_ground_) {
+    // (F16j) the ground evidence before the first fix (a shaking burst or a quiet stretch in flight) is refuted by the
+    // TDoA: the body is in the air and never was on the floor; the fix is the solve in motion of the same window
+    leaveGround(t_s, false);
+    summary_.takeoff_t_s = std::numeric_limits<double>::quiet_NaN();
+    summary_.start_floor_refuted = true;
+  }
   // (F16g) in motion, the filter runs again over the window from the fix's starting point; otherwise (on the floor,
   // a re-acquisition, or a window not recorded whole) the fix becomes the state now (F16b)
   const bool replayed =
@@ -394,6 +401,7 @@ void Estimator::leaveGround(double t_s, bool climbing) {
 
 void Estimator::enterGround(double t_s) {
   on_ground_ = true;
+  t_entered_ground_ = t_s;
   replay_.stop();  // (F16g) the record holds predictions and TDoA only
   descent_.clear();
   climb_.clear();
@@ -718,7 +726,9 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     const std::optional<double> floor_z =
         on_ground_ && params_.floor_constraint ? std::optional<double>(params_.ground_z_m) : std::nullopt;
     if (replay_.recording()) replay_.recordTdoa(z);
-    if (const std::optional<StartFix> fix = start_.add(z, ekf_.state(), floor_z)) {
+    // (F16j) floor contact before the first fix may be refuted by the TDoA; rest (motors off) is not
+    const bool floor_refutable = floor_z && !ready_ && t_last_rest_ < t_entered_ground_;
+    if (const std::optional<StartFix> fix = start_.add(z, ekf_.state(), floor_z, floor_refutable)) {
       propagate(true);
       if (landing_fix_) finishLandingFix(*fix);
       else finishStart(t, *fix);

@@ -29,7 +29,8 @@ void StartUp::begin(double t_s, const NavState& x_ref, bool moving, bool reacqui
   samples_.clear();
 }
 
-std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x_now, std::optional<double> floor_z_m) {
+std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x_now, std::optional<double> floor_z_m,
+                                     bool floor_refutable) {
   if (!active_) return std::nullopt;
   // (F16b) displacement since t_ref from the prediction, without the reference velocity (that is v0's part)
   MultilaterationSample s;
@@ -39,13 +40,22 @@ std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x
   if (samples_.size() < samples_.capacity()) samples_.push_back(s);
   if (!(z.t_s - t_try_ >= params_.window_s && samples_.size() >= params_.min_samples)) return std::nullopt;
 
-  const bool moving = moving_ && !floor_z_m;
+  bool moving = moving_ && !floor_z_m;
+  bool floor_refuted = false;
   std::optional<MultilaterationResult> r;
   if (floor_z_m) {
     // (F16f) with floor-level anchors, their delays are solved for; without 3 other anchors in view, the plain solve
     if (!floor_level_.empty())
       r = multilaterateOnFloorWithDelays(samples_, anchors_, b_t_tag_, guesses_, *floor_z_m, floor_level_);
     if (!r) r = multilaterateOnFloor(samples_, anchors_, b_t_tag_, guesses_, *floor_z_m);
+    // (F16j) at the first start, floor contact (F18) is tested against the TDoA
+    if (r && floor_refutable && !reacquisition_) {
+      if (std::optional<MultilaterationResult> in_air = refuteFloor(*r, *floor_z_m, z.t_s)) {
+        r = in_air;
+        moving = floor_refuted = true;
+        floor_z_m.reset();
+      }
+    }
   } else {
     r = moving ? multilaterateMoving(samples_, anchors_, b_t_tag_, guesses_, t_ref_)
                : multilaterate(samples_, anchors_, b_t_tag_, guesses_);
@@ -69,6 +79,7 @@ std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x
   }
   StartFix fix;
   fix.with_velocity = moving;
+  fix.floor_refuted = floor_refuted;
   fix.w_p0 = r->w_p0;
   fix.w_v0 = moving ? r->w_v0 : x_ref_.w_v_b;
   fix.t_ref_s = t_ref_;
@@ -101,6 +112,28 @@ std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x
   active_ = false;
   samples_.clear();
   return fix;
+}
+
+std::optional<MultilaterationResult> StartUp::refuteFloor(const MultilaterationResult& on_floor, double floor_z_m,
+                                                          double t_now_s) const {
+  // (F16j) On a floor the floor-level TDoA bias puts the free solve metres off, mostly above the room (util-pilot:
+  // z = 3.6…10 m, RMS residual 1.2…2.3 times the floor solve's). A body in the air is where the free solve says,
+  // inside the anchors' box, and the floor solve fits it only with invented delays. A window that holds a take-off
+  // (the body still near the floor at one end) is not refuted: the take-off detector (F15) restarts it in motion.
+  const std::optional<MultilaterationResult> free = multilaterate(samples_, anchors_, b_t_tag_, guesses_);
+  if (!free) return std::nullopt;
+  const Vec3& p = free->w_p0;
+  const bool inside = (p.head<2>().array() >= box_min_.head<2>().array() - params_.box_margin_m).all() &&
+                      (p.head<2>().array() <= box_max_.head<2>().array() + params_.box_margin_m).all() &&
+                      p.z() <= box_max_.z();
+  if (!inside || p.z() - floor_z_m < params_.floor_refute_height_m ||
+      free->rms_residual_m > params_.floor_refute_residual_ratio * on_floor.rms_residual_m)
+    return std::nullopt;
+  std::optional<MultilaterationResult> moving = multilaterateMoving(samples_, anchors_, b_t_tag_, guesses_, t_ref_);
+  if (!moving) return std::nullopt;
+  const double z_first = moving->w_p0.z(), z_last = z_first + (t_now_s - t_ref_) * moving->w_v0.z();
+  if (std::min(z_first, z_last) - floor_z_m < params_.floor_refute_height_m) return std::nullopt;
+  return moving;
 }
 
 }  // namespace uwb

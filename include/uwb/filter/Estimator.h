@@ -97,6 +97,7 @@ struct LocalizerSummary {
   std::size_t n_rejection_faults = 0; ///< re-acquisitions because most TDoA were rejected (F16d)
   std::size_t n_reverted_motion = 0;  ///< of them, with the state put back to the motion before the fault (F16d)
   bool start_replayed = false;         ///< the first start in motion ran the filter again from its fix (F16g)
+  bool start_floor_refuted = false;    ///< the first start's ground evidence was refuted by its TDoA (F16j)
   /// (F28) attitude resets by the heading alignment: their times (the first 100) and heading changes [rad]
   std::size_t n_heading_alignments = 0;
   std::vector<double> heading_alignment_t_s, heading_alignment_change_rad;
@@ -232,6 +233,7 @@ class Estimator {
   double g_ref_ = kGravity_mps2; ///< vertical specific force on the ground [m/s²]
   double t_last_shake_ = -1e300, t_shake_since_ = 0.0, t_left_ground_ = -1e300;
   double t_last_rest_ = -1e300;  ///< last IMU sample at rest (F18)
+  double t_entered_ground_ = -1e300;  ///< the ground phase began (F18)
   double t_last_descent_ = -1e300;  ///< last IMU sample with the estimate descending (F18)
   std::array<double, 60> low_z_{};  ///< recent heights, one per 50 ms, the last 3 s (F18)
   std::size_t i_low_z_ = 0, n_low_z_ = 0;

@@ -23,6 +23,9 @@ struct StartFix {
   double t_ref_s = 0.0;        ///< the reference instant: start of the collection, or its last move (F16b) [s]
   double rms_residual_m = 0.0;
   bool with_velocity = false;
+  /// (F16j) the start was to be on the floor (ground evidence before the first fix), but the TDoA put the body in the
+  /// air: the fix is the solve in motion of the same window, and the ground evidence is refuted
+  bool floor_refuted = false;
   /// (F16f) a fix on the floor: the range delay of each floor-level anchor, by anchor id (NaN: none found) [m]
   std::vector<double> anchor_delay_m;
 };
@@ -38,6 +41,11 @@ struct StartUpParams {
   /// … and, in a re-acquisition, one whose robustly weighted RMS residual is above this [m]: the TDoA do not agree on
   /// any position (garbage, a radio fault); the filter keeps predicting and the next window is tried
   double max_rms_residual_m = 1.0;
+  /// (F16j) a first start on floor contact is refuted when the free solve of its window lies inside the anchors' box and
+  /// the solve in motion keeps the body at least this high above the floor over the whole window [m] …
+  double floor_refute_height_m = 1.2;
+  /// … with an RMS residual at most this many times the floor solve's
+  double floor_refute_residual_ratio = 1.5;
 };
 
 class StartUp {
@@ -55,11 +63,17 @@ class StartUp {
   void cancel() { active_ = false; samples_.clear(); }
   /// Adds a TDoA taken while the filter's predicted state is x_now; returns the fix when a solve succeeds (the
   /// collection then ends). floor_z_m: the body sits on the floor now (ground evidence, F18) at this height of its
-  /// origin, so the solve is over x and y (F16c).
+  /// origin, so the solve is over x and y (F16c). floor_refutable: that evidence may be refuted by the TDoA (F16j: floor
+  /// contact before the first fix, not rest).
   std::optional<StartFix> add(const TdoaObservation& z, const NavState& x_now,
-                              std::optional<double> floor_z_m = std::nullopt);
+                              std::optional<double> floor_z_m = std::nullopt, bool floor_refutable = false);
 
  private:
+  /// (F16j) The solve in motion of the window when its TDoA put the body in the air rather than on the floor at
+  /// floor_z_m (on_floor: the floor solve of the same window; t_now_s: the window's last sample).
+  std::optional<MultilaterationResult> refuteFloor(const MultilaterationResult& on_floor, double floor_z_m,
+                                                   double t_now_s) const;
+
   const AnchorTable& anchors_;
   Vec3 b_t_tag_;
   StartUpParams params_;
