@@ -51,8 +51,9 @@ void GuardedEstimator::addTdoa(const TdoaObservation& z) {
   plain_.addTdoa(z);
   const TdoaUpdateResult& rc = corrected_.lastTdoaUpdate();
   const TdoaUpdateResult& ru = plain_.lastTdoaUpdate();
-  // only TDoA that both filters predicted enter the comparison
-  if (!scored(rc) || !scored(ru)) return;
+  // only TDoA that both filters predicted in flight enter the comparison (F24): on and near the floor the TDoA carry
+  // the floor-level bias (F14), which neither filter models and no bias model was trained on
+  if (!scored(rc) || !scored(ru) || !corrected_.lastTdoaInFlight() || !plain_.lastTdoaInFlight()) return;
   const double dt = std::isnan(t_last_) ? 0.0 : std::max(z.t_s - t_last_, 0.0);
   t_last_ = std::isnan(t_last_) ? z.t_s : std::max(t_last_, z.t_s);
   // (F24) L_k = e^{−Δt/τ} L_{k−1} + ℓ_u − ℓ_c, bounded; w follows σ(L) at a bounded rate

@@ -689,6 +689,7 @@ CooperativeRangeResult Estimator::addNeighbourRange(double t_s, const Moments3& 
 void Estimator::addTdoa(const TdoaObservation& z) {
   ++summary_.n_tdoa_total;
   last_tdoa_ = TdoaUpdateResult{};
+  last_tdoa_in_flight_ = false;
   const double t = z.t_s;
   if (!initialized_) {
     if (imu_mode_) {
@@ -811,6 +812,7 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   const bool flying = !acquiring && !near_floor && std::min(t - t_acq_end_, t - t_left_ground_) >= kRejectionSettle_s &&
                       ekf_.state().w_p_b.z() - params_.ground_z_m > kRejectionMinHeight_m &&
                       !(imu_mode_ && (rest_.stillNow() || rest_.shaking()));
+  last_tdoa_in_flight_ = flying;
   if (flying &&
       (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier)) {
     // (F16d) rejection rate in flight, exponentially forgotten over kRejectionMemory_s

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "FilterTestUtil.h"
 #include "uwb/filter/BiasGuard.h"
@@ -109,6 +110,27 @@ TEST(BiasGuard, LocalizerUsesTheGuardOnlyWithABiasModelAndWhenOn) {
   EXPECT_LT(guarded.summary.bias_guard_mean_weight, 0.5);
   EXPECT_LT((guarded.estimates.back().x.w_p_b - plain.estimates.back().x.w_p_b).norm(), 0.01);
   EXPECT_GT((unguarded.estimates.back().x.w_p_b - p).norm(), (plain.estimates.back().x.w_p_b - p).norm());
+}
+
+TEST(BiasGuard, TdoaOnTheFloorAreNoEvidence) {
+  // GIVEN a take-off log (on the floor with the motors running until 2 s, then a climb to a hover) whose floor TDoA
+  // carry a height bias of +1 m, and a bias model that predicts an offset on two pairs everywhere
+  filtertest::TakeoffLogSpec spec;
+  spec.tdoa_dz = [](double t) { return t < 2.0 ? 1.0 : 0.0; };
+  const SensorLog log = filtertest::takeoffLog(spec);
+  GuardedEstimator est(EkfParams{}, filtertest::arenaAnchors(), offsetPredictor(1.0));
+  // WHEN the events are fed
+  double last_ground_log_odds = std::numeric_limits<double>::quiet_NaN();
+  SensorEventCursor events(log);
+  for (SensorEvent ev; events.next(ev);) {
+    if (ev.kind == SensorEvent::Kind::kImu) est.addImu(ev.t_s, log.imu[ev.index].imu);
+    else if (ev.kind == SensorEvent::Kind::kTdoa) est.addTdoa(log.tdoa[ev.index]);
+    if (ev.t_s < 1.9) last_ground_log_odds = est.logOdds();
+  }
+  // THEN the comparison has not moved on the floor (F24: its TDoA carry the floor-level bias neither filter models),
+  // and it has in flight
+  EXPECT_EQ(last_ground_log_odds, 0.0);
+  EXPECT_NE(est.logOdds(), 0.0);
 }
 
 TEST(BiasGuard, MixtureOfEqualFiltersIsEitherFilter) {

@@ -174,6 +174,9 @@ class Estimator {
   /// The update of the TDoA last given to addTdoa; outcome kSkipped when it reached no update (not initialized,
   /// start-up collection, out of order). Its innovation and S are the filter's one-step prediction of it (F24).
   const TdoaUpdateResult& lastTdoaUpdate() const { return last_tdoa_; }
+  /// Whether the last TDoA was taken in flight: tracking, above the floor's band, neither still nor shaking (F16d,
+  /// F23c, F24).
+  bool lastTdoaInFlight() const { return last_tdoa_in_flight_; }
   /// The antenna-pattern bias learned in flight (F25); nullptr when EkfParams::antenna_bias_degree is 0.
   const OnlineAntennaBias* antennaBias() const { return antenna_ ? &*antenna_ : nullptr; }
 
@@ -282,6 +285,7 @@ class Estimator {
   };
   std::vector<RecentPair> recent_pairs_;
   TdoaUpdateResult last_tdoa_;
+  bool last_tdoa_in_flight_ = false;
   Mat3 bias_floor_ = Mat3::Zero();  ///< biasFloor() at t_bias_floor_s_; σ_b² I before the first TDoA (F23)
   std::optional<BiasLevel> bias_level_;  ///< the flight's bias level (F23c), with output_bias_memory_s > 0
   /// With a bias model: the level of the uncorrected TDoA (F24b), and the model as given, which bias_ scales
