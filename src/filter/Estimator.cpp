@@ -256,8 +256,8 @@ void Estimator::startAcquisition(double t_s, bool reacquisition) {
 
 void Estimator::finishStart(double t_s, const StartFix& fix) {
   if (fix.floor_refuted && on_ground_) {
-    // (F16j) the ground evidence before the first fix (a shaking burst or a quiet stretch in flight) is refuted by the
-    // TDoA: the body is in the air and never was on the floor; the fix is the solve in motion of the same window
+    // (F16j) floor contact before the first fix (a shaking burst in flight) is refuted by the TDoA: the body is in the
+    // air and never was on the floor; the fix is the solve in motion of the same window
     leaveGround(t_s, false);
     summary_.takeoff_t_s = std::numeric_limits<double>::quiet_NaN();
     summary_.start_floor_refuted = true;
