@@ -289,7 +289,10 @@ void Estimator::finishStart(double t_s, const StartFix& fix) {
   }
   ready_ = true;
   phase_ = FlightPhase::kAcquisition;
-  t_acq_end_ = t_s + params_.acquisition_s;
+  // (F16) the acquisition lasts acquisition_s from the fix; (F16g) a replayed start ran it from the window's start
+  // already, over the window's TDoA: it counts, and what is left of it runs from here
+  t_acq_end_ = (replayed ? fix.t_ref_s : t_s) + params_.acquisition_s;
+  t_fix_settled_ = t_s + params_.acquisition_s;  // (F25d) the antenna learner waits this long after any fix
   t_last_accept_ = t_s;
   n_rejected_streak_ = 0;
   n_rejected_recent_ = n_gated_recent_ = 0.0;
@@ -779,7 +782,8 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   const Vec3 w_p_tag_prior = levels ? Vec3(ekf_.state().w_p_b + ekf_.state().w_q_b * params_.b_t_tag) : Vec3::Zero();
   const TdoaUpdateResult r = updateTdoa(ekf_, anchors_, zc, opt, predictor);
   last_tdoa_ = r;
-  if (antenna_ && antenna_predicted_ && !acquiring && !near_floor && r.outcome == UpdateOutcome::kApplied) {
+  if (antenna_ && antenna_predicted_ && !acquiring && !near_floor && t >= t_fix_settled_ &&
+      r.outcome == UpdateOutcome::kApplied) {
     // (F25d) learned while tracking in the air only: near the floor the TDoA carry the ground bias (F14). The
     // robust weight of the update down-weights the same TDoA for the pattern.
     // The TDoA error is correlated in time (F12): the innovations carry far less than one independent sample each

@@ -237,6 +237,7 @@ class Estimator {
   double t_last_shake_ = -1e300, t_shake_since_ = 0.0, t_left_ground_ = -1e300;
   double t_last_rest_ = -1e300;  ///< last IMU sample at rest (F18)
   double t_entered_ground_ = -1e300;  ///< the ground phase began (F18)
+  double t_fix_settled_ = -1e300;  ///< acquisition_s after the last fix: the antenna learner starts (F25d)
   double t_last_descent_ = -1e300;  ///< last IMU sample with the estimate descending (F18)
   std::array<double, 60> low_z_{};  ///< recent heights, one per 50 ms, the last 3 s (F18)
   std::size_t i_low_z_ = 0, n_low_z_ = 0;
