@@ -251,6 +251,41 @@ TEST(Generalization, SimulatedLandingsAreNotPulledAwayByTheFloorLevelAnchors) {
   }
 }
 
+TEST(Generalization, SimulatedTouchdownDoesNotSlideAway) {
+  // GIVEN a simulated 30 s circle over UTIL constellation 4 (drone/room seed 718499, yaw rate 0.2 rad/s, IMU at
+  // 500 Hz; `scripts/sim_sweep.py --seed 4242`): between its touchdown and the rest the IMU shows, the floor-level
+  // anchors' TDoA pull on a body that sits still
+  const AnchorSurvey preset = [] {
+    try {
+      return sim::anchorPreset("util-const4", test::dataDir().string());
+    } catch (const std::exception&) {
+      return AnchorSurvey{};
+    }
+  }();
+  if (preset.anchors.empty()) GTEST_SKIP() << "the util-const4 survey was not found under " << test::dataDir();
+  sim::Scenario sc;
+  sc.survey = preset;
+  sc.trajectory.shape = sim::TrajectoryShape::kCircle;
+  sc.trajectory.duration_s = 30.0;
+  sim::fitTrajectoryToAnchors(sc.survey, &sc.trajectory);
+  sc.trajectory.yaw_rate_rps = 0.2;
+  sc.trajectory.yaw_mode = sim::YawMode::kConstantRate;
+  sim::SimParams sp;
+  sp.imu.rate_hz = 500.0;
+  const sim::SimResult s = sim::simulateFlight(sc, sp, 718499);
+  // WHEN localizing with the defaults, and with the lateral acceleration noise of before F3a
+  const LocalizationRun run = localizeFlight(s.flight, s.survey);
+  LocalizationOptions loose;
+  loose.params.lateral_acc_noise_mps2_sqrthz = 1.0;
+  const LocalizationRun run_loose = localizeFlight(s.flight, s.survey, loose);
+  // THEN the tilted thrust, level on the floor, holds the horizontal velocity: the largest error over the whole flight
+  // stays below 0.8 m (0.57 m); with 1.0 the TDoA drove the still body to 3 m/s sideways (2.95 m off, σ 0.15 m)
+  ASSERT_TRUE(run.metrics && run_loose.metrics);
+  EXPECT_LT(run.metrics->whole.max_m, 0.8);
+  EXPECT_GT(run_loose.metrics->whole.max_m, 2.0);
+  EXPECT_LT(run.metrics->airborne.rmse_m, 0.3);
+}
+
 TEST(Generalization, SimulatedLogBegunInTheAirLearnsTheFloorAtItsLanding) {
   // GIVEN a simulated zigzag (paper anchors, seed 9) logged from 12 s, in the air, to its end on the floor: the log
   // never saw the floor before, so it knows no floor-level delays, and the landing's TDoA carry them (S18, metres)
@@ -420,13 +455,13 @@ TEST(Generalization, SimulatedLandingDoesNotClimbAway) {
   const LocalizationRun run_off = localizeFlight(s.flight, s.survey, off);
   // THEN on the ground after the flight the estimate stays below 0.8 m with the defaults and without the range-bias
   // states (the landing's TDoA are taken with the floor's delays where they fit them, F16h); without those delays only
-  // with the bound (1.8 m without it); the bound does not change the airborne RMSE
+  // with the bound (1.2 m without it); the bound does not change the airborne RMSE
   ASSERT_TRUE(run.metrics && run_off.metrics && run_default.metrics && run_no_states.metrics);
   const EstimateChecks c = checks(run, s.flight, s.survey), c_off = checks(run_off, s.flight, s.survey);
   EXPECT_LT(checks(run_default, s.flight, s.survey).max_z_on_ground_m, 0.8);
   EXPECT_LT(checks(run_no_states, s.flight, s.survey).max_z_on_ground_m, 0.8);
   EXPECT_LT(c.max_z_on_ground_m, 0.8);
-  EXPECT_GT(c_off.max_z_on_ground_m, 1.5);
+  EXPECT_GT(c_off.max_z_on_ground_m, 1.0);
   EXPECT_GT(run.summary.n_descent_bound_updates, 0u);
   EXPECT_NEAR(run.metrics->airborne.rmse_m, run_off.metrics->airborne.rmse_m, 0.005);
 }

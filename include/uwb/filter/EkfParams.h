@@ -48,7 +48,7 @@ struct EkfParams {
   /// 0.02–0.09 m/s² (util-pilot, incl. Vicon differentiation noise), i.e. ≈ 0.05 m/s²/√Hz; 0.2 let the
   /// position-dependent TDoA bias pull the height around (z is the largest error axis). docs/math/filter.md F7.
   double acc_noise_mps2_sqrthz = 0.05;
-  double lateral_acc_noise_mps2_sqrthz = 1.0; ///< extra white acceleration on horizontal v (drag, kThrustOnly)
+  double lateral_acc_noise_mps2_sqrthz = 0.5; ///< white acceleration on horizontal v beyond the drag (kThrustOnly, F3a)
   double gyro_noise_radps_sqrthz = 0.01;      ///< gyroscope white noise on δθ
   /// Accelerometer-bias random walk. Chosen on the 0425 flights (0.001–0.005 within 0.1 % of each other, 0.01 and 0.03
   /// worse), checked on 0426 and the simulated scenarios (filter.md F7).
