@@ -93,6 +93,9 @@ constexpr double kContactRearm_s = 0.5;
 constexpr double kRestMaxClimb_mps = 0.3;
 constexpr double kRestDescent_mps = 0.2;
 constexpr double kLandingWindow_s = 3.0;
+/// … and the low height must have been reached at the descent: only heights from this long before its last descending
+/// sample on count (a touchdown ends a descent; a climb before a hover's dip is no landing) [s] (F18).
+constexpr double kLandingLowZLead_s = 0.5;
 constexpr double kContactSustained_s = 1.5;
 /// Below this estimated height above the floor TDoA are down-weighted as on the ground (F14) [m].
 constexpr double kLowFlight_m = 0.25;
@@ -596,7 +599,11 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
         (on_ground_ || !ready_ ||
          (x.w_p_b.z() - params_.ground_z_m < kContactMaxHeight_m && x.w_v_b.z() < kRestMaxClimb_mps) ||
          (t_s - t_last_descent_ < kLandingWindow_s &&
-          lowestRecentZ(kRestLowZSamples) - params_.ground_z_m < kContactMaxHeight_m));
+          lowestRecentZ(std::min(kRestLowZSamples, static_cast<std::size_t>(
+                                                       (t_s - t_last_descent_ + kLandingLowZLead_s) / kLowZPeriod_s) +
+                                                       1)) -
+                  params_.ground_z_m <
+              kContactMaxHeight_m));
     const bool ground_now = (rest || contact) && !climbing;
     if (ground_now && !on_ground_) {
       predictTo(t_s);
