@@ -594,16 +594,16 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
     // opens the window (the touchdown: the estimate may climb after it, F26).
     const NavState& x = ekf_.state();
     if (ready_ && x.w_v_b.z() < -kRestDescent_mps) t_last_descent_ = t_s;
+    // the heights of a landing: those since kLandingLowZLead_s before its last descending sample (the window's span)
+    const auto landingLowZ = [&] {
+      const double span_s = t_s - t_last_descent_ + kLandingLowZLead_s;
+      return lowestRecentZ(std::min(kRestLowZSamples, static_cast<std::size_t>(span_s / kLowZPeriod_s) + 1));
+    };
     const bool rest =
         rest_.atRest() &&
         (on_ground_ || !ready_ ||
          (x.w_p_b.z() - params_.ground_z_m < kContactMaxHeight_m && x.w_v_b.z() < kRestMaxClimb_mps) ||
-         (t_s - t_last_descent_ < kLandingWindow_s &&
-          lowestRecentZ(std::min(kRestLowZSamples, static_cast<std::size_t>(
-                                                       (t_s - t_last_descent_ + kLandingLowZLead_s) / kLowZPeriod_s) +
-                                                       1)) -
-                  params_.ground_z_m <
-              kContactMaxHeight_m));
+         (t_s - t_last_descent_ < kLandingWindow_s && landingLowZ() - params_.ground_z_m < kContactMaxHeight_m));
     const bool ground_now = (rest || contact) && !climbing;
     if (ground_now && !on_ground_) {
       predictTo(t_s);

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <set>
 #include <utility>
 
@@ -255,19 +256,10 @@ TEST(Generalization, SimulatedTouchdownDoesNotSlideAway) {
   // GIVEN a simulated 30 s circle over UTIL constellation 4 (drone/room seed 718499, yaw rate 0.2 rad/s, IMU at
   // 500 Hz; `scripts/sim_sweep.py --seed 4242`): between its touchdown and the rest the IMU shows, the floor-level
   // anchors' TDoA pull on a body that sits still
-  const AnchorSurvey preset = [] {
-    try {
-      return sim::anchorPreset("util-const4", test::dataDir().string());
-    } catch (const std::exception&) {
-      return AnchorSurvey{};
-    }
-  }();
-  if (preset.anchors.empty()) GTEST_SKIP() << "the util-const4 survey was not found under " << test::dataDir();
-  sim::Scenario sc;
-  sc.survey = preset;
-  sc.trajectory.shape = sim::TrajectoryShape::kCircle;
-  sc.trajectory.duration_s = 30.0;
-  sim::fitTrajectoryToAnchors(sc.survey, &sc.trajectory);
+  if (!std::filesystem::exists(test::dataDir() / "real" / "util-final-extract" / "survey" / "anchor_const4_survey.txt"))
+    GTEST_SKIP() << "the util-const4 survey was not found under " << test::dataDir();
+  sim::Scenario sc = sim::makeScenario(sim::anchorPreset("util-const4", test::dataDir().string()),
+                                       sim::TrajectoryShape::kCircle, 30.0);
   sc.trajectory.yaw_rate_rps = 0.2;
   sc.trajectory.yaw_mode = sim::YawMode::kConstantRate;
   sim::SimParams sp;
@@ -290,11 +282,7 @@ TEST(Generalization, SimulatedStillHoverAfterAnOvershootIsNoLanding) {
   // GIVEN a simulated 20 s hover at 2.2 m after a 1.5 s take-off (paper anchors, drone/room seed 274872, IMU at
   // 100 Hz, at which a still hover reads as quiet as rest; `scripts/sim_sweep.py --extreme --seed 4343`): the
   // estimate overshoots the climb and dips back, a descent within 3 s of heights below 0.8 m, but those were the climb
-  sim::Scenario sc;
-  sc.survey = sim::paperAnchors();
-  sc.trajectory.shape = sim::TrajectoryShape::kHover;
-  sc.trajectory.duration_s = 20.0;
-  sim::fitTrajectoryToAnchors(sc.survey, &sc.trajectory);
+  sim::Scenario sc = sim::makeScenario(sim::paperAnchors(), sim::TrajectoryShape::kHover, 20.0);
   sc.trajectory.yaw_rate_rps = 0.0;
   sc.trajectory.yaw_mode = sim::YawMode::kConstant;
   sc.trajectory.takeoff_s = 1.5;
