@@ -337,9 +337,10 @@ std::optional<InnovationStats> Ekf::correctAugmented(double y, double var, const
   const double S = st.innovation_var_m2;
   const double inv_sqrt_S = 1.0 / std::sqrt(S);
   const ErrVec w_x = g.u_x * inv_sqrt_S;
+  const ErrVec dx = g.u_x * (st.innovation_m / S);  // formed before the downdates: its stores are retired by inject
   detail::rankOneDowndate<kDim>(P_, w_x);
   range_bias_->downdate(w_x, g.u_b * inv_sqrt_S, g.u_b * (st.innovation_m / S));
-  inject(g.u_x * (st.innovation_m / S));  // (F8)
+  inject(dx);  // (F8)
   return st;
 }
 
