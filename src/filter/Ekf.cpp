@@ -337,7 +337,8 @@ std::optional<InnovationStats> Ekf::correctAugmented(double y, double var, const
   const double S = st.innovation_var_m2;
   const double inv_sqrt_S = 1.0 / std::sqrt(S);
   const ErrVec w_x = g.u_x * inv_sqrt_S;
-  const ErrVec dx = g.u_x * (st.innovation_m / S);  // formed before the downdates: its stores are retired by inject
+  // formed before the downdates, so that inject reads a vector written long before (no store-forwarding stall)
+  const ErrVec dx = g.u_x * (st.innovation_m / S);
   detail::rankOneDowndate<kDim>(P_, w_x);
   range_bias_->downdate(w_x, g.u_b * inv_sqrt_S, g.u_b * (st.innovation_m / S));
   inject(dx);  // (F8)
