@@ -6,6 +6,7 @@
 
 #include "uwb/graph/Cooperative.h"
 #include "uwb/graph/GaussianMessage.h"
+#include "uwb/graph/HalfLine.h"
 #include "uwb/graph/Nodes.h"
 #include "uwb/graph/TdoaCorrection.h"
 #include "uwb/graph/TdoaNode.h"

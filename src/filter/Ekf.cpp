@@ -5,8 +5,10 @@
 #include "uwb/filter/Ekf.h"
 
 #include "uwb/filter/InMotionAlignment.h"
+#include "uwb/graph/HalfLine.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace uwb {
@@ -423,6 +425,16 @@ void Ekf::positionUpdate(int axis, double value_m, double sigma_m) {
   m.y = value_m - x_.w_p_b(axis);
   m.var = sigma_m * sigma_m;
   correct(m);
+}
+
+bool Ekf::constrainPositionAbove(int axis, double lower_m) {
+  if (axis < 0 || axis > 2) throw std::invalid_argument("Ekf::constrainPositionAbove: axis must be 0, 1 or 2");
+  const double v = P_(kPos + axis, kPos + axis);
+  if (!(v > 0.0) || !std::isfinite(v)) return false;
+  const std::optional<ScalarObservation> msg = halfLineMessage(x_.w_p_b(axis), v, lower_m);  // (G23b)
+  if (!msg) return false;
+  positionUpdate(axis, msg->y, std::sqrt(msg->var));
+  return true;
 }
 
 void Ekf::inflatePosition(double sigma_m, double vel_sigma_mps) {

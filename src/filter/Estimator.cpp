@@ -5,6 +5,7 @@
 #include "uwb/filter/Estimator.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -69,11 +70,11 @@ constexpr double kDivergedSpeed_mps = 8.0;
 constexpr double kMaxIntegrationGap_s = 0.25;
 /// Pairs seen within this window enter the reported bias floor (F23) [s].
 constexpr double kRecentPairWindow_s = 0.5;
+/// Anchors a TDoA multilateration needs for a 3-D fix (three independent differences) (F16k).
+constexpr int kMinFixAnchors = 4;
 /// The bias floor's geometry term is recomputed at most this often [s] (F23).
 constexpr double kBiasFloorPeriod_s = 0.05;
 constexpr int kMaxPairId = 64;
-/// Floor constraint std [m] (F22).
-constexpr double kFloorSigma_m = 0.02;
 /// Height std of the body on the floor (F22) [m]: the body origin sits a few cm above the floor.
 constexpr double kGroundHeightSigma_m = 0.1;
 /// Ground contact (F18): shaking within this long counts [s]; only below this estimated height above the floor [m];
@@ -449,8 +450,8 @@ void Estimator::finishLandingFix(const StartFix& fix) {
 }
 
 void Estimator::applyFloorConstraint(bool on_ground) {
-  // (F22) z ≥ floor: a one-sided constraint, applied as a position update only when violated; on the ground (F14)
-  // the body sits on the floor: z = floor ± kGroundHeightSigma_m
+  // (F22) z ≥ floor: a one-sided constraint, applied when the estimate violates it; on the ground (F14) the body
+  // sits on the floor: z = floor ± kGroundHeightSigma_m
   if (!params_.floor_constraint || !ready_) return;
   const double z = ekf_.state().w_p_b.z();
   if (on_ground && start_.active()) return;
@@ -460,15 +461,10 @@ void Estimator::applyFloorConstraint(bool on_ground) {
     return;
   }
   if (z < params_.ground_z_m - params_.floor_margin_m) {
+    // in the air: the height's belief truncated to z ≥ floor (G23); the velocity and the other states follow through
+    // their covariance with the height
     propagate(true);
-    ekf_.positionUpdate(2, params_.ground_z_m, kFloorSigma_m);
-    if (ekf_.state().w_v_b.z() < 0.0) {
-      // the body cannot keep sinking into the floor either
-      ErrVec dx = ErrVec::Zero();
-      dx(kVel + 2) = -ekf_.state().w_v_b.z();
-      ekf_.inject(dx);
-    }
-    ++summary_.n_floor_updates;
+    if (ekf_.constrainPositionAbove(2, params_.ground_z_m)) ++summary_.n_floor_updates;
   }
 }
 
@@ -634,8 +630,12 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
     // (F16) divergence is checked at the same 10 ms period
     // (F16) and in flight without any TDoA accepted for max_lost_s (none received, e.g. a radio outage): the
     // prediction gets the re-acquisition's relaxed horizontal motion (F16e) until fresh TDoA fix the position
-    const bool lost_in_flight =
-        !on_ground_ && phase_ != FlightPhase::kAcquisition && t_s - t_last_accept_ > params_.max_lost_s;
+    const bool lost_in_flight = !on_ground_ && phase_ != FlightPhase::kAcquisition &&
+                                t_s - t_last_accept_ > params_.max_lost_s && [&] {
+                                  // (F16k) none received (an outage), or enough anchors for a fix
+                                  const int heard = anchorsHeard(params_.max_lost_s);
+                                  return heard == 0 || heard >= kMinFixAnchors;
+                                }();
     if (ready_ && !start_.active() && (diverged() || lost_in_flight)) {
       propagate(true);
       startAcquisition(t_s, true);
@@ -689,6 +689,7 @@ CooperativeRangeResult Estimator::addNeighbourRange(double t_s, const Moments3& 
     case UpdateOutcome::kApplied:
       ++summary_.n_coop_used;
       summary_.coop_omega_sum += r.omega;
+      t_last_accept_ = t_s;  // (F16k) a range to a neighbour fixes the position too: not lost
       break;
     case UpdateOutcome::kRejectedOutlier: ++summary_.n_coop_rejected; break;
     default: ++summary_.n_coop_not_ready; break;
@@ -877,7 +878,9 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   const bool rejecting = params_.max_rejection_rate < 1.0 && n_gated_recent_ >= kRejectionMinSamples &&
                          n_rejected_recent_ > params_.max_rejection_rate * n_gated_recent_;
   const bool nothing_accepted = t - t_last_accept_ > params_.max_lost_s && n_rejected_streak_ > kLostMinRejections;
-  if (!acquiring && (rejecting || nothing_accepted)) {
+  // (F16k) only TDoA of at least four anchors can fix a position again: with fewer in view (an occluded tag) a
+  // re-acquisition would wait for a fix that cannot come, so the filter keeps tracking and its gate takes them back
+  if (!acquiring && (rejecting || nothing_accepted) && anchorsHeard(kRecentPairWindow_s) >= kMinFixAnchors) {
     if (rejecting) {
       ++summary_.n_rejection_faults;
       revertToHealthyMotion(t);
@@ -958,6 +961,20 @@ Mat3 Estimator::reportedPositionCovariance() const {
   const Mat3 P = ekf_.covariance().block<3, 3>(kPos, kPos);
   if (!(params_.output_bias_sigma_m > 0.0) || !ready_) return P;
   return P + bias_floor_;
+}
+
+int Estimator::anchorsHeard(double window_s) const {
+  std::array<int, 2 * 64> ids{};
+  int n = 0;
+  const auto add = [&](int id) {
+    if (std::find(ids.begin(), ids.begin() + n, id) == ids.begin() + n && n < static_cast<int>(ids.size())) ids[n++] = id;
+  };
+  for (const RecentPair& rp : recent_pairs_) {
+    if (t_last_event_ - rp.t_s > window_s) continue;
+    add(rp.id_a);
+    add(rp.id_b);
+  }
+  return n;
 }
 
 Mat3 Estimator::biasFloor() const {

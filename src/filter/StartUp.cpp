@@ -4,6 +4,7 @@
 #include "uwb/filter/StartUp.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -29,6 +30,19 @@ void StartUp::begin(double t_s, const NavState& x_ref, bool moving, bool reacqui
   samples_.clear();
 }
 
+int StartUp::distinctAnchors() const {
+  std::array<int, 64> ids{};
+  int n = 0;
+  for (const MultilaterationSample& m : samples_) {
+    for (const int id : {m.z.id_a, m.z.id_b}) {
+      if (std::find(ids.begin(), ids.begin() + n, id) != ids.begin() + n) continue;
+      if (n == static_cast<int>(ids.size())) return n;
+      ids[static_cast<std::size_t>(n++)] = id;
+    }
+  }
+  return n;
+}
+
 std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x_now, std::optional<double> floor_z_m,
                                      bool floor_refutable) {
   if (!active_) return std::nullopt;
@@ -43,7 +57,11 @@ std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x
   bool moving = moving_ && !floor_z_m;
   bool floor_refuted = false;
   std::optional<MultilaterationResult> r;
-  if (floor_z_m) {
+  // (F16k) a position needs three independent TDoA (four anchors) in the air, two (three anchors) on a floor of known
+  // height; with fewer in the window the solve is free along a curve and its covariance a fiction: wait for more
+  const int n_anchors = distinctAnchors();
+  if (n_anchors < (floor_z_m ? 3 : 4)) {
+  } else if (floor_z_m) {
     // (F16f) with floor-level anchors, their delays are solved for; without 3 other anchors in view, the plain solve
     if (!floor_level_.empty())
       r = multilaterateOnFloorWithDelays(samples_, anchors_, b_t_tag_, guesses_, *floor_z_m, floor_level_);

@@ -109,6 +109,10 @@ class Ekf {
   void zeroVelocityUpdate(double sigma_mps);
   /// Scalar pseudo-measurement of the position along world axis `axis` (0..2): p_axis = value ± sigma.
   void positionUpdate(int axis, double value_m, double sigma_m);
+  /// The one-sided constraint p_axis ≥ lower_m (message-passing.md G23): the position's belief along that axis is
+  /// replaced by its moments truncated below lower_m, the other states following through their covariance with it.
+  /// Returns false (state untouched) when the belief has no mass below lower_m to speak of.
+  bool constrainPositionAbove(int axis, double lower_m);
   /// Adds sigma² to the position (and optionally velocity) variances: used on re-acquisition.
   void inflatePosition(double sigma_m, double vel_sigma_mps);
   /// P ← factor · P (factor > 0): the prior of a covariance-intersection update, P/ω (message-passing.md G21).

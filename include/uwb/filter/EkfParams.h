@@ -172,8 +172,9 @@ struct EkfParams {
   bool has_start_position = false;       ///< true: start at start_w_p_b instead of multilateration
   Vec3 start_w_p_b = Vec3::Zero();       ///< user-given start (body origin, world) [m]
   double ground_z_m = 0.0;               ///< floor height (world z of the body origin at rest on the floor) [m]
-  /// The body cannot be below the floor: an estimate with z < ground_z_m − floor_margin_m is pulled back by a
-  /// position update z = ground_z_m (F22). Off for rooms whose floor height in the anchor frame is unknown.
+  /// The body cannot be below the floor: in the air, an estimate with z < ground_z_m − floor_margin_m has its height
+  /// belief truncated to z ≥ ground_z_m (F22, message-passing.md G23); on the ground z = ground_z_m. Off for rooms
+  /// whose floor height in the anchor frame is unknown.
   bool floor_constraint = true;
   double floor_margin_m = 0.05;          ///< tolerance below ground_z_m before the floor constraint acts [m]
   /// TDoA std while the IMU says the body is at rest (F14, F18): near the floor the TDoA bias is large and

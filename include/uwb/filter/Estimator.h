@@ -203,6 +203,8 @@ class Estimator {
   Mat3 reportedPositionCovariance() const;
   /// The covariance of the anchors' range biases seen through the pairs in view (F23, BiasFloor.h).
   Mat3 biasFloor() const;
+  /// Distinct anchors of the TDoA received (applied or rejected) within window_s before the last event (F16k).
+  int anchorsHeard(double window_s) const;
   /// The pair-bias std that biasFloor() maps: output_bias_sigma_m, scaled by the flight's measured level (F23c).
   double outputBiasSigma() const;
   /// (F24b) The scale of the bias model's mean from the flight's uncorrected level; after each window of raw_level_.

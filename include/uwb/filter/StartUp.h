@@ -69,6 +69,8 @@ class StartUp {
                               std::optional<double> floor_z_m = std::nullopt, bool floor_refutable = false);
 
  private:
+  /// Distinct anchors among the window's TDoA (F16k).
+  int distinctAnchors() const;
   /// (F16j) The solve in motion of the window when its TDoA put the body in the air rather than on the floor at
   /// floor_z_m (on_floor: the floor solve of the same window; t_now_s: the window's last sample).
   std::optional<MultilaterationResult> refuteFloor(const MultilaterationResult& on_floor, double floor_z_m,
