@@ -461,10 +461,16 @@ void Estimator::applyFloorConstraint(bool on_ground) {
     return;
   }
   if (z < params_.ground_z_m - params_.floor_margin_m) {
-    // in the air: the height's belief truncated to z ≥ floor (G23); the velocity and the other states follow through
-    // their covariance with the height
+    // in the air: the height's belief truncated to z ≥ floor (G23); the other states follow through their covariance
+    // with the height. An estimate that sank through the floor cannot keep sinking: a downward velocity is set to zero
+    // (the mean only), which a velocity barely correlated with the height (a fresh fix) would otherwise keep
     propagate(true);
     if (ekf_.constrainPositionAbove(2, params_.ground_z_m)) ++summary_.n_floor_updates;
+    if (ekf_.state().w_v_b.z() < 0.0) {
+      ErrVec dx = ErrVec::Zero();
+      dx(kVel + 2) = -ekf_.state().w_v_b.z();
+      ekf_.inject(dx);
+    }
   }
 }
 

@@ -60,21 +60,21 @@ std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x
   // (F16k) a position needs three independent TDoA (four anchors) in the air, two (three anchors) on a floor of known
   // height; with fewer in the window the solve is free along a curve and its covariance a fiction: wait for more
   const int n_anchors = distinctAnchors();
-  if (n_anchors < (floor_z_m ? 3 : 4)) {
-  } else if (floor_z_m) {
+  const bool solvable = n_anchors >= (floor_z_m ? 3 : 4);
+  if (solvable && floor_z_m) {
     // (F16f) with floor-level anchors, their delays are solved for; without 3 other anchors in view, the plain solve
     if (!floor_level_.empty())
       r = multilaterateOnFloorWithDelays(samples_, anchors_, b_t_tag_, guesses_, *floor_z_m, floor_level_);
     if (!r) r = multilaterateOnFloor(samples_, anchors_, b_t_tag_, guesses_, *floor_z_m);
-    // (F16j) at the first start, floor contact (F18) is tested against the TDoA
-    if (r && floor_refutable && !reacquisition_) {
+    // (F16j) at the first start, floor contact (F18) is tested against the TDoA (by a solve in the air: F16k)
+    if (r && floor_refutable && !reacquisition_ && n_anchors >= 4) {
       if (std::optional<MultilaterationResult> in_air = refuteFloor(*r, *floor_z_m, z.t_s)) {
         r = in_air;
         moving = floor_refuted = true;
         floor_z_m.reset();
       }
     }
-  } else {
+  } else if (solvable) {
     r = moving ? multilaterateMoving(samples_, anchors_, b_t_tag_, guesses_, t_ref_)
                : multilaterate(samples_, anchors_, b_t_tag_, guesses_);
   }
