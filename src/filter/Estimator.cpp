@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "uwb/filter/BiasFloor.h"
+#include "uwb/filter/Multilateration.h"
 #include "uwb/model/TdoaModel.h"
 
 namespace uwb {
@@ -70,8 +71,6 @@ constexpr double kDivergedSpeed_mps = 8.0;
 constexpr double kMaxIntegrationGap_s = 0.25;
 /// Pairs seen within this window enter the reported bias floor (F23) [s].
 constexpr double kRecentPairWindow_s = 0.5;
-/// Anchors a TDoA multilateration needs for a 3-D fix (three independent differences) (F16k).
-constexpr int kMinFixAnchors = 4;
 /// The bias floor's geometry term is recomputed at most this often [s] (F23).
 constexpr double kBiasFloorPeriod_s = 0.05;
 constexpr int kMaxPairId = 64;
@@ -640,7 +639,7 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
                                 t_s - t_last_accept_ > params_.max_lost_s && [&] {
                                   // (F16k) none received (an outage), or enough anchors for a fix
                                   const int heard = anchorsHeard(params_.max_lost_s);
-                                  return heard == 0 || heard >= kMinFixAnchors;
+                                  return heard == 0 || heard >= minFixAnchors(false);
                                 }();
     if (ready_ && !start_.active() && (diverged() || lost_in_flight)) {
       propagate(true);
@@ -886,7 +885,7 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   const bool nothing_accepted = t - t_last_accept_ > params_.max_lost_s && n_rejected_streak_ > kLostMinRejections;
   // (F16k) only TDoA of at least four anchors can fix a position again: with fewer in view (an occluded tag) a
   // re-acquisition would wait for a fix that cannot come, so the filter keeps tracking and its gate takes them back
-  if (!acquiring && (rejecting || nothing_accepted) && anchorsHeard(kRecentPairWindow_s) >= kMinFixAnchors) {
+  if (!acquiring && (rejecting || nothing_accepted) && anchorsHeard(kRecentPairWindow_s) >= minFixAnchors(false)) {
     if (rejecting) {
       ++summary_.n_rejection_faults;
       revertToHealthyMotion(t);
@@ -970,17 +969,10 @@ Mat3 Estimator::reportedPositionCovariance() const {
 }
 
 int Estimator::anchorsHeard(double window_s) const {
-  std::array<int, 2 * 64> ids{};
-  int n = 0;
-  const auto add = [&](int id) {
-    if (std::find(ids.begin(), ids.begin() + n, id) == ids.begin() + n && n < static_cast<int>(ids.size())) ids[n++] = id;
-  };
-  for (const RecentPair& rp : recent_pairs_) {
-    if (t_last_event_ - rp.t_s > window_s) continue;
-    add(rp.id_a);
-    add(rp.id_b);
-  }
-  return n;
+  DistinctAnchors anchors;
+  for (const RecentPair& rp : recent_pairs_)
+    if (t_last_event_ - rp.t_s <= window_s) anchors.add(rp.id_a, rp.id_b);
+  return anchors.count();
 }
 
 Mat3 Estimator::biasFloor() const {

@@ -11,6 +11,12 @@
 #include "uwb/model/TdoaModel.h"
 
 namespace uwb {
+
+void DistinctAnchors::insert(int id) {
+  if (std::find(ids_.begin(), ids_.begin() + n_, id) != ids_.begin() + n_) return;
+  if (n_ < static_cast<int>(ids_.size())) ids_[static_cast<std::size_t>(n_++)] = id;
+}
+
 namespace {
 
 /// What one Huber-IRLS Gauss–Newton run from a start ended with.

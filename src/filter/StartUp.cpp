@@ -31,16 +31,9 @@ void StartUp::begin(double t_s, const NavState& x_ref, bool moving, bool reacqui
 }
 
 int StartUp::distinctAnchors() const {
-  std::array<int, 64> ids{};
-  int n = 0;
-  for (const MultilaterationSample& m : samples_) {
-    for (const int id : {m.z.id_a, m.z.id_b}) {
-      if (std::find(ids.begin(), ids.begin() + n, id) != ids.begin() + n) continue;
-      if (n == static_cast<int>(ids.size())) return n;
-      ids[static_cast<std::size_t>(n++)] = id;
-    }
-  }
-  return n;
+  DistinctAnchors anchors;
+  for (const MultilaterationSample& m : samples_) anchors.add(m.z.id_a, m.z.id_b);
+  return anchors.count();
 }
 
 std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x_now, std::optional<double> floor_z_m,
@@ -57,17 +50,16 @@ std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x
   bool moving = moving_ && !floor_z_m;
   bool floor_refuted = false;
   std::optional<MultilaterationResult> r;
-  // (F16k) a position needs three independent TDoA (four anchors) in the air, two (three anchors) on a floor of known
-  // height; with fewer in the window the solve is free along a curve and its covariance a fiction: wait for more
+  // (F16k) with fewer anchors in the window than a fix needs, wait for more
   const int n_anchors = distinctAnchors();
-  const bool solvable = n_anchors >= (floor_z_m ? 3 : 4);
+  const bool solvable = n_anchors >= minFixAnchors(floor_z_m.has_value());
   if (solvable && floor_z_m) {
     // (F16f) with floor-level anchors, their delays are solved for; without 3 other anchors in view, the plain solve
     if (!floor_level_.empty())
       r = multilaterateOnFloorWithDelays(samples_, anchors_, b_t_tag_, guesses_, *floor_z_m, floor_level_);
     if (!r) r = multilaterateOnFloor(samples_, anchors_, b_t_tag_, guesses_, *floor_z_m);
     // (F16j) at the first start, floor contact (F18) is tested against the TDoA (by a solve in the air: F16k)
-    if (r && floor_refutable && !reacquisition_ && n_anchors >= 4) {
+    if (r && floor_refutable && !reacquisition_ && n_anchors >= minFixAnchors(false)) {
       if (std::optional<MultilaterationResult> in_air = refuteFloor(*r, *floor_z_m, z.t_s)) {
         r = in_air;
         moving = floor_refuted = true;

@@ -225,5 +225,25 @@ TEST(MultilaterateOnFloorWithDelays, GivenFewerThanThreeOtherAnchorsThenNoSoluti
   EXPECT_TRUE(none->anchor_delay_m.empty());
 }
 
+TEST(DistinctAnchors, GivenPairsSharingAnchorsWhenCountedThenEachAnchorCountsOnce) {
+  DistinctAnchors anchors;
+  EXPECT_EQ(anchors.count(), 0);
+  anchors.add(0, 1);
+  anchors.add(1, 2);
+  anchors.add(2, 0);
+  EXPECT_EQ(anchors.count(), 3);  // two TDoA2 pairs of a cycle: three anchors, not enough for a fix in the air
+  EXPECT_LT(anchors.count(), minFixAnchors(false));
+  EXPECT_GE(anchors.count(), minFixAnchors(true));
+  anchors.add(7, 2);
+  EXPECT_EQ(anchors.count(), 4);
+  EXPECT_GE(anchors.count(), minFixAnchors(false));
+}
+
+TEST(DistinctAnchors, GivenMoreIdsThanItHoldsThenTheCountStopsAtItsCapacity) {
+  DistinctAnchors anchors;
+  for (int id = 0; id < 400; id += 2) anchors.add(id, id + 1);
+  EXPECT_EQ(anchors.count(), 128);
+}
+
 }  // namespace
 }  // namespace uwb

@@ -4,6 +4,7 @@
  */
 #pragma once
 
+#include <array>
 #include <optional>
 #include <vector>
 
@@ -30,6 +31,25 @@ struct MultilaterationResult {
   /// (F16f, multilaterateOnFloorWithDelays only) the range delay found for each floor-level anchor, indexed by anchor
   /// id; NaN for an anchor whose delay was not solved for (not floor-level, or not seen) [m]
   std::vector<double> anchor_delay_m;
+};
+
+/// (F16k) A TDoA position fix needs three independent differences, four anchors, in the air; on a floor of known
+/// height two suffice, three anchors. With fewer the solve is free along a curve and its covariance a fiction.
+constexpr int minFixAnchors(bool on_floor) { return on_floor ? 3 : 4; }
+
+/// The distinct anchor ids of a set of TDoA pairs, counted against minFixAnchors (F16k). Holds up to 128 ids.
+class DistinctAnchors {
+ public:
+  void add(int id_a, int id_b) {
+    insert(id_a);
+    insert(id_b);
+  }
+  int count() const { return n_; }
+
+ private:
+  void insert(int id);
+  std::array<int, 128> ids_{};
+  int n_ = 0;
 };
 
 /// Huber-IRLS Gauss–Newton on p0 (F16), started from each of `initial_guesses`; returns the lowest-cost solution,
