@@ -20,11 +20,12 @@ level of the model's mean on it.
 
 With --calibration, instead of the filters: `uwbtdoa predict-bias TEST --model M --json` scores the model's predictive
 distribution of the bias (docs/math/gp.md P43) on each test flight; per split the 1σ and 2σ coverage (nominal 68.3 and
-95.4 %; mean, lowest, highest over the pairs) and the mean NLPD.
+95.4 %; mean, lowest, highest over the pairs) and the mean NLPD. With --keep=DIR, each pair's `predict-bias` rows
+(error, bias mean, predictive std per TDoA) are kept there as SPLIT__TRAIN__TEST.csv, to rescore other predictive shapes.
 
 With --with="FLAGS", every run with a model gets these localize flags too (e.g. --with="--bias-guard").
 
-Usage: scripts/bias_splits.py [BUILD_DIR] [--calibration | --pairs] [--with="FLAGS"] [--kernel=K] [--inducing=M]   (data: $UWBTDOA_DATA or ../shared/data)
+Usage: scripts/bias_splits.py [BUILD_DIR] [--calibration | --pairs] [--with="FLAGS"] [--kernel=K] [--inducing=M] [--keep=DIR]   (data: $UWBTDOA_DATA or ../shared/data)
 """
 import json
 import os
@@ -33,13 +34,15 @@ import subprocess
 import sys
 import tempfile
 
-OPTS = ("--with=", "--kernel=", "--inducing=")
+OPTS = ("--with=", "--kernel=", "--inducing=", "--keep=")
 ARGS = [a for a in sys.argv[1:] if a not in ("--calibration", "--pairs") and not a.startswith(OPTS)]
 # --with="FLAGS": more localize flags for every run with a model (e.g. --with="--bias-guard")
 WITH = [f for a in sys.argv[1:] if a.startswith("--with=") for f in a[len("--with="):].split()]
 # --kernel=K, --inducing=M: the model trained for every split (default the paper's tdoa kernel with M = 30)
 KERNEL = next((a[len("--kernel="):] for a in sys.argv[1:] if a.startswith("--kernel=")), "tdoa")
 INDUCING = next((a[len("--inducing="):] for a in sys.argv[1:] if a.startswith("--inducing=")), "30")
+# --keep=DIR: with --calibration, the predict-bias rows of every pair
+KEEP = next((a[len("--keep="):] for a in sys.argv[1:] if a.startswith("--keep=")), None)
 CALIBRATION = "--calibration" in sys.argv[1:]
 PAIRS = "--pairs" in sys.argv[1:]
 BUILD = ARGS[0] if ARGS else "build"
@@ -78,9 +81,8 @@ def level_cell(run, key):
     return "–" if run.get(key) is None else f"{run[key]:.3f}"
 
 
-def calibration(name, model):
-    cmd = [CLI, "predict-bias", path(name), "--anchors", survey(name[:4]), "--model", model, "--json", "--out",
-           os.path.join(os.path.dirname(model), "predicted.csv")]
+def calibration(name, model, rows):
+    cmd = [CLI, "predict-bias", path(name), "--anchors", survey(name[:4]), "--model", model, "--json", "--out", rows]
     return json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)["calibration"]
 
 
@@ -96,7 +98,11 @@ def main_calibration():
                 if key not in cache:
                     cache[key] = os.path.join(tmp, f"model{len(cache)}.json")
                     train(train_set, cache[key])
-                c = calibration(test, cache[key])
+                rows = os.path.join(tmp, "predicted.csv")
+                if KEEP:
+                    os.makedirs(KEEP, exist_ok=True)
+                    rows = os.path.join(KEEP, f"{label.replace(' ', '_')}__{'+'.join(train_set)}__{test}.csv")
+                c = calibration(test, cache[key], rows)
                 c1.append(100 * c["coverage_1sigma"])
                 c2.append(100 * c["coverage_2sigma"])
                 nlpd.append(c["nlpd"])

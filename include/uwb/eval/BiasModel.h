@@ -68,10 +68,11 @@ struct BiasPreset {
 /// (P43b) Shape of the predictive distribution of ε around µ with σ² = var_f + σ_n²: a Student-t with `dof` degrees of
 /// freedom and scale `scale`·σ; dof = 0 is the Gaussian N(µ, scale² σ²). The TDoA error's tails are heavier than a
 /// Gaussian's (kurtosis 4–6 on a flight the model was not trained on). The defaults were chosen on the 0426 splits of
-/// docs/math/gp.md P43b and reported on 0425. The filter is not affected: it uses µ and a variance (P45).
+/// docs/math/gp.md P43b with the default kernel and reported on 0425. The filter is not affected: it uses µ and a
+/// variance (P45).
 struct PredictiveShape {
-  double dof = 4.0;
-  double scale = 0.85;
+  double dof = 3.0;
+  double scale = 0.8;
   static PredictiveShape gaussian() { return {0.0, 1.0}; }
   /// Throws std::invalid_argument unless dof = 0 or dof > 2 (a finite variance), and 0 < scale ≤ 10, both finite.
   void validate() const;
