@@ -4,6 +4,8 @@
  */
 #include "uwb/filter/CooperativeRange.h"
 
+#include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 
 #include "uwb/model/TdoaModel.h"
@@ -26,11 +28,12 @@ std::optional<double> cooperativeRangePrediction(const NavState& x, const Vec3& 
   return h;
 }
 
-double covarianceIntersectionWeight(double T, double u, double aPa, double s_indep, double s_dep) {
+double covarianceIntersectionWeight(double T, double u, double aPa, double q, double s_indep, double s_dep) {
   if (!(s_dep > 0.0)) return 1.0;
   // (G21) tr P⁺_pp(ω) = T/ω − u/(ω² S(ω)); golden-section search on (0, 1)
+  const double a_not_p = std::max(aPa - q, 0.0);  // the part of aPaᵀ the inflation along the position leaves alone
   const auto trace = [&](double w) {
-    const double S = aPa / w + s_indep + s_dep / (1.0 - w);
+    const double S = a_not_p + q / w + s_indep + s_dep / (1.0 - w);
     return T / w - u / (w * w * S);
   };
   constexpr double kPhi = 0.6180339887498949;
@@ -69,20 +72,24 @@ CooperativeRangeResult updateCooperativeRange(Ekf& ekf, const Moments3& neighbou
   const double s_indep = options.sigma_m * options.sigma_m;
   const double s_dep = (J_j * neighbour.V * J_j.transpose())(0, 0);  // (G20) the neighbour as an uncertain anchor
   double omega = 1.0;
+  const ErrMat& P = ekf.covariance();
+  const ErrVec Pa = P * a.transpose();
+  const double aPa = (a * Pa)(0, 0);
+  double q = aPa;  // (G21) the part of aPaᵀ through the position
   if (options.fusion == NeighbourFusion::kCovarianceIntersection) {
-    const ErrMat& P = ekf.covariance();
-    const ErrVec Pa = P * a.transpose();
-    omega = covarianceIntersectionWeight(P.block<3, 3>(kPos, kPos).trace(), Pa.segment<3>(kPos).squaredNorm(),
-                                         (a * Pa)(0, 0), s_indep, s_dep);
+    const Eigen::LLT<Mat3> llt(P.block<3, 3>(kPos, kPos));
+    if (llt.info() == Eigen::Success) q = Pa.segment<3>(kPos).dot(llt.solve(Pa.segment<3>(kPos)));
+    omega = covarianceIntersectionWeight(P.block<3, 3>(kPos, kPos).trace(), Pa.segment<3>(kPos).squaredNorm(), aPa,
+                                         q, s_indep, s_dep);
   }
   ScalarLinearMessage<kDim> msg;
   msg.a = a;
   msg.y = range_m - *h;
-  // (G21) naive: s = σ² + J_j Σ_j J_jᵀ; CI: the prior's P/ω with s = σ² + J_j Σ_j J_jᵀ/(1 − ω)
+  // (G21) naive: s = σ² + J_j Σ_j J_jᵀ; CI: the prior inflated along the position (P_pp/ω) with
+  // s = σ² + J_j Σ_j J_jᵀ/(1 − ω)
   msg.var = omega < 1.0 ? s_indep + s_dep / (1.0 - omega) : s_indep + s_dep;
   if (!(msg.var > 0.0)) msg.var = 1e-12;
-  const double aPa = (a * ekf.covariance() * a.transpose())(0, 0) / omega;
-  const double S = aPa + msg.var;
+  const double S = std::max(aPa - q, 0.0) + q / omega + msg.var;
   res.innovation_m = msg.y;
   res.nis = msg.y * msg.y / S;
   res.omega = omega;
@@ -90,7 +97,8 @@ CooperativeRangeResult updateCooperativeRange(Ekf& ekf, const Moments3& neighbou
     res.outcome = UpdateOutcome::kRejectedOutlier;
     return res;
   }
-  if (omega < 1.0) ekf.scaleCovariance(1.0 / omega);
+  // (G21) inflated along the position; where P_pp is not positive definite, the whole covariance (plain CI)
+  if (omega < 1.0 && !ekf.inflateAlongPosition(1.0 / omega)) ekf.scaleCovariance(1.0 / omega);
   res.outcome = ekf.correctPositionAttitude(msg) ? UpdateOutcome::kApplied : UpdateOutcome::kDegenerate;
   return res;
 }

@@ -7,6 +7,7 @@
 #include "uwb/filter/InMotionAlignment.h"
 #include "uwb/graph/HalfLine.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -365,6 +366,26 @@ std::optional<InnovationStats> Ekf::correctWithRangeBias(const ScalarLinearMessa
 void Ekf::scaleCovariance(double factor) {
   P_ *= factor;
   if (range_bias_) range_bias_->scale(factor);
+}
+
+bool Ekf::inflateAlongPosition(double factor) {
+  if (!(factor > 1.0) || !std::isfinite(factor)) return false;
+  const Eigen::LLT<Mat3> llt(P_.block<3, 3>(kPos, kPos));
+  if (llt.info() != Eigen::Success) return false;
+  // (G21) with G = P_·p: P += c G P_pp⁻¹ Gᵀ, c = f − 1; the range-bias rows likewise with G_β = P_βp
+  const double c = factor - 1.0;
+  const Eigen::Matrix<double, kDim, 3> G = P_.middleCols<3>(kPos);
+  const Eigen::Matrix<double, 3, kDim> K = llt.solve(G.transpose());  // P_pp⁻¹ P_p·
+  if (range_bias_) {
+    const Eigen::Matrix<double, kMaxBiasAnchors, 3> Gb = range_bias_->biasRows().middleCols<3>(kPos);
+    const Eigen::Matrix<double, 3, kMaxBiasAnchors> Kb = llt.solve(Gb.transpose());
+    BiasMat d_bb = c * Gb * Kb;
+    d_bb = (0.5 * (d_bb + d_bb.transpose())).eval();
+    range_bias_->inflate(c * Gb * K, d_bb);
+  }
+  ErrMat d = c * G * K;
+  P_ += 0.5 * (d + d.transpose());
+  return true;
 }
 
 std::optional<InnovationStats> Ekf::correct(const ScalarLinearMessage<kDim>& message) {

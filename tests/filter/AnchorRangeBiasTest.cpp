@@ -288,6 +288,43 @@ TEST(EkfRangeBias, ResetsClearTheCrossCovarianceOfWhatTheyReset) {
   EXPECT_LT((ekf.rangeBias()->joint(ekf.covariance()) - 2.0 * J).norm(), 1e-12);
 }
 
+TEST(EkfRangeBias, InflationAlongThePositionIsTheDenseFormulaOnTheJointCovariance) {
+  // GIVEN a filter whose joint covariance over [δx, δβ] is correlated with the position
+  TdoaUpdateOptions opt;
+  Ekf ekf = correlatedFilter(rangeBiasParams(), 7, {{0.0, 0, 1, 0.3}, {0.0, 1, 2, -0.2}}, &opt);
+  ASSERT_GT(ekf.rangeBias()->cross().middleRows<3>(kPos).norm(), 0.0);
+  const AugMat J = ekf.rangeBias()->joint(ekf.covariance());
+  // WHEN it is inflated along the position by f (a covariance intersection's weight ω = 1/f, G21)
+  const double f = 2.5;
+  ASSERT_TRUE(ekf.inflateAlongPosition(f));
+  const AugMat J2 = ekf.rangeBias()->joint(ekf.covariance());
+  // THEN it is J + (f − 1) J_·p J_pp⁻¹ J_p· computed densely
+  const Eigen::Matrix<double, kAugDim, 3> G = J.middleCols<3>(kPos);
+  const AugMat expected = J + (f - 1.0) * G * J.block<3, 3>(kPos, kPos).inverse() * G.transpose();
+  EXPECT_LT((J2 - expected).cwiseAbs().maxCoeff(), 1e-12 * J.cwiseAbs().maxCoeff());
+  // AND the position block is f times the prior, and the covariance of the other states given the position (their
+  // Schur complement) is unchanged
+  EXPECT_LT((J2.block<3, 3>(kPos, kPos) - f * J.block<3, 3>(kPos, kPos)).norm(), 1e-12);
+  const auto schur = [](const AugMat& A) {
+    Eigen::Matrix<double, kAugDim - 3, kAugDim> R;  // every row but the position's
+    int r = 0;
+    for (int i = 0; i < kAugDim; ++i)
+      if (i < kPos || i >= kPos + 3) R.row(r++) = A.row(i);
+    Eigen::Matrix<double, kAugDim - 3, kAugDim - 3> rest;
+    Eigen::Matrix<double, kAugDim - 3, 3> cross = R.middleCols<3>(kPos);
+    int c = 0;
+    for (int j = 0; j < kAugDim; ++j)
+      if (j < kPos || j >= kPos + 3) rest.col(c++) = R.col(j);
+    return Eigen::Matrix<double, kAugDim - 3, kAugDim - 3>(
+        rest - cross * A.block<3, 3>(kPos, kPos).inverse() * cross.transpose());
+  };
+  EXPECT_LT((schur(J2) - schur(J)).cwiseAbs().maxCoeff(), 1e-10);
+  // AND f ≤ 1 does nothing
+  Ekf same = ekf;
+  EXPECT_FALSE(same.inflateAlongPosition(1.0));
+  EXPECT_EQ(same.covariance(), ekf.covariance());
+}
+
 /// Circle of radius 1.2 m at 1.4 m height, 0.6 rad/s.
 filtertest::Truth circle(double t) {
   const double w = 0.6, r = 1.2;

@@ -84,7 +84,7 @@ TEST(CooperativeRange, CovarianceIntersectionWeightMinimisesThePositionTrace) {
   const double s_dep = (J * nb.V * J.transpose())(0, 0);
   for (double w = 0.02; w < 1.0; w += 0.02) {
     Ekf e = base;
-    e.scaleCovariance(1.0 / w);
+    ASSERT_TRUE(e.inflateAlongPosition(1.0 / w));
     ScalarLinearMessage<kDim> msg;
     msg.a = a;
     msg.y = 0.0;

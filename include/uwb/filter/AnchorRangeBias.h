@@ -56,6 +56,11 @@ class AnchorRangeBias {
     P_bx_ *= factor;
     P_bb_ *= factor;
   }
+  /// Adds d_bx to P_βx and d_bb (symmetric) to P_ββ (the bias rows of a joint inflation, G21).
+  void inflate(const BiasRowsMat& d_bx, const BiasMat& d_bb) {
+    P_bx_ += d_bx;
+    P_bb_ += d_bb;
+  }
 
   /// The bias part of a rank-one correction of the joint covariance (G18): P_βx ← P_βx − w_β w_xᵀ,
   /// P_ββ ← P_ββ − w_β w_βᵀ, β̂ ← β̂ + dbeta (the Ekf downdates P by w_x w_xᵀ).

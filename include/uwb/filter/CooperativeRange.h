@@ -24,14 +24,15 @@ std::optional<double> cooperativeRangePrediction(const NavState& x, const Vec3& 
 /// How a neighbour's belief enters (G21).
 enum class NeighbourFusion : unsigned char {
   kNaive,                   ///< as if independent of this agent's state: s = σ² + J_j Σ_j J_jᵀ (double counts)
-  kCovarianceIntersection,  ///< prior P/ω and neighbour Σ_j/(1 − ω), ω minimising the position trace (G21)
+  kCovarianceIntersection,  ///< position prior P_pp/ω and neighbour Σ_j/(1 − ω), ω minimising the position trace (G21)
 };
 
 /// (G21) The covariance-intersection weight ω ∈ (0, 1] that minimises the trace of the posterior position block
-/// tr(P⁺_pp) = T/ω − u/(ω² S(ω)), S(ω) = aPaᵀ/ω + s_indep + s_dep/(1 − ω), given T = tr(P_pp), u = |P_p· aᵀ|²
-/// (position rows of P aᵀ), aPa = a P aᵀ, the independent noise s_indep = σ² and the neighbour term s_dep = J_j Σ_j J_jᵀ.
-/// Returns 1 when s_dep = 0 (nothing correlated: the ordinary update).
-double covarianceIntersectionWeight(double T, double u, double aPa, double s_indep, double s_dep);
+/// tr(P⁺_pp) = T/ω − u/(ω² S(ω)), S(ω) = aPaᵀ − q + q/ω + s_indep + s_dep/(1 − ω), given T = tr(P_pp),
+/// u = |P_p· aᵀ|² (position rows of P aᵀ), aPa = a P aᵀ, its part through the position q = (P_p· aᵀ)ᵀ P_pp⁻¹ P_p· aᵀ
+/// (q = aPa when a observes the position alone), the independent noise s_indep = σ² and the neighbour term
+/// s_dep = J_j Σ_j J_jᵀ. Returns 1 when s_dep = 0 (nothing correlated: the ordinary update).
+double covarianceIntersectionWeight(double T, double u, double aPa, double q, double s_indep, double s_dep);
 
 struct CooperativeRangeOptions {
   double sigma_m = 0.1;     ///< TWR noise std [m]

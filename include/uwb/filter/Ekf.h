@@ -117,6 +117,10 @@ class Ekf {
   void inflatePosition(double sigma_m, double vel_sigma_mps);
   /// P ← factor · P (factor > 0): the prior of a covariance-intersection update, P/ω (message-passing.md G21).
   void scaleCovariance(double factor);
+  /// (G21) The joint covariance inflated along the position only, P ← P + (f − 1) P_·p P_pp⁻¹ P_p· (over [δx, δβ]):
+  /// the position block times f, the regression of every other state on the position kept, their conditional
+  /// covariance given the position unchanged. false (nothing done) unless f > 1 and P_pp is positive definite.
+  bool inflateAlongPosition(double factor);
   /// Adds sigma² to the x and y position variances and vel_sigma² to the velocity variances.
   void inflateHorizontalPosition(double sigma_m, double vel_sigma_mps);
   /// Overwrites the position; keeps other state; sets the position block of P to sigma² I, clears its correlations.
