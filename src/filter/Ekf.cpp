@@ -448,15 +448,20 @@ void Ekf::positionUpdate(int axis, double value_m, double sigma_m) {
   correct(m);
 }
 
-bool Ekf::constrainPositionAbove(int axis, double lower_m) {
-  if (axis < 0 || axis > 2) throw std::invalid_argument("Ekf::constrainPositionAbove: axis must be 0, 1 or 2");
+bool Ekf::constrainPosition(int axis, double bound_m, double sign) {
+  if (axis < 0 || axis > 2) throw std::invalid_argument("Ekf::constrainPosition: axis must be 0, 1 or 2");
   const double v = P_(kPos + axis, kPos + axis);
   if (!(v > 0.0) || !std::isfinite(v)) return false;
-  const std::optional<ScalarObservation> msg = halfLineMessage(x_.w_p_b(axis), v, lower_m);  // (G23b)
+  // (G23b) on s·p ≥ s·bound: the message to s·p, mapped back to p by the same sign
+  const std::optional<ScalarObservation> msg = halfLineMessage(sign * x_.w_p_b(axis), v, sign * bound_m);
   if (!msg) return false;
-  positionUpdate(axis, msg->y, std::sqrt(msg->var));
+  positionUpdate(axis, sign * msg->y, std::sqrt(msg->var));
   return true;
 }
+
+bool Ekf::constrainPositionAbove(int axis, double lower_m) { return constrainPosition(axis, lower_m, 1.0); }
+
+bool Ekf::constrainPositionBelow(int axis, double upper_m) { return constrainPosition(axis, upper_m, -1.0); }
 
 void Ekf::inflatePosition(double sigma_m, double vel_sigma_mps) {
   P_.diagonal().segment<3>(kPos).array() += sigma_m * sigma_m;

@@ -105,8 +105,6 @@ constexpr double kLowFlight_m = 0.25;
 constexpr double kLandingBand_m = 0.5;
 /// (F16i) a landing's floor window ends without a fix after this long [s] (StartUp keeps 3 s of history)
 constexpr double kLandingFixMax_s = 3.0;
-/// Std of the height message that enforces the descent bound (F26) [m].
-constexpr double kDescentBoundSigma_m = 0.05;
 /// Constant time of the take-off detector's leaky vertical-velocity integrator [s] (F15).
 constexpr double kTakeoffLeak_s = 1.0;
 /// (F25) whether the learned pattern's variance hᵀ P_θ h is added to the filter's TDoA variance.
@@ -474,16 +472,15 @@ void Estimator::applyFloorConstraint(bool on_ground) {
 }
 
 void Estimator::applyDescentBound(double t_s) {
-  // (F26) landing: the estimate may not climb more than the margin above the IMU's dead-reckoned descent; a
-  // one-sided height message, applied only when violated (as the floor constraint, F22)
+  // (F26) landing: the estimate may not climb more than the margin above the IMU's dead-reckoned descent; the height's
+  // belief truncated to z ≤ floor + bound (G23), applied only when violated (as the floor constraint, F22)
   if (!(params_.descent_margin_m > 0.0) || !ready_ || start_.active() || on_ground_) return;
   const NavState& x = ekf_.state();
   const double h = x.w_p_b.z() - params_.ground_z_m;
   const double bound = descent_.update(t_s, h, x.w_v_b.z());
   if (!(h > bound)) return;  // no bound (NaN) or within it
   propagate(true);
-  ekf_.positionUpdate(2, params_.ground_z_m + bound, kDescentBoundSigma_m);
-  ++summary_.n_descent_bound_updates;
+  if (ekf_.constrainPositionBelow(2, params_.ground_z_m + bound)) ++summary_.n_descent_bound_updates;
 }
 
 bool Estimator::diverged() const {

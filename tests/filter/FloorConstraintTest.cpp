@@ -94,5 +94,33 @@ TEST(Ekf, FloorConstraintLeavesABeliefWellAboveTheFloorAlone) {
   EXPECT_THROW(ekf.constrainPositionAbove(3, 0.0), std::invalid_argument);
 }
 
+TEST(Ekf, ConstraintFromAboveIsTheMirrorOfTheConstraintFromBelow) {
+  // GIVEN a correlated belief, and the same belief with every state's sign flipped (δx → −δx keeps P)
+  const ErrMat P0 = correlatedCovariance(5);
+  EkfParams params = EkfParams::defaults();
+  params.range_bias_sigma_m = 0.0;
+  NavState x0, x0m;
+  x0.w_p_b = Vec3(1.0, -0.5, 1.3);
+  x0.w_v_b = Vec3(0.2, 0.0, 0.4);
+  x0m.w_p_b = -x0.w_p_b;
+  x0m.w_v_b = -x0.w_v_b;
+  Ekf below(params), above(params);
+  below.initialize(x0, P0);
+  above.initialize(x0m, P0);
+  // WHEN one is held to z ≤ 1.0 and the other to −z ≥ −1.0 (F26's bound, G23 on the negated height)
+  ASSERT_TRUE(below.constrainPositionBelow(2, 1.0));
+  ASSERT_TRUE(above.constrainPositionAbove(2, -1.0));
+  // THEN the means are mirror images and the covariances equal, and the height has the moments of its marginal
+  // truncated above
+  EXPECT_LT((below.state().w_p_b + above.state().w_p_b).norm(), 1e-12);
+  EXPECT_LT((below.state().w_v_b + above.state().w_v_b).norm(), 1e-12);
+  EXPECT_LT((below.covariance() - above.covariance()).cwiseAbs().maxCoeff(), 1e-12);
+  const TruncatedMoments t = truncatedBelow(-1.3, P0(kPos + 2, kPos + 2), -1.0);
+  EXPECT_NEAR(below.state().w_p_b.z(), -t.mean, 1e-12);
+  EXPECT_NEAR(below.covariance()(kPos + 2, kPos + 2), t.var, 1e-12);
+  EXPECT_LT(below.state().w_p_b.z(), 1.0);
+  EXPECT_THROW(below.constrainPositionBelow(-1, 0.0), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace uwb

@@ -113,6 +113,8 @@ class Ekf {
   /// replaced by its moments truncated below lower_m, the other states following through their covariance with it.
   /// Returns false (state untouched) when the belief has no mass below lower_m to speak of.
   bool constrainPositionAbove(int axis, double lower_m);
+  /// The one-sided constraint p_axis ≤ upper_m: the same node on −p_axis ≥ −upper_m (G23).
+  bool constrainPositionBelow(int axis, double upper_m);
   /// Adds sigma² to the position (and optionally velocity) variances: used on re-acquisition.
   void inflatePosition(double sigma_m, double vel_sigma_mps);
   /// P ← factor · P (factor > 0): the prior of a covariance-intersection update, P/ω (message-passing.md G21).
@@ -146,6 +148,8 @@ class Ekf {
   void inject(const ErrVec& dx);
 
  private:
+  /// (G23) sign · p_axis ≥ sign · bound_m, sign = ±1.
+  bool constrainPosition(int axis, double bound_m, double sign);
   EkfParams params_;
   NavState x_;
   ErrMat P_ = ErrMat::Identity();
