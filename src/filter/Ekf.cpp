@@ -372,19 +372,16 @@ bool Ekf::inflateAlongPosition(double factor) {
   if (!(factor > 1.0) || !std::isfinite(factor)) return false;
   const Eigen::LLT<Mat3> llt(P_.block<3, 3>(kPos, kPos));
   if (llt.info() != Eigen::Success) return false;
-  // (G21) with G = P_·p: P += c G P_pp⁻¹ Gᵀ, c = f − 1; the range-bias rows likewise with G_β = P_βp
+  // (G21) with G = P_·p and P_pp = L Lᵀ: P += c WᵀW, W = L⁻¹ Gᵀ, c = f − 1 (= c G P_pp⁻¹ Gᵀ, symmetric as written);
+  // the range-bias rows likewise with W_β = L⁻¹ P_pβ
   const double c = factor - 1.0;
-  const Eigen::Matrix<double, kDim, 3> G = P_.middleCols<3>(kPos);
-  const Eigen::Matrix<double, 3, kDim> K = llt.solve(G.transpose());  // P_pp⁻¹ P_p·
+  const Eigen::Matrix<double, 3, kDim> W = llt.matrixL().solve(P_.middleCols<3>(kPos).transpose());
   if (range_bias_) {
-    const Eigen::Matrix<double, kMaxBiasAnchors, 3> Gb = range_bias_->biasRows().middleCols<3>(kPos);
-    const Eigen::Matrix<double, 3, kMaxBiasAnchors> Kb = llt.solve(Gb.transpose());
-    BiasMat d_bb = c * Gb * Kb;
-    d_bb = (0.5 * (d_bb + d_bb.transpose())).eval();
-    range_bias_->inflate(c * Gb * K, d_bb);
+    const Eigen::Matrix<double, 3, kMaxBiasAnchors> Wb =
+        llt.matrixL().solve(range_bias_->biasRows().middleCols<3>(kPos).transpose());
+    range_bias_->inflate(c * Wb.transpose() * W, c * Wb.transpose() * Wb);
   }
-  ErrMat d = c * G * K;
-  P_ += 0.5 * (d + d.transpose());
+  P_.noalias() += c * W.transpose() * W;
   return true;
 }
 
