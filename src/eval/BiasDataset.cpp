@@ -47,10 +47,17 @@ BiasDataset buildBiasDataset(const std::vector<Flight>& flights, const AnchorSur
     if (!flight.hasGroundTruth())
       throw InputError(SourceLocation{flight.source, 0, 0, "pose_x"},
                        "training flight " + name + " has no ground-truth pose (pose_* columns are empty)");
-    if (!flight.pose_has_orientation)
+    // A position-only pose (util-final-extract) leaves the body frame unknown: the track then carries the level,
+    // unturned attitude (io/PoseTrack.h), so the lever arm is added in the world frame (as SOURCE.md prescribes) and
+    // the features' anchor angles are taken in the world frame. That is the frame the filter itself reports without
+    // an IMU, so features from such a flight match the ones the filter forms at run time. With an IMU the filter
+    // knows the body frame, and features from a level, unturned truth would not be the ones it forms: there the
+    // estimate must give them.
+    if (!flight.pose_has_orientation && params.inputs == BiasInputSource::kGroundTruth && flight.hasImu())
       throw InputError(SourceLocation{flight.source, 0, 0, "pose_qw"},
                        "training flight " + name +
-                           " has no ground-truth orientation; the bias features need the body frame");
+                           " has an IMU but no ground-truth orientation; the bias features need the body frame: "
+                           "take the GP inputs from the filter's estimate (--inputs estimate)");
     const PoseTrack track(flight, params.pose_track);
     TdoaResidualParams rp;
     rp.b_t_tag = params.b_t_tag;
@@ -68,6 +75,7 @@ BiasDataset buildBiasDataset(const std::vector<Flight>& flights, const AnchorSur
 
     BiasFlightReport rep;
     rep.source = name;
+    rep.orientation_from_truth = flight.pose_has_orientation;
     rep.bias_level_m = bias_level_m;
     rep.n_measurements = rr.n_measurements;
     rep.n_unknown_anchor = rr.n_unknown_anchor;
@@ -139,6 +147,9 @@ std::string BiasDataset::reportText() const {
     os << "  " << f.source << ": " << f.n_measurements << " | " << f.n_unknown_anchor << " | " << f.n_no_ground_truth
        << " | " << f.n_pose_glitch << " (" << f.n_pose_glitches_detected << " glitch samples) | " << f.n_on_ground << " | "
        << f.n_non_neighbour << " | " << f.n_outlier << " | " << f.n_no_estimate << " | " << f.n_used << "\n";
+    if (!f.orientation_from_truth)
+      os << "    (position-only pose: lever arm added in the world frame"
+         << (params.inputs == BiasInputSource::kGroundTruth ? ", features in the level, unturned body frame)\n" : ")\n");
   }
   return os.str();
 }

@@ -100,13 +100,51 @@ TEST(BiasDataset, FlightWithoutGroundTruthIsAClearError) {
   Flight f = circleFlight(5);
   f.pose.clear();
   EXPECT_THROW(buildBiasDataset({f}, ringSurvey()), InputError);
+}
+
+TEST(BiasDataset, PositionOnlyPoseWithoutAnImuGivesWorldFrameFeaturesAsTheFilterFormsThem) {
+  // GIVEN a flight without IMU whose pose has no orientation (the util-final-extract layout)
   Flight g = circleFlight(5);
   g.pose_has_orientation = false;
+  const AnchorSurvey s = ringSurvey();
+  // WHEN we build the dataset from the ground truth
+  const BiasDataset ds = buildBiasDataset({g}, s);
+  // THEN it trains, and says that the body frame was taken level and unturned
+  ASSERT_FALSE(ds.samples.empty());
+  EXPECT_FALSE(ds.flights.at(0).orientation_from_truth);
+  EXPECT_NE(ds.reportText().find("position-only pose"), std::string::npos) << ds.reportText();
+  // AND each sample is eq. 6 with the lever arm in the world frame and the features of the identity attitude, the
+  // attitude the filter reports without an IMU
+  const PoseTrack track(g.pose, false);
+  for (const BiasSample& smp : ds.samples) {
+    const auto gt = track.interpolate(smp.t_s);
+    ASSERT_TRUE(gt);
+    const TdoaFeature want = makeTdoaFeature(smp.feature.id_a, smp.feature.id_b, gt->w_p_b, Quat::Identity(),
+                                             s.position(smp.feature.id_a), s.position(smp.feature.id_b));
+    EXPECT_NEAR(smp.feature.yaw_a_rad, want.yaw_a_rad, 1e-12);
+    EXPECT_NEAR(smp.feature.yaw_b_rad, want.yaw_b_rad, 1e-12);
+    EXPECT_LT((smp.feature.b_p_a - want.b_p_a).norm(), 1e-12);
+    const double predicted = predictTdoa(gt->w_p_b, Quat::Identity(), kUtilTagOffset_b, s.position(smp.feature.id_a),
+                                         s.position(smp.feature.id_b));
+    EXPECT_NEAR(smp.error_m, smp.measured_m - predicted, 1e-12);
+  }
+}
+
+TEST(BiasDataset, PositionOnlyPoseOfAFlightWithAnImuNeedsTheEstimatedInputs) {
+  // GIVEN a flight with an IMU whose pose has no orientation: the filter knows a body frame the truth does not give
+  Flight g = circleFlight(5);
+  g.pose_has_orientation = false;
+  for (int k = 0; k < 100; ++k) {
+    g.acc.push_back({0.01 * k, Vec3(0, 0, kGravity_mps2)});
+    g.gyro.push_back({0.01 * k, Vec3::Zero()});
+  }
+  // WHEN the GP inputs are to come from the ground truth THEN a clear error names the column and the way out
   try {
     buildBiasDataset({g}, ringSurvey());
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("orientation"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("pose_qw"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--inputs estimate"), std::string::npos) << e.what();
   }
 }
 

@@ -73,6 +73,9 @@ struct BiasFlightReport {
   std::size_t n_outlier = 0;           ///< |ε| > max_abs_error_m
   std::size_t n_used = 0;
   std::size_t n_pose_glitches_detected = 0;  ///< rejected pose samples (attitude + position)
+  /// false for a position-only pose: the lever arm was added in the world frame and, with ground-truth inputs, the
+  /// features took the level, unturned attitude (buildBiasDataset)
+  bool orientation_from_truth = true;
   /// The TDoA bias level the filter measured in flight before any correction (filter.md F23c, F24b); NaN without a
   /// filter run (ground-truth inputs) or when it counted no window
   double bias_level_m = std::numeric_limits<double>::quiet_NaN();
