@@ -300,7 +300,8 @@ void bindEval(py::module_& m) {
         return buildBiasDataset(copies, survey, params);
       },
       py::arg("flights"), py::arg("survey"),
-      "Training data from flights with ground-truth pose and orientation. Keyword arguments override\n"
+      "Training data from flights with a ground-truth pose (position-only without IMU: world-frame features).\n"
+      "Keyword arguments override\n"
       "BiasDatasetParams (min_z_m, glitch_margin_s, max_abs_error_m, neighbour_pairs_only, b_t_tag, "
       "inputs='estimate'|'truth': GP inputs from the uncorrected filter (the default, as the CLI's train) or from the "
       "ground truth).");

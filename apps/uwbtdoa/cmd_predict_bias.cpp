@@ -43,9 +43,6 @@ void run(const Options& o) {
   uwb::FlightReadOptions ro;
   ro.required = {uwb::Stream::kTdoa};
   const uwb::Flight flight = uwb::readFlightCsv(o.flight, ro);
-  if (!flight.hasGroundTruth() || !flight.pose_has_orientation)
-    throw uwb::InputError(uwb::SourceLocation{o.flight, 0, 0, "pose_qw"},
-                          "predict-bias needs the ground-truth pose with orientation to compute the GP features");
   const uwb::BiasModel model = uwb::BiasModel::load(o.model);
   std::string inputs = o.inputs;
   if (inputs.empty()) {
@@ -55,6 +52,7 @@ void run(const Options& o) {
                  : "truth";
   }
   const uwb::BiasInputSource source = uwb::biasInputSourceFromString(inputs);
+  uwb::requireFeatureFrame(flight, source, o.flight);
   std::string out = "t,idA,idB,tdoa_meas,error_m,bias_mean_m,bias_std_m,airborne,predictive_std_m\n";
   double se_b = 0, se_a = 0;
   std::size_t n_air = 0, n_rows = 0;

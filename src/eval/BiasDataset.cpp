@@ -32,6 +32,23 @@ void BiasDatasetParams::validate() const {
   pose_track.validate();
 }
 
+void requireFeatureFrame(const Flight& flight, BiasInputSource inputs, const std::string& name) {
+  if (!flight.hasGroundTruth())
+    throw InputError(SourceLocation{flight.source, 0, 0, "pose_x"},
+                     "flight " + name + " has no ground-truth pose (pose_* columns are empty)");
+  // A position-only pose (util-final-extract) leaves the body frame unknown: the track then carries the level,
+  // unturned attitude (io/PoseTrack.h), so the lever arm is added in the world frame (as SOURCE.md prescribes) and
+  // the features' anchor angles are taken in the world frame. That is the frame the filter itself reports without
+  // an IMU, so features from such a flight match the ones the filter forms at run time. With an IMU the filter
+  // knows the body frame, and features from a level, unturned truth would not be the ones it forms: there the
+  // estimate must give them.
+  if (!flight.pose_has_orientation && inputs == BiasInputSource::kGroundTruth && flight.hasImu())
+    throw InputError(SourceLocation{flight.source, 0, 0, "pose_qw"},
+                     "flight " + name +
+                         " has an IMU but no ground-truth orientation; the bias features need the body frame: take "
+                         "the GP inputs from the filter's estimate (--inputs estimate)");
+}
+
 BiasDataset buildBiasDataset(const std::vector<Flight>& flights, const AnchorSurvey& survey,
                              const BiasDatasetParams& params) {
   params.validate();
@@ -44,20 +61,7 @@ BiasDataset buildBiasDataset(const std::vector<Flight>& flights, const AnchorSur
   for (std::size_t fi = 0; fi < flights.size(); ++fi) {
     const Flight& flight = flights[fi];
     const std::string name = flight.source.empty() ? "flight #" + std::to_string(fi + 1) : flight.source;
-    if (!flight.hasGroundTruth())
-      throw InputError(SourceLocation{flight.source, 0, 0, "pose_x"},
-                       "training flight " + name + " has no ground-truth pose (pose_* columns are empty)");
-    // A position-only pose (util-final-extract) leaves the body frame unknown: the track then carries the level,
-    // unturned attitude (io/PoseTrack.h), so the lever arm is added in the world frame (as SOURCE.md prescribes) and
-    // the features' anchor angles are taken in the world frame. That is the frame the filter itself reports without
-    // an IMU, so features from such a flight match the ones the filter forms at run time. With an IMU the filter
-    // knows the body frame, and features from a level, unturned truth would not be the ones it forms: there the
-    // estimate must give them.
-    if (!flight.pose_has_orientation && params.inputs == BiasInputSource::kGroundTruth && flight.hasImu())
-      throw InputError(SourceLocation{flight.source, 0, 0, "pose_qw"},
-                       "training flight " + name +
-                           " has an IMU but no ground-truth orientation; the bias features need the body frame: "
-                           "take the GP inputs from the filter's estimate (--inputs estimate)");
+    requireFeatureFrame(flight, params.inputs, name);
     const PoseTrack track(flight, params.pose_track);
     TdoaResidualParams rp;
     rp.b_t_tag = params.b_t_tag;

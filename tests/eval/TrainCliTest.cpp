@@ -1,7 +1,8 @@
 /** @file TrainCliTest.cpp
  *  @brief `uwbtdoa train`: --dump-arrays writes the training arrays with named columns, the summary reports the
  *         full-data ELBO, and a given seed and thread count gives the same model file; the default model
- *         (pair-tdoa-pos, M = 30, docs/math/gp.md P26c) corrects a flight it was not trained on.
+ *         (pair-tdoa-pos, M = 30, docs/math/gp.md P26c) corrects a flight it was not trained on, also from the
+ *         position-only, IMU-less flights of util-final-extract.
  */
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -105,6 +106,42 @@ TEST(TrainCli, TheDefaultModelIsPerPairWithAnArenaMapAndCorrectsAnotherFlight) {
   const double before = nlohmann::json::parse(plain.out).at("rmse_airborne_m").get<double>();
   const double after = nlohmann::json::parse(corrected.out).at("rmse_airborne_m").get<double>();
   EXPECT_LT(after, 0.9 * before) << "uncorrected " << before << " m, corrected " << after << " m";
+  std::filesystem::remove_all(dir);
+}
+
+TEST(TrainCli, APositionOnlyFlightWithoutImuTrainsAModelThatCorrectsAnotherDayInItsRoom) {
+  // GIVEN the TDoA-only flights of util-final-extract: position-only pose, no IMU (their SOURCE.md)
+  if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
+  const auto dir_in = test::dataDir() / "real" / "util-final-extract";
+  const std::string survey = " --anchors " + (dir_in / "survey" / "anchor_const4_survey.txt").string();
+  std::string flights;
+  for (int k = 1; k <= 3; ++k) {
+    const auto f = dir_in / ("const4-trial1-tdoa2-traj" + std::to_string(k) + ".csv");
+    if (!std::filesystem::exists(f)) GTEST_SKIP() << "util-final-extract not found under " << test::dataDir();
+    flights += f.string() + " ";
+  }
+  const auto test_flight = dir_in / "const4-trial2-tdoa2-traj2.csv";
+  if (!std::filesystem::exists(test_flight)) GTEST_SKIP() << "util-final-extract not found under " << test::dataDir();
+  const auto dir = std::filesystem::temp_directory_path() / ("uwb_train_extract_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string model = (dir / "m.json").string();
+  // WHEN the default model is trained on one trial's three flights
+  const test::CliResult trained = test::runCli("train " + flights + survey + " --quiet --json --out " + model);
+  ASSERT_EQ(trained.exit_code, 0) << trained.err;
+  // THEN it takes a flight of the other trial well below the uncorrected filter (measured: 0.171 -> 0.101 m)
+  const std::string localize = "localize " + test_flight.string() + survey + " --no-diagnostics --json";
+  const test::CliResult plain = test::runCli(localize), corrected = test::runCli(localize + " --bias-model " + model);
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  ASSERT_EQ(corrected.exit_code, 0) << corrected.err;
+  const double before = nlohmann::json::parse(plain.out).at("rmse_airborne_m").get<double>();
+  const double after = nlohmann::json::parse(corrected.out).at("rmse_airborne_m").get<double>();
+  EXPECT_LT(after, 0.8 * before) << "uncorrected " << before << " m, corrected " << after << " m";
+  // AND predict-bias scores the model there, its features formed in the same frame
+  const test::CliResult scored = test::runCli("predict-bias " + test_flight.string() + survey + " --model " + model +
+                                              " --json --out " + (dir / "bias.csv").string());
+  ASSERT_EQ(scored.exit_code, 0) << scored.err;
+  const nlohmann::json cal = nlohmann::json::parse(scored.out).at("calibration");
+  EXPECT_GT(cal.at("coverage_2sigma").get<double>(), 0.9);
   std::filesystem::remove_all(dir);
 }
 

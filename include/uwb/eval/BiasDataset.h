@@ -90,8 +90,13 @@ struct BiasDataset {
   std::string reportText() const;
 };
 
-/// Builds the dataset. Throws InputError when a flight has no ground-truth pose or no pose orientation (the
-/// body-frame features need it), and std::invalid_argument for bad params.
+/// Throws InputError (naming the flight's source) when the GP features of `flight` cannot be formed as the filter
+/// forms them at run time: without a ground-truth pose, or with `inputs` from the truth of a flight with an IMU whose
+/// pose has no orientation. A position-only pose of a flight without IMU is taken level and unturned, the attitude
+/// the filter reports without an IMU.
+void requireFeatureFrame(const Flight& flight, BiasInputSource inputs, const std::string& name);
+
+/// Builds the dataset. Throws InputError where requireFeatureFrame does, and std::invalid_argument for bad params.
 BiasDataset buildBiasDataset(const std::vector<Flight>& flights, const AnchorSurvey& survey,
                              const BiasDatasetParams& params = {});
 
