@@ -31,8 +31,10 @@ distribution of the bias (docs/math/gp.md P43) on each test flight; per split th
 (error, bias mean, predictive std per TDoA) are kept there as SPLIT__TRAIN__TEST.csv, to rescore other predictive shapes.
 
 With --with="FLAGS", every run with a model gets these localize flags too (e.g. --with="--bias-guard").
+With --only=TEXT, only the splits whose label contains TEXT run (e.g. --only=const4).
 
-Usage: scripts/bias_splits.py [BUILD_DIR] [--calibration | --pairs] [--with="FLAGS"] [--kernel=K] [--inducing=M] [--keep=DIR]   (data: $UWBTDOA_DATA or ../shared/data)
+Usage: scripts/bias_splits.py [BUILD_DIR] [--calibration | --pairs] [--with="FLAGS"] [--kernel=K] [--inducing=M] [--keep=DIR]
+                              [--only=TEXT]   (data: $UWBTDOA_DATA or ../shared/data)
 """
 import json
 import os
@@ -41,7 +43,7 @@ import subprocess
 import sys
 import tempfile
 
-OPTS = ("--with=", "--kernel=", "--inducing=", "--keep=")
+OPTS = ("--with=", "--kernel=", "--inducing=", "--keep=", "--only=")
 ARGS = [a for a in sys.argv[1:] if a not in ("--calibration", "--pairs") and not a.startswith(OPTS)]
 # --with="FLAGS": more localize flags for every run with a model (e.g. --with="--bias-guard")
 WITH = [f for a in sys.argv[1:] if a.startswith("--with=") for f in a[len("--with="):].split()]
@@ -50,6 +52,8 @@ KERNEL = next((a[len("--kernel="):] for a in sys.argv[1:] if a.startswith("--ker
 INDUCING = next((a[len("--inducing="):] for a in sys.argv[1:] if a.startswith("--inducing=")), "30")
 # --keep=DIR: with --calibration, the predict-bias rows of every pair
 KEEP = next((a[len("--keep="):] for a in sys.argv[1:] if a.startswith("--keep=")), None)
+# --only=TEXT: the splits whose label contains TEXT
+ONLY = next((a[len("--only="):] for a in sys.argv[1:] if a.startswith("--only=")), "")
 CALIBRATION = "--calibration" in sys.argv[1:]
 PAIRS = "--pairs" in sys.argv[1:]
 BUILD = ARGS[0] if ARGS else "build"
@@ -150,7 +154,7 @@ def splits():
         s.append((f"{other}->const4", [(FLIGHTS[other], t) for t in f]))
     for other in ("0426", "0425"):
         s.append((f"const4->{other}", [(f, t) for t in FLIGHTS[other]]))
-    return s
+    return [(label, pairs) for label, pairs in s if ONLY in label]
 
 
 def main():

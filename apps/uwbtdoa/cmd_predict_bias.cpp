@@ -66,13 +66,18 @@ void run(const Options& o) {
       variance_m2.push_back(p.varianceM2());
     }
   };
+  // (P43c) the flight's uncorrected bias level, measured by the filter that gives the GP inputs; unknown (nothing
+  // added) with ground-truth inputs
+  double flight_level_m = std::numeric_limits<double>::quiet_NaN(), mean_level_m = flight_level_m;
   if (source == uwb::BiasInputSource::kFilterEstimate) {
     uwb::BiasDatasetParams dp;
     dp.inputs = source;
     dp.min_z_m = o.min_z;
     const uwb::BiasDataset data = uwb::buildBiasDataset({flight}, survey, dp);
+    flight_level_m = data.flights.at(0).bias_level_m;
+    mean_level_m = uwb::modelMeanLevels(model, data, dp.localization.params.output_bias_memory_s).at(0);
     for (const auto& smp : data.samples) {
-      const uwb::BiasPredictive p = model.predictive(smp.feature);
+      const uwb::BiasPredictive p = model.predictive(smp.feature, flight_level_m, mean_level_m);
       out += fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},1,{:.7g}\n", smp.t_s, smp.feature.id_a,
                          smp.feature.id_b, smp.measured_m, smp.error_m, p.mean_m, std::sqrt(p.latent_variance_m2),
                          std::sqrt(p.varianceM2()));
@@ -99,7 +104,12 @@ void run(const Options& o) {
   const std::string json_text = uwb::app::dumpJson(
       nlohmann::json{{"flight", o.flight}, {"model", o.model}, {"inputs", inputs}, {"n_rows", n_rows},
                      {"n_airborne", n_air}, {"bias_rmse_before_m", before}, {"bias_rmse_after_m", after},
-                     {"calibration", cal_json}, {"out", o.out}});
+                     {"calibration", cal_json}, {"out", o.out},
+                     {"flight_bias_level_m", std::isfinite(flight_level_m) ? nlohmann::json(flight_level_m) : nlohmann::json(nullptr)},
+                     {"training_bias_level_m", model.trainingBiasLevel()},
+                     {"model_mean_level_m", std::isfinite(mean_level_m) ? nlohmann::json(mean_level_m) : nlohmann::json(nullptr)},
+                     {"training_mean_level_m", model.trainingMeanLevel()},
+                     {"level_excess_std_m", std::sqrt(model.levelExcessVarianceM2(flight_level_m, mean_level_m))}});
   uwb::writeFileAtomically(o.out, out, "bias CSV");
   if (o.json_out) {
     std::cout << json_text << '\n';

@@ -5,6 +5,7 @@
 
 #include <boost/math/distributions/students_t.hpp>
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -95,8 +96,15 @@ BiasCalibration biasCalibration(const BiasDataset& data, const BiasModel& model)
   r.reserve(data.samples.size());
   var.reserve(data.samples.size());
   std::size_t uncovered = 0;
+  // (P43c) with the level the filter measured on the sample's flight and that of the model's mean there
+  const std::vector<double> mean_levels =
+      modelMeanLevels(model, data, data.params.localization.params.output_bias_memory_s);
   for (const auto& s : data.samples) {
-    const BiasPredictive p = model.predictive(s.feature);
+    const bool known = s.flight >= 0 && static_cast<std::size_t>(s.flight) < data.flights.size();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const std::size_t fi = known ? static_cast<std::size_t>(s.flight) : 0;
+    const BiasPredictive p =
+        model.predictive(s.feature, known ? data.flights[fi].bias_level_m : nan, known ? mean_levels[fi] : nan);
     if (!p.covered) {
       ++uncovered;
       continue;

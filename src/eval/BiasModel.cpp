@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -329,6 +330,24 @@ BiasPredictive BiasModel::predictive(const TdoaFeature& f) const {
     return p;
   }
   return p;
+}
+
+BiasPredictive BiasModel::predictive(const TdoaFeature& f, double flight_level_m, double flight_mean_level_m) const {
+  BiasPredictive p = predictive(f);
+  if (p.covered) p.level_variance_m2 = levelExcessVarianceM2(flight_level_m, flight_mean_level_m);
+  return p;
+}
+
+double BiasModel::levelExcessVarianceM2(double flight_level_m, double flight_mean_level_m) const {
+  const auto known = [](double l) { return std::isfinite(l) && l > 0.0; };
+  if (!known(training_bias_level_m_) || !known(flight_level_m)) return 0.0;
+  // (P43c) what no mean explains, on this flight against the training flights
+  double unexplained = flight_level_m * flight_level_m, trained = training_bias_level_m_ * training_bias_level_m_;
+  if (known(flight_mean_level_m) && known(training_mean_level_m_)) {
+    unexplained -= flight_mean_level_m * flight_mean_level_m;
+    trained -= training_mean_level_m_ * training_mean_level_m_;
+  }
+  return std::max(0.0, unexplained - trained);
 }
 
 BiasPredictor BiasModel::predictor() const {
@@ -655,7 +674,7 @@ void applyBiasModelLevel(const BiasModel& model, EkfParams* params) {
     params->bias_model_training_mean_level_m = model.trainingMeanLevel();
 }
 
-double modelMeanLevel(const BiasModel& model, const BiasDataset& data, double memory_s) {
+std::vector<double> modelMeanLevels(const BiasModel& model, const BiasDataset& data, double memory_s) {
   // (F24c) per flight, the samples in time order through the F23c windows, µ in place of the residual; the body
   // origin stands for the tag (the lever arm is centimetres, the windows' geometry does not feel it)
   std::map<int, BiasLevel> levels;
@@ -664,10 +683,19 @@ double modelMeanLevel(const BiasModel& model, const BiasDataset& data, double me
     const TdoaFeature& f = s.feature;
     it->second.add(s.t_s, f.id_a, f.w_p_anchor_a, f.id_b, f.w_p_anchor_b, f.w_p_b, model.predict(f).mean_m);
   }
-  double sum = 0.0;
-  int n = 0;
+  std::vector<double> out(data.flights.size(), std::numeric_limits<double>::quiet_NaN());
   for (const auto& [flight, level] : levels) {
     const double l = level.pairLevelData();
+    if (flight >= 0 && static_cast<std::size_t>(flight) < out.size() && std::isfinite(l))
+      out[static_cast<std::size_t>(flight)] = l;
+  }
+  return out;
+}
+
+double modelMeanLevel(const BiasModel& model, const BiasDataset& data, double memory_s) {
+  double sum = 0.0;
+  int n = 0;
+  for (const double l : modelMeanLevels(model, data, memory_s)) {
     if (!std::isfinite(l)) continue;
     sum += l;
     ++n;

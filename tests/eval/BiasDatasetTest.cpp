@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <cstdio>
@@ -13,6 +14,7 @@
 
 #include "support/TestSupport.h"
 #include "uwb/core/Error.h"
+#include "uwb/eval/BiasCalibration.h"
 #include "uwb/eval/BiasDataset.h"
 #include "uwb/eval/BiasModel.h"
 #include "uwb/io/UtilCsv.h"
@@ -185,6 +187,46 @@ TEST(BiasModel, TheHeldOutPartScoresThePredictiveDistribution) {
   EXPECT_NEAR(rep.holdout_coverage_1sigma, 0.668, 0.08);
   EXPECT_NEAR(rep.holdout_coverage_2sigma, 0.985, 0.03);
   EXPECT_TRUE(std::isfinite(rep.holdout_nlpd));
+}
+
+TEST(BiasModel, AFlightMoreBiasedThanTheTrainingFlightsWidensThePredictiveDistributionByTheExcess) {
+  // GIVEN a model trained on the synthetic flight (5 cm noise), whose training flights' level is 0.10 m
+  const BiasDataset train = buildBiasDataset({circleFlight(40, 0.05)}, ringSurvey());
+  BiasModel model = trainBiasModel(train, smallZ1Training());
+  model.setTrainingBiasLevel(0.10);
+  model.setTrainingMeanLevel(0.0);  // the level of its mean there unknown
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const TdoaFeature& f = train.samples.front().feature;
+  const BiasPredictive plain = model.predictive(f);
+  ASSERT_TRUE(plain.covered);
+  // THEN a flight at level 0.25 m adds ℓ² − ℓ_train² = 0.0525 m² (P43c); a less biased flight or an unknown level
+  // adds nothing, and the mean is never touched
+  const BiasPredictive more = model.predictive(f, 0.25, nan);
+  EXPECT_NEAR(more.level_variance_m2, 0.25 * 0.25 - 0.10 * 0.10, 1e-15);
+  EXPECT_NEAR(more.varianceM2(), plain.varianceM2() + 0.0525, 1e-12);
+  EXPECT_EQ(more.mean_m, plain.mean_m);
+  EXPECT_EQ(model.predictive(f, 0.05, nan).level_variance_m2, 0.0);
+  EXPECT_EQ(model.predictive(f, nan, nan).level_variance_m2, 0.0);
+  // AND with the levels of the model's mean known on both sides, only what the mean does not explain counts:
+  // (0.25² − 0.20²) − (0.10² − 0.06²) = 0.0225 − 0.0064 = 0.0161 m²; a mean that explains the whole excess adds 0
+  model.setTrainingMeanLevel(0.06);
+  EXPECT_NEAR(model.predictive(f, 0.25, 0.20).level_variance_m2, 0.0161, 1e-15);
+  EXPECT_EQ(model.predictive(f, 0.25, 0.24).level_variance_m2, 0.0);
+  EXPECT_NEAR(model.predictive(f, 0.25, nan).level_variance_m2, 0.0525, 1e-15);  // ℓ_µ unknown: both terms drop
+  // AND a model of unknown training level adds nothing
+  BiasModel unknown = model;
+  unknown.setTrainingBiasLevel(0.0);
+  EXPECT_EQ(unknown.predictive(f, 0.25, 0.20).level_variance_m2, 0.0);
+  // AND on a flight with 25 cm of extra white error, which no mean explains, the calibration takes the flight's
+  // level from its dataset: the intervals that under-cover without the excess cover near their nominal mass with it
+  model.setTrainingMeanLevel(0.0);
+  BiasDataset test = buildBiasDataset({circleFlight(40, 0.25)}, ringSurvey());
+  const BiasCalibration blind = biasCalibration(test, model);
+  test.flights.at(0).bias_level_m = std::sqrt(0.10 * 0.10 + 0.25 * 0.25);
+  const BiasCalibration aware = biasCalibration(test, model);
+  EXPECT_LT(blind.coverage_1sigma, 0.4);
+  EXPECT_NEAR(aware.coverage_1sigma, 0.683, 0.08);
+  EXPECT_NEAR(aware.coverage_2sigma, 0.954, 0.04);
 }
 
 TEST(BiasModel, LearnsTheSyntheticBiasAndRoundTripsBitIdentically) {

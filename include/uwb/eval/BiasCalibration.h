@@ -48,8 +48,9 @@ struct BiasCalibration {
   PredictiveShape shape = PredictiveShape::gaussian();  ///< the predictive distribution scored (P43b)
 };
 
-/// Scores r = ε − µ against σ² = var_f + σ_n² over the dataset's samples (features as stored in the dataset), with
-/// the model's predictive shape.
+/// Scores r = ε − µ against σ² = var_f + σ_n² + the level excess of the sample's flight (P43c, from the level the
+/// dataset's filter run measured; none for ground-truth inputs) over the dataset's samples (features as stored in the
+/// dataset), with the model's predictive shape.
 BiasCalibration biasCalibration(const BiasDataset& data, const BiasModel& model);
 
 /// From residuals and predictive variances directly (same definitions), for the given shape (default: Gaussian).

@@ -125,8 +125,11 @@ struct BiasPredictive {
   double mean_m = 0.0;              ///< pair mean (P28) + GP mean
   double latent_variance_m2 = 0.0;  ///< var_f of the GP mean (with the jitter)
   double noise_variance_m2 = 0.0;   ///< σ_n² of the GP's likelihood: the part of ε the inputs do not explain
+  /// (P43c) the flight's bias variance beyond the training flights': max(0, ℓ² − ℓ_train²) of the levels
+  /// (BiasModel::levelExcessVarianceM2); 0 when either level is unknown
+  double level_variance_m2 = 0.0;
   bool covered = false;             ///< false: no GP covers the pair (mean 0, variances 0)
-  double varianceM2() const { return latent_variance_m2 + noise_variance_m2; }
+  double varianceM2() const { return latent_variance_m2 + noise_variance_m2 + level_variance_m2; }
 };
 
 /// Progress: (model index, number of models, epoch report).
@@ -151,6 +154,17 @@ class BiasModel {
   BiasPrediction predict(const TdoaFeature& f) const;
   /// Predictive distribution of ε itself (latent and likelihood variance, without the extra variance P31).
   BiasPredictive predictive(const TdoaFeature& f) const;
+  /// The same on a flight whose uncorrected TDoA bias level the filter measured as flight_level_m (F23c) and on
+  /// which the model's mean has the level flight_mean_level_m (F24c), with the excess variance of P43c added where
+  /// the model covers the pair.
+  BiasPredictive predictive(const TdoaFeature& f, double flight_level_m, double flight_mean_level_m) const;
+  /// (P43c) The part of a flight's TDoA error variance that neither the model's mean explains nor its training
+  /// flights showed. A pair level ℓ is the RMS of a pair's error (filter.md F23c), ℓ_µ that of the model's mean
+  /// (F24c): with ε = µ + r, E[r²] ≈ ℓ² − ℓ_µ² on the flight and ℓ_train² − ℓ_µ,train² on the training flights,
+  /// where the likelihood noise was learned. The excess is max(0, (ℓ² − ℓ_µ²) − (ℓ_train² − ℓ_µ,train²)); with ℓ_µ
+  /// or ℓ_µ,train unknown (NaN, ≤ 0) both mean terms drop; 0 when ℓ or ℓ_train is unknown. A flight at a lower level
+  /// gets nothing taken away.
+  double levelExcessVarianceM2(double flight_level_m, double flight_mean_level_m) const;
   /// A cheap-to-copy, thread-compatible callable for the filter (shares this model's immutable state).
   BiasPredictor predictor() const;
 
@@ -224,6 +238,8 @@ std::vector<BiasModel::PairMean> pairMeans(const std::vector<BiasSample>& sample
 /// BiasLevel over each flight's samples in time order, forgotten with memory_s), averaged over the flights that
 /// counted a window; 0 when none did.
 double modelMeanLevel(const BiasModel& model, const BiasDataset& data, double memory_s);
+/// The same per flight of `data` (index as data.flights); NaN for a flight that counted no window.
+std::vector<double> modelMeanLevels(const BiasModel& model, const BiasDataset& data, double memory_s);
 
 /// Indices of held-out samples: every k-th block of `block_s` seconds of each flight, k = round(1/fraction).
 std::vector<bool> holdoutMask(const std::vector<BiasSample>& samples, double fraction, double block_s);
