@@ -100,11 +100,10 @@ BiasCalibration biasCalibration(const BiasDataset& data, const BiasModel& model)
   const std::vector<double> mean_levels =
       modelMeanLevels(model, data, data.params.localization.params.output_bias_memory_s);
   for (const auto& s : data.samples) {
-    const bool known = s.flight >= 0 && static_cast<std::size_t>(s.flight) < data.flights.size();
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    const std::size_t fi = known ? static_cast<std::size_t>(s.flight) : 0;
-    const BiasPredictive p =
-        model.predictive(s.feature, known ? data.flights[fi].bias_level_m : nan, known ? mean_levels[fi] : nan);
+    const std::size_t fi = s.flight >= 0 ? static_cast<std::size_t>(s.flight) : mean_levels.size();
+    const BiasPredictive p = model.predictive(s.feature, fi < data.flights.size() ? data.flights[fi].bias_level_m : nan,
+                                              fi < mean_levels.size() ? mean_levels[fi] : nan);
     if (!p.covered) {
       ++uncovered;
       continue;

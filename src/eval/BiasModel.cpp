@@ -683,11 +683,13 @@ std::vector<double> modelMeanLevels(const BiasModel& model, const BiasDataset& d
     const TdoaFeature& f = s.feature;
     it->second.add(s.t_s, f.id_a, f.w_p_anchor_a, f.id_b, f.w_p_anchor_b, f.w_p_b, model.predict(f).mean_m);
   }
-  std::vector<double> out(data.flights.size(), std::numeric_limits<double>::quiet_NaN());
+  std::size_t n = data.flights.size();
+  for (const auto& [flight, level] : levels)
+    if (flight >= 0) n = std::max(n, static_cast<std::size_t>(flight) + 1);
+  std::vector<double> out(n, std::numeric_limits<double>::quiet_NaN());
   for (const auto& [flight, level] : levels) {
     const double l = level.pairLevelData();
-    if (flight >= 0 && static_cast<std::size_t>(flight) < out.size() && std::isfinite(l))
-      out[static_cast<std::size_t>(flight)] = l;
+    if (flight >= 0 && std::isfinite(l)) out[static_cast<std::size_t>(flight)] = l;
   }
   return out;
 }

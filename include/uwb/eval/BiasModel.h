@@ -238,7 +238,8 @@ std::vector<BiasModel::PairMean> pairMeans(const std::vector<BiasSample>& sample
 /// BiasLevel over each flight's samples in time order, forgotten with memory_s), averaged over the flights that
 /// counted a window; 0 when none did.
 double modelMeanLevel(const BiasModel& model, const BiasDataset& data, double memory_s);
-/// The same per flight of `data` (index as data.flights); NaN for a flight that counted no window.
+/// The same per flight (indexed by BiasSample::flight, at least data.flights.size() entries); NaN for a flight that
+/// counted no window.
 std::vector<double> modelMeanLevels(const BiasModel& model, const BiasDataset& data, double memory_s);
 
 /// Indices of held-out samples: every k-th block of `block_s` seconds of each flight, k = round(1/fraction).
