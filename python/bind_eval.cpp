@@ -6,6 +6,7 @@
  *    id_a, id_b (int32), yaw_a, yaw_b [rad], b_p_a, b_p_b (N, 3) [m, body frame], w_p_b (N, 3) [m, world],
  *    w_p_anchor_a, w_p_anchor_b (N, 3) [m, world]. A key that the model's feature map reads must be present.
  */
+#include <limits>
 #include <functional>
 #include <map>
 #include <optional>
@@ -361,6 +362,10 @@ void bindEval(py::module_& m) {
                     "TDoA bias level of the training flights [m] (filter.md F24b; 0 unknown: the mean is not scaled)")
       .def_property("training_mean_level_m", &BiasModel::trainingMeanLevel, &BiasModel::setTrainingMeanLevel,
                     "Level of the model's own mean on its training flights [m] (filter.md F24c; 0 unknown)")
+      .def("level_excess_variance_m2", &BiasModel::levelExcessVarianceM2, py::arg("flight_level_m"),
+           py::arg("flight_mean_level_m") = std::numeric_limits<double>::quiet_NaN(),
+           "Variance [m²] a flight at TDoA bias level flight_level_m (and level flight_mean_level_m of the model's mean\n"
+           "on it; NaN unknown) shows beyond the training flights (docs/math/gp.md P43c); 0 when a level is unknown.")
       .def_property("metadata_json", [](const BiasModel& b) { return b.metadata_json; },
                     [](BiasModel& b, const std::string& s) { b.metadata_json = s; })
       .def("save", &BiasModel::save, py::arg("path"), "Writes the model file (the CLI's --bias-model format).")
@@ -440,8 +445,10 @@ void bindEval(py::module_& m) {
         return jsonToPython(toJson(c));
       },
       py::arg("dataset"), py::arg("model"),
-      "Calibration of the model's predicted bias on a dataset (docs/math/gp.md P43, P43b): r = ε − µ against\n"
-      "σ² = var_f + σ_n² and the central intervals of the model's predictive shape (Student-t or Gaussian).\n"
+      "Calibration of the model's predicted bias on a dataset (docs/math/gp.md P43, P43b, P43c): r = ε − µ against\n"
+      "σ² = var_f + σ_n² + the variance the sample's flight shows beyond the model's training flights (from the\n"
+      "levels its filter run measured; none for ground-truth inputs) and the central intervals of the model's\n"
+      "predictive shape (Student-t or Gaussian).\n"
       "Returns {n, n_uncovered, coverage_1sigma, coverage_2sigma, nlpd [nats], rmse_m, mean_std_m, levels,\n"
       "coverage (at levels), predictive_dof, predictive_scale}.");
 

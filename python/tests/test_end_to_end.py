@@ -200,3 +200,12 @@ def test_the_default_training_pipeline_corrects_a_real_flight_it_was_not_trained
     before = u.localize_flight(test, survey)["metrics"]["airborne"]["rmse_m"]
     after = u.localize_flight(test, survey, bias_model=model)["metrics"]["airborne"]["rmse_m"]
     assert after < 0.9 * before, (before, after)
+    # a flight more biased than the training flights gets the excess of its level as predictive variance (gp.md
+    # P43c); a less biased one, or one of unknown level, nothing
+    level = model.training_bias_level_m
+    assert model.level_excess_variance_m2(2 * level) == pytest.approx(3 * level ** 2)
+    assert model.level_excess_variance_m2(0.5 * level) == 0.0
+    assert model.level_excess_variance_m2(float("nan")) == 0.0
+    # the calibration on the test flight takes its level from the dataset's filter run
+    cal = u.bias_calibration(u.build_bias_dataset([test], survey), model)
+    assert 0.5 < cal["coverage_1sigma"] < 0.9 and 0.85 < cal["coverage_2sigma"] <= 1.0, cal
