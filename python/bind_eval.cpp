@@ -198,6 +198,7 @@ py::dict summaryDict(const LocalizerSummary& s) {
   d["bias_level_m"] = s.bias_level_m, d["n_bias_level_windows"] = s.n_bias_level_windows;
   d["raw_bias_level_m"] = s.raw_bias_level_m, d["bias_model_mean_scale"] = s.bias_model_mean_scale;
   d["min_bias_model_mean_scale"] = s.min_bias_model_mean_scale, d["model_mean_level_m"] = s.model_mean_level_m;
+  d["bias_model_level_variance_m2"] = s.bias_model_level_variance_m2;
   d["reacquisition_t_s"] = s.reacquisition_t_s;
   d["reacquired_t_s"] = s.reacquired_t_s, d["takeoff_t_s"] = s.takeoff_t_s, d["landing_t_s"] = s.landing_t_s;
   d["started_in_motion"] = s.started_in_motion, d["ready_t_s"] = s.ready_t_s;

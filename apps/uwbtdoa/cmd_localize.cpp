@@ -247,6 +247,7 @@ void runLocalize(const LocalizeArgs& a) {
   j["bias_model_training_mean_level_m"] = params.bias_model_training_mean_level_m;
   j["bias_model_mean_scale"] = s.bias_model_mean_scale;
   j["min_bias_model_mean_scale"] = s.min_bias_model_mean_scale;
+  j["bias_model_level_variance_m2"] = s.bias_model_level_variance_m2;
   j["fuse_tof"] = params.fuse_tof;
   j["n_tof"] = s.n_tof_total;
   j["n_tof_used"] = s.n_tof_used;

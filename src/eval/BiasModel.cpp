@@ -339,15 +339,7 @@ BiasPredictive BiasModel::predictive(const TdoaFeature& f, double flight_level_m
 }
 
 double BiasModel::levelExcessVarianceM2(double flight_level_m, double flight_mean_level_m) const {
-  const auto known = [](double l) { return std::isfinite(l) && l > 0.0; };
-  if (!known(training_bias_level_m_) || !known(flight_level_m)) return 0.0;
-  // (P43c) what no mean explains, on this flight against the training flights
-  double unexplained = flight_level_m * flight_level_m, trained = training_bias_level_m_ * training_bias_level_m_;
-  if (known(flight_mean_level_m) && known(training_mean_level_m_)) {
-    unexplained -= flight_mean_level_m * flight_mean_level_m;
-    trained -= training_mean_level_m_ * training_mean_level_m_;
-  }
-  return std::max(0.0, unexplained - trained);
+  return levelExcessVariance(flight_level_m, flight_mean_level_m, training_bias_level_m_, training_mean_level_m_);
 }
 
 BiasPredictor BiasModel::predictor() const {

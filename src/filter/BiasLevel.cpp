@@ -115,4 +115,16 @@ double BiasLevel::pairLevelData() const {
   return std::sqrt(2.0 * std::max(sum_r_ / sum_tau_, 0.0));
 }
 
+double levelExcessVariance(double level_m, double mean_level_m, double train_level_m, double train_mean_level_m) {
+  const auto known = [](double l) { return std::isfinite(l) && l > 0.0; };
+  if (!known(level_m) || !known(train_level_m)) return 0.0;
+  // (P43c) what no mean explains, on this flight against the training flights
+  double unexplained = level_m * level_m, trained = train_level_m * train_level_m;
+  if (known(mean_level_m) && known(train_mean_level_m)) {
+    unexplained -= mean_level_m * mean_level_m;
+    trained -= train_mean_level_m * train_mean_level_m;
+  }
+  return std::max(0.0, unexplained - trained);
+}
+
 }  // namespace uwb

@@ -169,6 +169,9 @@ std::vector<EkfParamInfo> makeRegistry() {
       real("bias_model_training_mean_level_m", &P::bias_model_training_mean_level_m, "m", kNonNegative,
            "Level of the model's own mean on its training flights (from the model file; 0 unknown: the model's "
            "level on this flight is not compared, F24c)"),
+      boolean("bias_model_level_variance", &P::bias_model_level_variance,
+              "With a bias model: corrected TDoA get the variance the flight shows beyond the model's training "
+              "flights (F24e, gp.md P43c)"),
       real("max_lost_s", &P::max_lost_s, "s", kPositive,
            "All TDoA rejected this long: re-acquire (inflate P, open the gate)"),
       real("lost_velocity_tau_s", &P::lost_velocity_tau_s, "s", kNonNegative,

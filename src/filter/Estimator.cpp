@@ -197,6 +197,7 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
         BiasPrediction b = model_bias_(feature);
         last_model_mean_m_ = b.mean_m;
         b.mean_m *= model_mean_scale_;
+        b.variance_m2 += model_level_variance_m2_;  // (F24e) 0 unless bias_model_level_variance
         return b;
       };
       // (F24c) and what the model itself predicts on this flight, against what it predicted on its training flights
@@ -1017,6 +1018,13 @@ void Estimator::updateModelMeanScale() {
     if (mean_level > 0.0) rho *= mean_train / mean_level;
   }
   model_mean_scale_ = std::pow(std::min(1.0, rho), params_.bias_model_level_exponent);
+  if (params_.bias_model_level_variance) {
+    // (F24e) gp.md P43c with the levels so far
+    model_level_variance_m2_ =
+        levelExcessVariance(level, mean_level_ ? summary_.model_mean_level_m : 0.0, train,
+                            params_.bias_model_training_mean_level_m);
+    summary_.bias_model_level_variance_m2 = model_level_variance_m2_;
+  }
   summary_.bias_model_mean_scale = model_mean_scale_;
   summary_.min_bias_model_mean_scale = std::min(summary_.min_bias_model_mean_scale, model_mean_scale_);
 }

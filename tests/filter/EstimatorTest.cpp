@@ -469,6 +469,39 @@ TEST(Estimator, ABiasModelThatPredictsThisFlightsSmallerBiasIsNotScaledDownForIt
   EXPECT_TRUE(std::isnan(b.summary.model_mean_level_m));  // not measured without the training mean level
 }
 
+TEST(Estimator, AFlightMoreBiasedThanTheModelsTrainingFlightsCanWidenTheCorrectedTdoa) {
+  // GIVEN a flight whose TDoA carry a constant bias per pair, and a model that predicts none of it, trained on
+  // flights of a quarter of this flight's level (their mean's level unknown)
+  const auto bias = [](int pair) { return 0.2 * std::sin(1.7 * pair + 0.3); };
+  const SensorLog log = filtertest::flightLog(arenaAnchors(), circle, 0.0, 40.0, 0.05, true, 3,
+                                              [&](double, int pair) { return bias(pair); }, 0.05);
+  const BiasPredictor nothing = [](const TdoaFeature&) {
+    BiasPrediction b;
+    b.variance_m2 = 1e-4;
+    return b;
+  };
+  EkfParams probe = lateralFullParams();
+  probe.bias_model_training_level_m = 0.2;
+  const double level = TdoaLocalizer(probe, arenaAnchors(), nothing).run(log, 0.1).summary.raw_bias_level_m;
+  ASSERT_GT(level, 0.05);
+  EkfParams off = lateralFullParams();
+  off.bias_model_training_level_m = 0.25 * level;
+  EkfParams on = off;
+  on.bias_model_level_variance = true;
+  const LocalizerResult a = TdoaLocalizer(off, arenaAnchors(), nothing).run(log, 0.1);
+  const LocalizerResult b = TdoaLocalizer(on, arenaAnchors(), nothing).run(log, 0.1);
+  // THEN with F24e each corrected TDoA gains ℓ² − ℓ_train² (gp.md P43c) of the level measured so far (ℓ starts
+  // from the training level and keeps its weight of 10 windows, F24b); without it nothing is added
+  const double train = 0.25 * level;
+  EXPECT_EQ(a.summary.bias_model_level_variance_m2, 0.0);
+  ASSERT_GT(b.summary.raw_bias_level_m, 1.5 * train);
+  EXPECT_NEAR(b.summary.bias_model_level_variance_m2,
+              levelExcessVariance(b.summary.raw_bias_level_m, std::nan(""), train, 0.0), 1e-15);
+  EXPECT_GT(b.summary.bias_model_level_variance_m2, train * train);
+  EXPECT_NE(a.estimates.back().x.w_p_b, b.estimates.back().x.w_p_b);
+  EXPECT_TRUE(std::isfinite(circleRmsFrom(b, 20.0)));
+}
+
 TEST(Estimator, OnTheFloorTheReportedCovarianceCarriesTheFloorLevelBias) {
   // GIVEN a take-off log (on the floor for 2 s, then a climb), localized with the bias floor of F23 and without it
   const SensorLog log = filtertest::takeoffLog(filtertest::TakeoffLogSpec{});

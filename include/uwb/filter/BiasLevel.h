@@ -69,4 +69,9 @@ class BiasLevel {
   int n_windows_ = 0;
 };
 
+/// (gp.md P43c) The TDoA error variance a flight shows beyond a bias model's training flights and beyond what the
+/// model's mean explains: max(0, (ℓ² − ℓ_µ²) − (ℓ_train² − ℓ_µ,train²)) of the pair levels (F23c; ℓ_µ the level of
+/// the mean, F24c). The ℓ_µ terms drop unless both are known; 0 unless ℓ and ℓ_train are known (known: finite, > 0).
+double levelExcessVariance(double level_m, double mean_level_m, double train_level_m, double train_mean_level_m);
+
 }  // namespace uwb

@@ -151,6 +151,10 @@ struct EkfParams {
   /// file, 0 unknown). When known, ρ of F24b is divided by the level of µ on this flight / this one: a model that
   /// itself predicts a smaller bias on this path than on its training flights is not scaled down for that.
   double bias_model_training_mean_level_m = 0.0;
+  /// (F24e) With a bias model whose levels are known: each corrected TDoA's variance gains the variance this flight
+  /// shows beyond the model's training flights and beyond what the model's mean explains (gp.md P43c), with the
+  /// levels as measured so far in flight. Off by default (F24e: no gain on the choice splits).
+  bool bias_model_level_variance = false;
 
   // --- scheduling ---
   double max_predict_dt_s = 0.01;        ///< IMU samples are averaged over at most this interval [s]

@@ -111,6 +111,8 @@ struct LocalizerSummary {
   double model_mean_level_m = std::numeric_limits<double>::quiet_NaN();
   double bias_model_mean_scale = 1.0;      ///< the scale of the model's mean at the end (F24b)
   double min_bias_model_mean_scale = 1.0;  ///< its lowest during the flight (F24b)
+  /// With bias_model_level_variance: the variance added to each corrected TDoA at the end (F24e) [m²]
+  double bias_model_level_variance_m2 = 0.0;
   std::size_t n_reacquisitions = 0;    ///< lost or diverged → position found again by multilateration (F16)
   std::size_t n_time_jumps = 0;        ///< sensor-time gaps or backward jumps handled (F17)
   std::vector<double> reacquisition_t_s;  ///< when each re-acquisition started (first 100)
@@ -298,6 +300,7 @@ class Estimator {
   double last_model_mean_m_ = 0.0;
   BiasPredictor model_bias_;
   double model_mean_scale_ = 1.0;
+  double model_level_variance_m2_ = 0.0;  ///< (F24e) added to a corrected TDoA's variance
   double t_bias_floor_s_ = -1e300;
 };
 
