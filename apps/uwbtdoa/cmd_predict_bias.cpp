@@ -29,6 +29,8 @@
 
 namespace {
 
+nlohmann::json finiteOrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
 struct Options {
   std::string flight, anchors, model, out;
   double min_z = uwb::kAirborneMinZ_m;
@@ -105,9 +107,9 @@ void run(const Options& o) {
       nlohmann::json{{"flight", o.flight}, {"model", o.model}, {"inputs", inputs}, {"n_rows", n_rows},
                      {"n_airborne", n_air}, {"bias_rmse_before_m", before}, {"bias_rmse_after_m", after},
                      {"calibration", cal_json}, {"out", o.out},
-                     {"flight_bias_level_m", std::isfinite(flight_level_m) ? nlohmann::json(flight_level_m) : nlohmann::json(nullptr)},
+                     {"flight_bias_level_m", finiteOrNull(flight_level_m)},
                      {"training_bias_level_m", model.trainingBiasLevel()},
-                     {"model_mean_level_m", std::isfinite(mean_level_m) ? nlohmann::json(mean_level_m) : nlohmann::json(nullptr)},
+                     {"model_mean_level_m", finiteOrNull(mean_level_m)},
                      {"training_mean_level_m", model.trainingMeanLevel()},
                      {"level_excess_std_m", std::sqrt(model.levelExcessVarianceM2(flight_level_m, mean_level_m))}});
   uwb::writeFileAtomically(o.out, out, "bias CSV");

@@ -125,8 +125,8 @@ struct BiasPredictive {
   double mean_m = 0.0;              ///< pair mean (P28) + GP mean
   double latent_variance_m2 = 0.0;  ///< var_f of the GP mean (with the jitter)
   double noise_variance_m2 = 0.0;   ///< σ_n² of the GP's likelihood: the part of ε the inputs do not explain
-  /// (P43c) the flight's bias variance beyond the training flights': max(0, ℓ² − ℓ_train²) of the levels
-  /// (BiasModel::levelExcessVarianceM2); 0 when either level is unknown
+  /// (P43c) the flight's bias variance beyond its training flights' and beyond what the mean explains
+  /// (BiasModel::levelExcessVarianceM2); 0 when a level is unknown
   double level_variance_m2 = 0.0;
   bool covered = false;             ///< false: no GP covers the pair (mean 0, variances 0)
   double varianceM2() const { return latent_variance_m2 + noise_variance_m2 + level_variance_m2; }
