@@ -6,8 +6,8 @@
  *    id_a, id_b (int32), yaw_a, yaw_b [rad], b_p_a, b_p_b (N, 3) [m, body frame], w_p_b (N, 3) [m, world],
  *    w_p_anchor_a, w_p_anchor_b (N, 3) [m, world]. A key that the model's feature map reads must be present.
  */
-#include <limits>
 #include <functional>
+#include <limits>
 #include <map>
 #include <optional>
 #include <nlohmann/json.hpp>

@@ -96,14 +96,17 @@ BiasCalibration biasCalibration(const BiasDataset& data, const BiasModel& model)
   r.reserve(data.samples.size());
   var.reserve(data.samples.size());
   std::size_t uncovered = 0;
-  // (P43c) with the level the filter measured on the sample's flight and that of the model's mean there
-  const std::vector<double> mean_levels =
+  // (P43c) per flight, the level the filter measured on it and that of the model's mean there (NaN: unknown); the
+  // entries cover every flight index ≥ 0 of the samples (modelMeanLevels)
+  constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<double> mean_level =
       modelMeanLevels(model, data, data.params.localization.params.output_bias_memory_s);
+  std::vector<double> level(mean_level.size(), kUnknown);
+  for (std::size_t fi = 0; fi < data.flights.size(); ++fi) level[fi] = data.flights[fi].bias_level_m;
   for (const auto& s : data.samples) {
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    const std::size_t fi = s.flight >= 0 ? static_cast<std::size_t>(s.flight) : mean_levels.size();
-    const BiasPredictive p = model.predictive(s.feature, fi < data.flights.size() ? data.flights[fi].bias_level_m : nan,
-                                              fi < mean_levels.size() ? mean_levels[fi] : nan);
+    const std::size_t fi = static_cast<std::size_t>(s.flight);
+    const BiasPredictive p = s.flight >= 0 ? model.predictive(s.feature, level[fi], mean_level[fi])
+                                           : model.predictive(s.feature, kUnknown, kUnknown);
     if (!p.covered) {
       ++uncovered;
       continue;
