@@ -28,7 +28,8 @@ level of the model's mean on it.
 With --calibration, instead of the filters: `uwbtdoa predict-bias TEST --model M --json` scores the model's predictive
 distribution of the bias (docs/math/gp.md P43) on each test flight; per split the 1σ and 2σ coverage (nominal 68.3 and
 95.4 %; mean, lowest, highest over the pairs) and the mean NLPD. With --keep=DIR, each pair's `predict-bias` rows
-(error, bias mean, predictive std per TDoA) are kept there as SPLIT__TRAIN__TEST.csv, to rescore other predictive shapes.
+(error, bias mean, predictive std per TDoA) are kept there as SPLIT__TRAIN__TEST.csv, and its JSON summary (levels,
+calibration) as SPLIT__TRAIN__TEST.json, to rescore other predictive shapes.
 
 With --with="FLAGS", every run with a model gets these localize flags too (e.g. --with="--bias-guard").
 With --only=TEXT, only the splits whose label contains TEXT run (e.g. --only=const4).
@@ -104,7 +105,11 @@ def level_cell(run, key):
 def calibration(name, model, rows):
     cmd = [CLI, "predict-bias", path(name), "--anchors", survey(session_of(name)), "--model", model, "--json", "--out",
            rows]
-    return json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)["calibration"]
+    summary = json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
+    if KEEP:  # the levels and the calibration beside the rows
+        with open(rows[:-len(".csv")] + ".json", "w") as f:
+            json.dump(summary, f, indent=1)
+    return summary["calibration"]
 
 
 def main_calibration():

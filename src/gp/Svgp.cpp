@@ -415,13 +415,24 @@ VecX SvgpPredictor::predictMean(const MatX& X_raw, int num_threads) const {
 }
 
 void SvgpPredictor::predictOne(const Eigen::Ref<const RowVecX>& x_raw, double& mean, double& var_f) const {
-  RowVecX x = x_raw;
-  if (shift_.size() > 0) x = (x - shift_.transpose()).cwiseQuotient(scale_.transpose());
-  VecX k(Z_.rows());
+  // The filter predicts at every TDoA: the input row, k and Q k live in a per-thread scratch that grows on a thread's
+  // first call (or a larger model) and is reused after, so a running filter does not allocate (tests/alloc).
+  thread_local std::vector<double> scratch;
+  const Eigen::Index d = x_raw.size(), m = Z_.rows();
+  if (scratch.size() < static_cast<std::size_t>(d + 2 * m)) scratch.resize(static_cast<std::size_t>(d + 2 * m));
+  Eigen::Map<RowVecX> x(scratch.data(), d);
+  Eigen::Map<VecX> k(scratch.data() + d, m), qk(scratch.data() + d + m, m);
+  if (shift_.size() > 0) {
+    if (d != shift_.size()) throw std::invalid_argument("SVGP: input has the wrong number of columns");
+    x = (x_raw - shift_.transpose()).cwiseQuotient(scale_.transpose());
+  } else {
+    x = x_raw;
+  }
   kernel_.crossColumn(Z_, x, k);
   mean = c_ + k.dot(alpha_);
   // P20: kᵀ Q k; Q is stored full (symmetric), so a plain GEMV vectorizes best
-  var_f = kdiag_ + jitter_ + k.dot(Q_ * k);
+  qk.noalias() = Q_ * k;
+  var_f = kdiag_ + jitter_ + k.dot(qk);
 }
 
 // ---------------------------------------------------------------------------------------------------------------

@@ -5,7 +5,8 @@
  *         (StartUp: multilateration of position and velocity), rest detection (RestDetector) and the TDoA update
  *         through the graph's node (updateTdoa) as components of their own.
  *
- *  No look-ahead, bounded memory, nothing given out is rewritten, no allocation per event after the start-up.
+ *  No look-ahead, bounded memory, nothing given out is rewritten, no allocation per event after the start-up (with or
+ *  without a bias model; tests/alloc counts).
  *  No phase decision drops a measurement: at rest TDoA are down-weighted (F14), while moving they are gated on their
  *  innovation (F11); being at rest is re-decided from the IMU at every sample (F18).
  *
