@@ -14,7 +14,13 @@ of F27's online learning), and "online" is the default filter (the states) on th
 airborne RMSE over the second half of each flight (scripts/online_bias_eval.py's definition) and its change against
 the reference, then the median and worst change per session.
 
-Usage: scripts/bias_oracle.py [BUILD_DIR] [--span=S] [FLIGHT_NAME...]   (data: $UWBTDOA_DATA or ../shared/data; default: the
+With --imu, instead: how far the accelerometer alone carries the position (what it can tell from a TDoA bias that
+changes over that time). From 100 airborne starts per flight, the Vicon position and velocity (±25 ms central
+difference) are dead-reckoned with the logged specific force turned by the Vicon attitude, less gravity and less the
+flight's best constant world-frame acceleration offset; printed: the RMS horizontal and vertical error after 0.5, 1
+and 2 s. Meaningful only where the Vicon body frame is the IMU's (0426; on 0425 the offset is 2.2–2.3 m/s²).
+
+Usage: scripts/bias_oracle.py [BUILD_DIR] [--span=S | --imu] [FLIGHT_NAME...]   (data: $UWBTDOA_DATA or ../shared/data; default: the
        16 TDoA2 development flights of util-pilot)
 """
 import os
@@ -26,7 +32,8 @@ import numpy as np
 
 # --span=S: the running mean's span for "fast" [s] (default 2)
 SPAN = [float(a[len("--span="):]) for a in sys.argv[1:] if a.startswith("--span=")]
-ARGS = [a for a in sys.argv[1:] if not a.startswith("--span=")]
+IMU = "--imu" in sys.argv[1:]
+ARGS = [a for a in sys.argv[1:] if not a.startswith("--span=") and a != "--imu"]
 BUILD = ARGS[0] if ARGS else "build"
 sys.path.insert(0, os.path.join(BUILD, "python"))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -80,7 +87,53 @@ def second_half(path, survey_path, flags, truth, tmp):
     return rmse_parts(traj, *truth)[1]
 
 
+def rotation(q):
+    """Body-to-world rotation matrices of quaternions (N, 4) in (x, y, z, w)."""
+    x, y, z, w = q.T
+    return np.stack([np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
+                     np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
+                     np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1)], -2)
+
+
+def dead_reckoning(name):
+    session = name.split("-")[0]
+    flight = uwbtdoa.read_flight_csv(os.path.join(PILOT, session, name + ".csv"))
+    pose, acc = flight.pose, flight.acc
+    tp, p, t, f_b = pose["t"], pose["p"], acc["t"], acc["value"]
+    h = 0.025
+    pos = np.stack([np.interp(t, tp, p[:, k]) for k in range(3)], 1)
+    vel = np.stack([(np.interp(t + h, tp, p[:, k]) - np.interp(t - h, tp, p[:, k])) / (2 * h) for k in range(3)], 1)
+    nearest = np.clip(np.searchsorted(tp, t), 0, len(tp) - 1)
+    a_w = np.einsum("nij,nj->ni", rotation(pose["q"][nearest]), f_b) - np.array([0.0, 0.0, 9.81])
+    dvdt = np.stack([(np.interp(t + 2 * h, t, vel[:, k]) - np.interp(t - 2 * h, t, vel[:, k])) / (4 * h)
+                     for k in range(3)], 1)
+    air = pos[:, 2] > 0.5
+    offset = np.mean((a_w - dvdt)[air], 0)
+    a_w -= offset
+    starts = np.where(air)[0][:: max(1, air.sum() // 100)]
+    dt_mean = float(np.median(np.diff(t)))
+    cells = []
+    for horizon in (0.5, 1.0, 2.0):
+        n = int(horizon / dt_mean)
+        err = []
+        for i0 in starts:
+            if i0 + n >= len(t) or not air[i0:i0 + n].all():
+                continue
+            steps = np.diff(t[i0:i0 + n + 1])
+            v = vel[i0] + np.r_[np.zeros((1, 3)), np.cumsum(a_w[i0:i0 + n] * steps[:, None], 0)]
+            p_end = pos[i0] + np.sum(v[:-1] * steps[:, None] + 0.5 * a_w[i0:i0 + n] * (steps ** 2)[:, None], 0)
+            err.append(p_end - pos[i0 + n])
+        e = np.array(err)
+        cells.append(f"{horizon:.1f} s: xy {np.sqrt(np.mean(e[:, 0] ** 2 + e[:, 1] ** 2)):.3f} m, "
+                     f"z {np.sqrt(np.mean(e[:, 2] ** 2)):.3f} m")
+    print(f"{name:12s} offset {np.array2string(offset, precision=2)} m/s²; " + "; ".join(cells), flush=True)
+
+
 def main():
+    if IMU:
+        for name in FLIGHTS:
+            dead_reckoning(name)
+        return
     runs = ("reference", "online", "full", "perp", "fast")
     print(f"{'flight':12s} " + " ".join(f"{r:>17s}" for r in runs))
     change = {}
