@@ -176,6 +176,29 @@ TEST(Svgp, SinglePredictionEqualsBatchPrediction) {
   }
 }
 
+TEST(SvgpPredictor, SinglePredictionsOfModelsOfDifferentSizeInTurnShareTheThreadsScratch) {
+  // GIVEN two models of different size (M = 5 and 40) on the same inputs, and their batch predictions
+  Problem small = makeProblem(21, 200, 5);
+  small.gp.setInputTransform(VecX::Constant(3, 0.1), VecX::Constant(3, 1.5));
+  Problem large = makeProblem(22, 200, 40);
+  const SvgpPredictor ps = small.gp.predictor(), pl = large.gp.predictor();
+  const SvgpPrediction bs = ps.predict(small.X), bl = pl.predict(small.X);
+  // WHEN the single-point path alternates between them on one thread (its scratch grows once and is reused)
+  for (Eigen::Index i = 0; i < small.X.rows(); ++i) {
+    double ms, vs, ml, vl;
+    ps.predictOne(small.X.row(i), ms, vs);
+    pl.predictOne(small.X.row(i), ml, vl);
+    // THEN each equals its own model's batch prediction
+    EXPECT_NEAR(ms, bs.mean[i], 1e-12);
+    EXPECT_NEAR(vs, bs.var_f[i], 1e-12);
+    EXPECT_NEAR(ml, bl.mean[i], 1e-12);
+    EXPECT_NEAR(vl, bl.var_f[i], 1e-12);
+  }
+  // AND an input row of the wrong width is refused, not read past its end
+  double m, v;
+  EXPECT_THROW(ps.predictOne(RowVecX::Zero(2), m, v), std::invalid_argument);
+}
+
 TEST(SvgpPredictor, BatchedAndSinglePredictionsAgreeWithTheReferencePath) {
   // GIVEN models with an input transform, small and trained-size (M = 60 k-means inducing points)
   for (int M : {7, 60}) {
