@@ -16,6 +16,8 @@
 #include <filesystem>
 #include <random>
 
+#include "uwb/eval/BiasDataset.h"
+#include "uwb/eval/BiasModel.h"
 #include "uwb/eval/Localization.h"
 #include "uwb/filter/Estimator.h"
 #include "uwb/filter/TdoaLocalizer.h"
@@ -203,9 +205,20 @@ void BM_WholeFlightReal0425Traj2(benchmark::State& state) {
   const SensorLog log = sensorLogFromFlight(f);
   // arg 0: defaults; 1: the tag antenna pattern learned in flight (F25, degree 3); 2: the bias guard (F24) with a
   // zero-mean bias model, i.e. two filters side by side; 3: without the range-bias states (F27); 4: without the
-  // in-motion heading alignment (F28)
+  // in-motion heading alignment (F28); 5: a trained model, `train`'s default (pair-tdoa-pos, M = 30) of 0425-traj1,
+  // as `localize --bias-model` runs it (guarded, GP mean and variance at every TDoA of the corrected filter)
   EkfParams p;
   BiasPredictor bias;
+  if (state.range(0) == 5) {
+    const std::filesystem::path other = data / "real/util-pilot/0425/0425-traj1.csv";
+    BiasTrainParams tp;
+    tp.preset = kDefaultTrainPreset;
+    BiasDatasetParams dp;
+    dp.inputs = BiasInputSource::kFilterEstimate;
+    const BiasModel model = trainBiasModel(buildBiasDataset({readFlightCsv(other.string())}, survey, dp), tp);
+    applyBiasModelLevel(model, &p);
+    bias = model.predictor();
+  }
   if (state.range(0) == 1) p.antenna_bias_degree = 3;
   if (state.range(0) == 3) {
     p.range_bias_sigma_m = 0.0;
@@ -220,7 +233,7 @@ void BM_WholeFlightReal0425Traj2(benchmark::State& state) {
   const double duration = f.timeSpan().second - f.timeSpan().first;
   runFlightBenchmark(state, localizer, log, duration);
 }
-BENCHMARK(BM_WholeFlightReal0425Traj2)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Arg(4)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WholeFlightReal0425Traj2)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Arg(4)->Arg(5)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace uwb
