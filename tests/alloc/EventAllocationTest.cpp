@@ -147,6 +147,16 @@ const BiasModel& model() {
   return m;
 }
 
+/// Pushes the flight through `filter` and expects no allocation after the first 10 s, and a filter that worked.
+template <class Filter>
+void expectNoAllocationPerEvent(Filter& filter, const char* what) {
+  std::size_t n = 0;
+  const long allocations = allocationsAfterWarmUp(filter, flight().log, 10.0, &n);
+  EXPECT_GT(n, 20000u) << what;
+  EXPECT_EQ(allocations, 0) << what << ", over " << n << " events";
+  EXPECT_GT(filter.summary().n_tdoa_used, 5000u) << what;
+}
+
 TEST(EventAllocation, TheEstimatorAllocatesNothingPerEventOnceRunning) {
   // GIVEN the default filter on a simulated flight, and the same with the optional learners and models switched
   struct Variant {
@@ -164,39 +174,24 @@ TEST(EventAllocation, TheEstimatorAllocatesNothingPerEventOnceRunning) {
   variants[3].params.output_bias_sigma_m = 0.0;
   for (const Variant& v : variants) {
     Estimator est(v.params, anchorTableFromSurvey(flight().sim.survey));
-    // WHEN every event after the first 10 s is pushed
-    std::size_t n = 0;
-    const long allocations = allocationsAfterWarmUp(est, flight().log, 10.0, &n);
-    // THEN none of them touched the heap
-    EXPECT_GT(n, 20000u) << v.name;
-    EXPECT_EQ(allocations, 0) << v.name << ", over " << n << " events";
-    EXPECT_GT(est.summary().n_tdoa_used, 5000u) << v.name;
+    // WHEN every event after the first 10 s is pushed, THEN none of them touched the heap
+    expectNoAllocationPerEvent(est, v.name);
   }
 }
 
-TEST(EventAllocation, WithABiasModelTheCorrectedFilterAllocatesNothingPerEvent) {
-  // GIVEN a trained bias model as the filter's correction, without the guard
-  EkfParams p;
-  p.bias_guard = false;
-  applyBiasModelLevel(model(), &p);
-  Estimator est(p, anchorTableFromSurvey(flight().sim.survey), model().predictor());
-  // WHEN every event after the first 10 s is pushed
-  std::size_t n = 0;
-  const long allocations = allocationsAfterWarmUp(est, flight().log, 10.0, &n);
-  // THEN none of them touched the heap, with the GP predicted at every TDoA
-  EXPECT_EQ(allocations, 0) << "over " << n << " events";
-  EXPECT_GT(est.summary().n_tdoa_used, 5000u);
-}
-
-TEST(EventAllocation, TheGuardedPairAllocatesNothingPerEvent) {
-  // GIVEN the default way a model runs: the corrected and the uncorrected filter side by side (F24)
-  EkfParams p;
-  applyBiasModelLevel(model(), &p);
-  GuardedEstimator est(p, anchorTableFromSurvey(flight().sim.survey), model().predictor());
-  std::size_t n = 0;
-  const long allocations = allocationsAfterWarmUp(est, flight().log, 10.0, &n);
-  EXPECT_EQ(allocations, 0) << "over " << n << " events";
-  EXPECT_GT(est.summary().n_tdoa_used, 5000u);
+TEST(EventAllocation, WithABiasModelTheFilterAllocatesNothingPerEvent) {
+  // GIVEN a trained bias model (the GP predicted at every TDoA of the corrected filter), the corrected filter alone
+  // and the default way a model runs: the corrected and the uncorrected filter side by side (F24)
+  EkfParams alone;
+  alone.bias_guard = false;
+  applyBiasModelLevel(model(), &alone);
+  EkfParams guarded;
+  applyBiasModelLevel(model(), &guarded);
+  Estimator corrected(alone, anchorTableFromSurvey(flight().sim.survey), model().predictor());
+  GuardedEstimator pair(guarded, anchorTableFromSurvey(flight().sim.survey), model().predictor());
+  // WHEN every event after the first 10 s is pushed, THEN none of them touched the heap
+  expectNoAllocationPerEvent(corrected, "the corrected filter");
+  expectNoAllocationPerEvent(pair, "the guarded pair");
 }
 
 TEST(EventAllocation, TheCounterSeesAnAllocation) {
