@@ -121,6 +121,7 @@ long allocationsAfterWarmUp(Filter& filter, const SensorLog& log, double warm_up
 struct SimulatedFlight {
   sim::SimResult sim;
   SensorLog log;
+  SensorLog log_with_tof;  ///< the same with a downward range at 25 Hz from the exact pose (the simulator has none)
 };
 
 /// A simulated flight with take-off, circle and landing (IMU, TDoA2 with the simulator's bias, ground truth).
@@ -130,6 +131,14 @@ const SimulatedFlight& flight() {
     s.sim = sim::simulateFlight(sim::makeScenario(sim::paperAnchors(), sim::TrajectoryShape::kCircle, 40.0),
                                 sim::SimParams{}, /*seed=*/5);
     s.log = sensorLogFromFlight(s.sim.flight);
+    s.log_with_tof = s.log;
+    double t_next = 0.0;
+    for (const PoseSample& p : s.sim.pose_exact) {
+      if (p.t_s < t_next) continue;
+      const double cos_tilt = (p.w_q_b * Vec3::UnitZ()).z();
+      s.log_with_tof.tof.push_back({p.t_s, p.w_p_b.z() / cos_tilt - 0.037});
+      t_next = p.t_s + 0.04;
+    }
     return s;
   }();
   return f;
@@ -149,9 +158,9 @@ const BiasModel& model() {
 
 /// Pushes the flight through `filter` and expects no allocation after the first 10 s, and a filter that worked.
 template <class Filter>
-void expectNoAllocationPerEvent(Filter& filter, const char* what) {
+void expectNoAllocationPerEvent(Filter& filter, const char* what, const SensorLog& log = flight().log) {
   std::size_t n = 0;
-  const long allocations = allocationsAfterWarmUp(filter, flight().log, 10.0, &n);
+  const long allocations = allocationsAfterWarmUp(filter, log, 10.0, &n);
   EXPECT_GT(n, 20000u) << what;
   EXPECT_EQ(allocations, 0) << what << ", over " << n << " events";
   EXPECT_GT(filter.summary().n_tdoa_used, 5000u) << what;
@@ -163,7 +172,7 @@ TEST(EventAllocation, TheEstimatorAllocatesNothingPerEventOnceRunning) {
     const char* name;
     EkfParams params;
   };
-  std::vector<Variant> variants(4);
+  std::vector<Variant> variants(5);
   variants[0].name = "defaults";
   variants[1].name = "antenna pattern learned in flight (F25)";
   variants[1].params.antenna_bias_degree = 3;
@@ -172,10 +181,13 @@ TEST(EventAllocation, TheEstimatorAllocatesNothingPerEventOnceRunning) {
   variants[3].name = "robust Cauchy update, bias floor off";
   variants[3].params.robust_loss = RobustLoss::kCauchy;
   variants[3].params.output_bias_sigma_m = 0.0;
+  variants[4].name = "downward ToF fused (F21)";
+  variants[4].params.fuse_tof = true;
   for (const Variant& v : variants) {
     Estimator est(v.params, anchorTableFromSurvey(flight().sim.survey));
     // WHEN every event after the first 10 s is pushed, THEN none of them touched the heap
-    expectNoAllocationPerEvent(est, v.name);
+    expectNoAllocationPerEvent(est, v.name, v.params.fuse_tof ? flight().log_with_tof : flight().log);
+    if (v.params.fuse_tof) EXPECT_GT(est.summary().n_tof_used, 500u);
   }
 }
 
