@@ -136,7 +136,7 @@ const SimulatedFlight& flight() {
     for (const PoseSample& p : s.sim.pose_exact) {
       if (p.t_s < t_next) continue;
       const double cos_tilt = (p.w_q_b * Vec3::UnitZ()).z();
-      s.log_with_tof.tof.push_back({p.t_s, p.w_p_b.z() / cos_tilt - 0.037});
+      s.log_with_tof.tof.push_back({p.t_s, p.w_p_b.z() / cos_tilt - EkfParams{}.tof_offset_m});  // (F21)
       t_next = p.t_s + 0.04;
     }
     return s;
