@@ -16,6 +16,7 @@
 #include "uwb/eval/BiasModel.h"
 #include "uwb/eval/Localization.h"
 #include "uwb/filter/BiasGuard.h"
+#include "uwb/filter/CooperativeRange.h"
 #include "uwb/filter/Estimator.h"
 #include "uwb/filter/SensorEvents.h"
 #include "uwb/sim/FlightSimulator.h"
@@ -95,8 +96,10 @@ namespace {
 
 /// Heap allocations made by the events after the first warm_up_s seconds of the log (the start-up: levelling,
 /// multilateration, the replay of the start window), each event pushed as the batch path pushes it.
-template <class Filter>
-long allocationsAfterWarmUp(Filter& filter, const SensorLog& log, double warm_up_s, std::size_t* n_counted) {
+/// after_event(filter, event) runs after each event (e.g. a neighbour's range), counted alike.
+template <class Filter, class AfterEvent>
+long allocationsAfterWarmUp(Filter& filter, const SensorLog& log, double warm_up_s, std::size_t* n_counted,
+                            const AfterEvent& after_event) {
   SensorEventCursor cursor(log);
   const double t_armed = cursor.firstStamp() + warm_up_s;
   long before = 0;
@@ -111,6 +114,7 @@ long allocationsAfterWarmUp(Filter& filter, const SensorLog& log, double warm_up
       case SensorEvent::Kind::kTdoa: filter.addTdoa(log.tdoa[ev.index]); break;
       case SensorEvent::Kind::kTof: filter.addTof(log.tof[ev.index]); break;
     }
+    after_event(filter, ev);
     if (filter.ready()) static_cast<void>(filter.estimate());
     if (g_counting.load()) ++*n_counted;
   }
@@ -160,7 +164,7 @@ const BiasModel& model() {
 template <class Filter>
 void expectNoAllocationPerEvent(Filter& filter, const char* what, const SensorLog& log = flight().log) {
   std::size_t n = 0;
-  const long allocations = allocationsAfterWarmUp(filter, log, 10.0, &n);
+  const long allocations = allocationsAfterWarmUp(filter, log, 10.0, &n, [](Filter&, const SensorEvent&) {});
   EXPECT_GT(n, 20000u) << what;
   EXPECT_EQ(allocations, 0) << what << ", over " << n << " events";
   EXPECT_GT(filter.summary().n_tdoa_used, 5000u) << what;
@@ -204,6 +208,31 @@ TEST(EventAllocation, WithABiasModelTheFilterAllocatesNothingPerEvent) {
   // WHEN every event after the first 10 s is pushed, THEN none of them touched the heap
   expectNoAllocationPerEvent(corrected, "the corrected filter");
   expectNoAllocationPerEvent(pair, "the guarded pair");
+}
+
+TEST(EventAllocation, ARangeToANeighbourAllocatesNothing) {
+  // GIVEN the filter of one agent of a swarm: a two-way range to a neighbour hovering at a known belief every 0.1 s,
+  // fused by covariance intersection (G21), the path `uwbtdoa swarm` drives
+  Estimator est(EkfParams{}, anchorTableFromSurvey(flight().sim.survey));
+  Moments3 neighbour;
+  neighbour.m = Vec3(0.5, -0.5, 1.0);
+  neighbour.V = Mat3::Identity() * 0.01;
+  const CooperativeRangeOptions options;
+  const std::vector<PoseSample>& truth = flight().sim.pose_exact;
+  double t_next = 0.0;
+  std::size_t k = 0;
+  const auto range = [&](Estimator& f, const SensorEvent& ev) {
+    if (ev.t_s < t_next) return;
+    while (k + 1 < truth.size() && truth[k + 1].t_s <= ev.t_s) ++k;
+    static_cast<void>(f.addNeighbourRange(ev.t_s, neighbour, (truth[k].w_p_b - neighbour.m).norm(), options));
+    t_next = ev.t_s + 0.1;
+  };
+  // WHEN every event and range after the first 10 s is pushed
+  std::size_t n = 0;
+  const long allocations = allocationsAfterWarmUp(est, flight().log, 10.0, &n, range);
+  // THEN none of them touched the heap, and the ranges were fused
+  EXPECT_EQ(allocations, 0) << "over " << n << " events";
+  EXPECT_GT(est.summary().n_coop_used, 100u);
 }
 
 TEST(EventAllocation, TheCounterSeesAnAllocation) {
