@@ -11,6 +11,7 @@
 #include <atomic>
 #include <cstdlib>
 #include <new>
+#include <random>
 
 #include "uwb/eval/BiasDataset.h"
 #include "uwb/eval/BiasModel.h"
@@ -233,6 +234,21 @@ TEST(EventAllocation, ARangeToANeighbourAllocatesNothing) {
   // THEN none of them touched the heap, and the ranges were fused
   EXPECT_EQ(allocations, 0) << "over " << n << " events";
   EXPECT_GT(est.summary().n_coop_used, 100u);
+}
+
+TEST(EventAllocation, AReacquisitionAllocatesNothing) {
+  // GIVEN the flight with 3 s of garbage TDoA (uniform in ±10 m) from 20 s on: the gate rejects them, the estimate is
+  // declared lost and found again by multilateration (F16)
+  SensorLog log = flight().log;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> garbage(-10.0, 10.0);
+  for (TdoaObservation& z : log.tdoa)
+    if (z.t_s >= 20.0 && z.t_s < 23.0) z.tdoa_m = garbage(rng);
+  Estimator est(EkfParams{}, anchorTableFromSurvey(flight().sim.survey));
+  // WHEN every event after the first 10 s is pushed
+  expectNoAllocationPerEvent(est, "garbage and re-acquisition", log);
+  // THEN it re-acquired
+  EXPECT_GE(est.summary().n_reacquisitions, 1u);
 }
 
 TEST(EventAllocation, TheCounterSeesAnAllocation) {
