@@ -29,8 +29,6 @@
 
 namespace {
 
-nlohmann::json finiteOrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
 struct Options {
   std::string flight, anchors, model, out;
   double min_z = uwb::kAirborneMinZ_m;
@@ -77,9 +75,11 @@ void run(const Options& o) {
     dp.min_z_m = o.min_z;
     const uwb::BiasDataset data = uwb::buildBiasDataset({flight}, survey, dp);
     flight_level_m = data.flights.at(0).bias_level_m;
-    mean_level_m = uwb::modelMeanLevels(model, data, dp.localization.params.output_bias_memory_s).at(0);
-    for (const auto& smp : data.samples) {
-      const uwb::BiasPredictive p = model.predictive(smp.feature, flight_level_m, mean_level_m);
+    const uwb::DatasetPredictives predictives = uwb::datasetPredictives(model, data);
+    mean_level_m = predictives.flight_mean_level_m.at(0);
+    for (std::size_t i = 0; i < data.samples.size(); ++i) {
+      const uwb::BiasSample& smp = data.samples[i];
+      const uwb::BiasPredictive& p = predictives.samples[i];
       out += fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},1,{:.7g}\n", smp.t_s, smp.feature.id_a,
                          smp.feature.id_b, smp.measured_m, smp.error_m, p.mean_m, std::sqrt(p.latent_variance_m2),
                          std::sqrt(p.varianceM2()));
@@ -107,9 +107,9 @@ void run(const Options& o) {
       nlohmann::json{{"flight", o.flight}, {"model", o.model}, {"inputs", inputs}, {"n_rows", n_rows},
                      {"n_airborne", n_air}, {"bias_rmse_before_m", before}, {"bias_rmse_after_m", after},
                      {"calibration", cal_json}, {"out", o.out},
-                     {"flight_bias_level_m", finiteOrNull(flight_level_m)},
+                     {"flight_bias_level_m", flight_level_m},
                      {"training_bias_level_m", model.trainingBiasLevel()},
-                     {"model_mean_level_m", finiteOrNull(mean_level_m)},
+                     {"model_mean_level_m", mean_level_m},
                      {"training_mean_level_m", model.trainingMeanLevel()},
                      {"level_excess_std_m", std::sqrt(model.levelExcessVarianceM2(flight_level_m, mean_level_m))}});
   uwb::writeFileAtomically(o.out, out, "bias CSV");

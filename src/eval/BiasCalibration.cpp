@@ -5,7 +5,6 @@
 
 #include <boost/math/distributions/students_t.hpp>
 #include <cmath>
-#include <limits>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -96,22 +95,15 @@ BiasCalibration biasCalibration(const BiasDataset& data, const BiasModel& model)
   r.reserve(data.samples.size());
   var.reserve(data.samples.size());
   std::size_t uncovered = 0;
-  // (P43c) per flight, the level the filter measured on it and that of the model's mean there (NaN: unknown); the
-  // entries cover every flight index ≥ 0 of the samples (modelMeanLevels)
-  constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();
-  const std::vector<double> mean_level =
-      modelMeanLevels(model, data, data.params.localization.params.output_bias_memory_s);
-  std::vector<double> level(mean_level.size(), kUnknown);
-  for (std::size_t fi = 0; fi < data.flights.size(); ++fi) level[fi] = data.flights[fi].bias_level_m;
-  for (const auto& s : data.samples) {
-    const std::size_t fi = static_cast<std::size_t>(s.flight);
-    const BiasPredictive p = s.flight >= 0 ? model.predictive(s.feature, level[fi], mean_level[fi])
-                                           : model.predictive(s.feature, kUnknown, kUnknown);
+  // (P43c) each sample on its flight: the level the dataset's filter run measured there and that of the model's mean
+  const std::vector<BiasPredictive> predictive = datasetPredictives(model, data).samples;
+  for (std::size_t i = 0; i < predictive.size(); ++i) {
+    const BiasPredictive& p = predictive[i];
     if (!p.covered) {
       ++uncovered;
       continue;
     }
-    r.push_back(s.error_m - p.mean_m);
+    r.push_back(data.samples[i].error_m - p.mean_m);
     var.push_back(p.varianceM2());
   }
   BiasCalibration c = biasCalibration(r, var, model.predictiveShape());

@@ -666,14 +666,17 @@ void applyBiasModelLevel(const BiasModel& model, EkfParams* params) {
     params->bias_model_training_mean_level_m = model.trainingMeanLevel();
 }
 
-std::vector<double> modelMeanLevels(const BiasModel& model, const BiasDataset& data, double memory_s) {
-  // (F24c) per flight, the samples in time order through the F23c windows, µ in place of the residual; the body
-  // origin stands for the tag (the lever arm is centimetres, the windows' geometry does not feel it)
+namespace {
+/// (F24c) per flight, the samples in time order through the F23c windows, mean_m[i] (the model's mean at sample i)
+/// in place of the residual; the body origin stands for the tag (the lever arm is centimetres, the windows' geometry
+/// does not feel it). Indexed by BiasSample::flight, NaN for a flight that counted no window.
+std::vector<double> meanLevels(const BiasDataset& data, const std::vector<double>& mean_m, double memory_s) {
   std::map<int, BiasLevel> levels;
-  for (const BiasSample& s : data.samples) {
+  for (std::size_t i = 0; i < data.samples.size(); ++i) {
+    const BiasSample& s = data.samples[i];
     auto it = levels.try_emplace(s.flight, memory_s).first;
     const TdoaFeature& f = s.feature;
-    it->second.add(s.t_s, f.id_a, f.w_p_anchor_a, f.id_b, f.w_p_anchor_b, f.w_p_b, model.predict(f).mean_m);
+    it->second.add(s.t_s, f.id_a, f.w_p_anchor_a, f.id_b, f.w_p_anchor_b, f.w_p_b, mean_m[i]);
   }
   std::size_t n = data.flights.size();
   for (const auto& [flight, level] : levels)
@@ -684,6 +687,34 @@ std::vector<double> modelMeanLevels(const BiasModel& model, const BiasDataset& d
     if (flight >= 0 && std::isfinite(l)) out[static_cast<std::size_t>(flight)] = l;
   }
   return out;
+}
+}  // namespace
+
+std::vector<double> modelMeanLevels(const BiasModel& model, const BiasDataset& data, double memory_s) {
+  std::vector<double> mean_m(data.samples.size());
+  for (std::size_t i = 0; i < data.samples.size(); ++i) mean_m[i] = model.predict(data.samples[i].feature).mean_m;
+  return meanLevels(data, mean_m, memory_s);
+}
+
+DatasetPredictives datasetPredictives(const BiasModel& model, const BiasDataset& data) {
+  // the GP once per sample: its predictive mean is the model's mean of predict() where it covers the pair (the same
+  // operations); an uncovered pair's mean (its pair mean, no GP) comes from predict()
+  DatasetPredictives d;
+  d.samples.reserve(data.samples.size());
+  std::vector<double> mean_m(data.samples.size());
+  for (std::size_t i = 0; i < data.samples.size(); ++i) {
+    d.samples.push_back(model.predictive(data.samples[i].feature));
+    mean_m[i] = d.samples.back().covered ? d.samples.back().mean_m : model.predict(data.samples[i].feature).mean_m;
+  }
+  d.flight_mean_level_m = meanLevels(data, mean_m, data.params.localization.params.output_bias_memory_s);
+  // (P43c) each covered sample gains the excess of its flight, from the level the dataset's filter run measured
+  for (std::size_t i = 0; i < data.samples.size(); ++i) {
+    const int fi = data.samples[i].flight;
+    if (fi < 0 || static_cast<std::size_t>(fi) >= data.flights.size() || !d.samples[i].covered) continue;
+    d.samples[i].level_variance_m2 = model.levelExcessVarianceM2(data.flights[static_cast<std::size_t>(fi)].bias_level_m,
+                                                                 d.flight_mean_level_m[static_cast<std::size_t>(fi)]);
+  }
+  return d;
 }
 
 double modelMeanLevel(const BiasModel& model, const BiasDataset& data, double memory_s) {

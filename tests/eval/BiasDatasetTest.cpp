@@ -229,6 +229,35 @@ TEST(BiasModel, AFlightMoreBiasedThanTheTrainingFlightsWidensThePredictiveDistri
   EXPECT_NEAR(aware.coverage_2sigma, 0.954, 0.04);
 }
 
+TEST(BiasModel, DatasetPredictivesEvaluateTheGpOnceAndEqualThePerSampleReference) {
+  // GIVEN a model with known training levels and a dataset whose flight has a measured level
+  const BiasDataset train = buildBiasDataset({circleFlight(30, 0.05)}, ringSurvey());
+  BiasModel model = trainBiasModel(train, smallZ1Training());
+  model.setTrainingBiasLevel(0.10);
+  model.setTrainingMeanLevel(0.05);
+  BiasDataset test = buildBiasDataset({circleFlight(30, 0.25)}, ringSurvey());
+  test.flights.at(0).bias_level_m = 0.3;
+  // WHEN the predictive distributions are formed for the whole dataset at once
+  const DatasetPredictives d = datasetPredictives(model, test);
+  // THEN the level of the mean is modelMeanLevels', and every sample equals predictive(f, ℓ, ℓ_µ) bit for bit
+  const double memory_s = test.params.localization.params.output_bias_memory_s;
+  const std::vector<double> reference_levels = modelMeanLevels(model, test, memory_s);
+  ASSERT_EQ(d.flight_mean_level_m.size(), reference_levels.size());
+  EXPECT_EQ(d.flight_mean_level_m[0], reference_levels[0]);
+  ASSERT_EQ(d.samples.size(), test.samples.size());
+  int n_wider = 0;
+  for (std::size_t i = 0; i < test.samples.size(); ++i) {
+    const BiasPredictive ref = model.predictive(test.samples[i].feature, 0.3, reference_levels[0]);
+    EXPECT_EQ(d.samples[i].mean_m, ref.mean_m) << i;
+    EXPECT_EQ(d.samples[i].latent_variance_m2, ref.latent_variance_m2) << i;
+    EXPECT_EQ(d.samples[i].noise_variance_m2, ref.noise_variance_m2) << i;
+    EXPECT_EQ(d.samples[i].level_variance_m2, ref.level_variance_m2) << i;
+    EXPECT_EQ(d.samples[i].covered, ref.covered) << i;
+    n_wider += d.samples[i].level_variance_m2 > 0.0 ? 1 : 0;
+  }
+  EXPECT_EQ(n_wider, static_cast<int>(test.samples.size()));  // the flight is more biased than the training ones
+}
+
 TEST(BiasModel, LearnsTheSyntheticBiasAndRoundTripsBitIdentically) {
   // GIVEN a synthetic dataset with bias 0.1 sin(yaw_a)
   const BiasDataset ds = buildBiasDataset({circleFlight(30)}, ringSurvey());

@@ -242,6 +242,16 @@ double modelMeanLevel(const BiasModel& model, const BiasDataset& data, double me
 /// counted no window.
 std::vector<double> modelMeanLevels(const BiasModel& model, const BiasDataset& data, double memory_s);
 
+/// The predictive distribution of every sample's ε (BiasModel::predictive, P43) on its flight, with the GP evaluated
+/// once per sample: the level of the model's mean per flight (F24c, the filter's memory of data.params) from those
+/// means, and each covered sample's level excess of P43c from its flight's bias_level_m (none where unknown, e.g.
+/// ground-truth inputs).
+struct DatasetPredictives {
+  std::vector<BiasPredictive> samples;       ///< one per data.samples entry, in order
+  std::vector<double> flight_mean_level_m;   ///< as modelMeanLevels
+};
+DatasetPredictives datasetPredictives(const BiasModel& model, const BiasDataset& data);
+
 /// Indices of held-out samples: every k-th block of `block_s` seconds of each flight, k = round(1/fraction).
 std::vector<bool> holdoutMask(const std::vector<BiasSample>& samples, double fraction, double block_s);
 
