@@ -167,7 +167,9 @@ TEST(RunDiagnosticsReal, SurveyOfAnotherArenaOrShiftedIsReported) {
     const auto fit = std::find_if(w.begin(), w.end(), has("does not fit"));
     ASSERT_NE(fit, w.end());
     const auto chance = std::find_if(w.begin(), w.end(), has("beyond chance"));
-    if (chance != w.end()) EXPECT_LT(chance - w.begin(), fit - w.begin());
+    if (chance != w.end()) {
+      EXPECT_LT(chance - w.begin(), fit - w.begin());
+    }
   }
   {
     Flight f = real->flight;
