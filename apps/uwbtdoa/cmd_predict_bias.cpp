@@ -115,8 +115,8 @@ void run(const Options& o) {
     if (air && std::abs(r.residual_m) <= 1.0) score(r.residual_m, p);
   }
   if (n_non_finite > 0) {
-    throw std::runtime_error(fmt::format("{} of {} bias rows hold a non-finite value (first at {}): the model {} or the "
-                                         "estimate of {} is broken; nothing written",
+    throw std::runtime_error(fmt::format("{} of {} bias rows hold a value that is not finite (first at {}): the model {} or "
+                                         "the estimate of {} is broken; nothing written",
                                          n_non_finite, n_rows, first_non_finite, o.model, o.flight));
   }
   const double before = n_air ? std::sqrt(se_b / n_air) : std::nan(""), after = n_air ? std::sqrt(se_a / n_air) : std::nan("");
