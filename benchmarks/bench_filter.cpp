@@ -20,6 +20,7 @@
 #include "uwb/eval/BiasModel.h"
 #include "uwb/eval/Localization.h"
 #include "uwb/filter/Estimator.h"
+#include "uwb/filter/FlightMode.h"
 #include "uwb/filter/TdoaLocalizer.h"
 #include "uwb/io/UtilCsv.h"
 #include "uwb/model/TdoaModel.h"
@@ -180,6 +181,33 @@ void BM_EstimatorImuEvent(benchmark::State& state) { runEstimatorEvents(state, S
 BENCHMARK(BM_EstimatorImuEvent)->Iterations(30000)->UseManualTime()->Unit(benchmark::kNanosecond);
 void BM_EstimatorTdoaEvent(benchmark::State& state) { runEstimatorEvents(state, SensorEvent::Kind::kTdoa); }
 BENCHMARK(BM_EstimatorTdoaEvent)->Iterations(12000)->UseManualTime()->Unit(benchmark::kNanosecond);
+
+/// The flight-mode supervisor's share of an event (filter.md F29): one IMU step with its decision, and one TDoA
+/// folded into the height window, as the estimator calls them; compare with BM_EstimatorImuEvent / TdoaEvent.
+void BM_FlightModeImuStep(benchmark::State& state) {
+  FlightModeSupervisor s;
+  s.reset(FlightMode::kAirborne);
+  double t = 0.0;
+  const ImuModeEvidence e{false, false, false, 0.003};
+  for (auto _ : state) {
+    t += 0.001;
+    s.addImu(t, 0.001, e, true);
+    benchmark::DoNotOptimize(s.decide(t));
+  }
+}
+BENCHMARK(BM_FlightModeImuStep)->Unit(benchmark::kNanosecond);
+void BM_FlightModeTdoa(benchmark::State& state) {
+  FlightModeSupervisor s;
+  s.reset(FlightMode::kAirborne);
+  double t = 0.0, r = 0.01;
+  for (auto _ : state) {
+    t += 0.0025;
+    r = -r;
+    s.addTdoa(t, r, r, 0.6, 1.5);
+    benchmark::DoNotOptimize(s.tdoaLogOdds());
+  }
+}
+BENCHMARK(BM_FlightModeTdoa)->Unit(benchmark::kNanosecond);
 
 void BM_WholeFlightSynthetic(benchmark::State& state) {
   const AnchorTable anchors = benchAnchors();

@@ -19,7 +19,8 @@ void addFilterOptions(CLI::App& sub, FilterOptionArgs& a) {
                  "flags override it");
   sub.add_option("--bias-model", a.bias_model, "Bias model JSON (GP) to correct the TDoA");
   for (const EkfParamInfo& info : ekfParamRegistry()) {
-    const std::string names = info.flag() + (info.cli_alias.empty() ? "" : ",--" + info.cli_alias);
+    const std::string names = info.flag() + (info.cli_alias.empty() ? "" : ",--" + info.cli_alias) +
+                              (info.cli_negation.empty() ? "" : ",!--" + info.cli_negation);
     const std::string help = info.doc + " " + ekfParamHelpSuffix(info);
     a.param_text.emplace_back();
     a.param_flag.push_back(false);

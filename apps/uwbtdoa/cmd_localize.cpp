@@ -277,6 +277,15 @@ void runLocalize(const LocalizeArgs& a) {
   j["ready_t_s"] = std::isnan(s.ready_t_s) ? json(nullptr) : json(s.ready_t_s);
   j["n_tdoa_degenerate"] = s.n_tdoa_degenerate;
   j["n_reacquisitions"] = s.n_reacquisitions;
+  j["floor_doubted_s"] = s.floor_doubted_s;
+  j["floor_doubted_max_height_m"] = s.floor_doubted_max_height_m;
+  j["n_mode_overrules"] = s.n_mode_overrules;
+  j["air_shake_rms_radps"] = s.air_shake_rms_radps;
+  j["n_inconsistent_periods"] = s.n_inconsistent_periods;
+  j["inconsistent_s"] = s.inconsistent_s;
+  j["n_consistency_widenings"] = s.n_consistency_widenings;
+  j["n_floor_checks"] = s.n_floor_checks;
+  j["n_floor_refutations"] = s.n_floor_refutations;
   j["n_rejection_faults"] = s.n_rejection_faults;
   j["n_reverted_motion"] = s.n_reverted_motion;
   j["start_replayed"] = s.start_replayed;

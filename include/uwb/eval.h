@@ -14,5 +14,6 @@
 #include "uwb/eval/Localization.h"
 #include "uwb/eval/ProtocolScenarios.h"
 #include "uwb/eval/RunDiagnostics.h"
+#include "uwb/eval/SignatureMatrix.h"
 #include "uwb/eval/SwarmLocalization.h"
 #include "uwb/eval/TrajectoryMetrics.h"

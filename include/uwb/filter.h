@@ -15,6 +15,7 @@
 #include "uwb/filter/EkfParamRegistry.h"
 #include "uwb/filter/EkfParams.h"
 #include "uwb/filter/Estimator.h"
+#include "uwb/filter/FlightMode.h"
 #include "uwb/filter/FloorLevelAnchors.h"
 #include "uwb/filter/InMotionAlignment.h"
 #include "uwb/filter/Multilateration.h"

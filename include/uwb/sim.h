@@ -5,6 +5,7 @@
 #pragma once
 
 #include "uwb/sim/FlightSimulator.h"
+#include "uwb/sim/ImuSignature.h"
 #include "uwb/sim/Kinematics.h"
 #include "uwb/sim/ResidualProfile.h"
 #include "uwb/sim/Scenario.h"

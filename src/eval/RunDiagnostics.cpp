@@ -45,9 +45,13 @@ std::vector<EstimateResidual> whileTracking(std::vector<EstimateResidual> res, c
 /// The residuals without those of the times the estimator had the body on the ground (rest or floor contact, F18):
 /// their TDoA carry the floor-level bias (filter.md F14, F16f), not the survey's error, and weigh the more the shorter
 /// the flight (0425-traj9 logged from 20 s: 6 s in the air, 2 s on the floor, 0.50 m with them against 0.37 m).
-std::vector<EstimateResidual> inFlight(std::vector<EstimateResidual> res, const LocalizerSummary& s) {
+/// Nor those of the estimate within kLowBand_m of the floor (the descent to a landing and the climb after a
+/// take-off): there the TDoA carry the floor-level bias as well (F14, F16h), and an estimate held by the downward
+/// range (F21) shows it in full (0425-traj9 logged from 20 s with the ToF: 0.53 m with them).
+constexpr double kLowBand_m = 0.5;
+std::vector<EstimateResidual> inFlight(std::vector<EstimateResidual> res, const LocalizerSummary& s, double floor_z_m) {
   std::erase_if(res, [&](const EstimateResidual& r) {
-    return inIntervals(r.t_s, s.ground_entered_t_s, s.ground_left_t_s);
+    return inIntervals(r.t_s, s.ground_entered_t_s, s.ground_left_t_s) || r.w_z_est_m - floor_z_m < kLowBand_m;
   });
   return res;
 }
@@ -73,7 +77,7 @@ SurveyFitCheck checkSurveyFit(const Flight& flight, const AnchorSurvey& survey, 
       whileTracking(
           estimateResiduals(flight.tdoa, survey, run.trajectory, options.params.b_t_tag, t0, t1, p.max_gap_s),
           run.summary),
-      run.summary);
+      run.summary, options.params.ground_z_m);
   c.n = res.size();
   c.truncated_rms_m = truncatedRms(res, p.gross_residual_m);
   const auto n_gross = std::count_if(res.begin(), res.end(),
@@ -247,7 +251,7 @@ std::vector<EstimateResidual> estimateResiduals(const std::vector<TdoaMeasuremen
     TdoaJacobians J;
     const std::optional<double> z = evaluateTdoa(pose->w_p_b, pose->w_q_b, ia->second, ib->second, model, &J);
     if (!z) continue;
-    out.push_back({m.t_s, m.id_a, m.id_b, m.tdoa_m - *z, J.J_z_anchor_a, J.J_z_anchor_b});
+    out.push_back({m.t_s, m.id_a, m.id_b, m.tdoa_m - *z, J.J_z_anchor_a, J.J_z_anchor_b, pose->w_p_b.z()});
   }
   return out;
 }
@@ -259,10 +263,28 @@ double truncatedRms(const std::vector<EstimateResidual>& residuals, double c_m) 
   return std::sqrt(sum / static_cast<double>(residuals.size()));
 }
 
+bool EstimateDoubts::doubtful() const { return floor_doubted_s > 2.0; }
+
+EstimateDoubts estimateDoubts(const LocalizationRun& run) {
+  EstimateDoubts d;
+  d.floor_doubted_s = run.summary.floor_doubted_s;
+  d.floor_doubted_max_height_m = run.summary.floor_doubted_max_height_m;
+  d.inconsistent_s = run.summary.inconsistent_s;
+  d.n_inconsistent_periods = run.summary.n_inconsistent_periods;
+  d.air_shake_rms_radps = run.summary.air_shake_rms_radps;
+  d.duration_s = run.duration_s;
+  return d;
+}
+
 RunDiagnostics diagnoseRun(const Flight& flight, const AnchorSurvey& survey, const LocalizationOptions& options,
                            const LocalizationRun& run, const BiasPredictor& bias, const RunDiagnosticParams& params) {
   RunDiagnostics d;
   d.survey_source = survey.source.empty() ? "the survey" : survey.source;
+  d.doubts = estimateDoubts(run);
+  // (F29d) the survey is checked against an estimate whose mode the TDoA did not doubt: one held on the floor against
+  // its TDoA would make any survey look wrong. Innovations beyond chance alone (F30) do not stop the checks: a wrong
+  // survey is one of their causes, and the warning of F30 comes first.
+  if (d.doubts.doubtful()) return d;
   if (params.survey_fit) d.survey = checkSurveyFit(flight, survey, options, run, params);
   // a survey that does not fit as a whole makes every anchor look wrong: the per-anchor check is not meaningful
   if (params.anchor_survey && !d.survey.misfit) d.anchors = checkAnchorSurvey(flight, survey, options, run, bias, params);
@@ -272,6 +294,20 @@ RunDiagnostics diagnoseRun(const Flight& flight, const AnchorSurvey& survey, con
 
 std::vector<std::string> RunDiagnostics::warnings() const {
   std::vector<std::string> w;
+  // what the estimator assumed comes first (F29d, F30)
+  if (doubts.floor_doubted_s > 1.0)
+    w.push_back("ground contact was assumed from the IMU for " + fmt("%.1f", doubts.floor_doubted_s) +
+                " s while the TDoA put the tag up to " + fmt("%.2f", doubts.floor_doubted_max_height_m) +
+                " m above the floor (the IMU's floor evidence: rest, or gyro shaking above 2× the " +
+                fmt("%.2f", doubts.air_shake_rms_radps) +
+                " rad/s this flight showed in the air); --ground-phase none ignores the IMU's ground evidence");
+  if (doubts.inconsistent_s > 1.0)
+    w.push_back("the TDoA disagreed with the estimate beyond chance for " + fmt("%.1f", doubts.inconsistent_s) +
+                " s (" + std::to_string(doubts.n_inconsistent_periods) +
+                " period(s); mean NIS above 4 for 1 s): the position's σ was widened there");
+  if (doubts.doubtful())
+    w.push_back("the survey checks were not run: the estimator held the body on the floor against its TDoA (see "
+                "above), and a survey cannot be judged against that estimate");
   if (survey.misfit)
     w.push_back("the survey " + survey_source + " does not fit the TDoA: residual RMS " +
                 fmt("%.2f", survey.truncated_rms_m) + " m over the flight (clean flights ≤ 0.3 m), " +
@@ -297,6 +333,8 @@ std::vector<std::string> RunDiagnostics::warnings() const {
 std::string RunDiagnostics::verdict() const {
   std::string v;
   const auto add = [&v](const std::string& t) { v += (v.empty() ? "" : "; ") + t; };
+  if (doubts.floor_doubted_s > 1.0) add("floor doubted " + fmt("%.1f", doubts.floor_doubted_s) + " s");
+  if (doubts.inconsistent_s > 1.0) add("inconsistent " + fmt("%.1f", doubts.inconsistent_s) + " s");
   if (survey.misfit) add("survey misfit (rms " + fmt("%.2f", survey.truncated_rms_m) + " m)");
   if (survey.frame_offset) add("frame offset " + fmtVec(survey.mean_error_m) + " m vs truth");
   if (anchors.named_id >= 0)

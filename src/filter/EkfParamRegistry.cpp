@@ -42,9 +42,9 @@ EkfParamInfo integer(std::string name, int EkfParams::*field, EkfParamRange rang
   return i;
 }
 
-EkfParamInfo boolean(std::string name, bool EkfParams::*field, std::string doc) {
+EkfParamInfo boolean(std::string name, bool EkfParams::*field, std::string doc, std::string negation = "") {
   EkfParamInfo i;
-  i.name = std::move(name), i.doc = std::move(doc);
+  i.name = std::move(name), i.doc = std::move(doc), i.cli_negation = std::move(negation);
   i.kind = EkfParamKind::kBool;
   i.get = [field](const EkfParams& p) { return EkfParamValue(p.*field); };
   i.set = [field](EkfParams& p, const EkfParamValue& v) { p.*field = std::get<bool>(v); };
@@ -240,7 +240,8 @@ std::vector<EkfParamInfo> makeRegistry() {
       real("output_bias_vertical_scale", &P::output_bias_vertical_scale, "–", kPositive,
            "Factor on the vertical part of the bias term of the reported covariance in flight (F23d)"),
       // --- downward ToF range (Flow deck VL53L1x, F21) ---
-      boolean("fuse_tof", &P::fuse_tof, "Fuse the downward ToF range as a height update (F21)"),
+      boolean("fuse_tof", &P::fuse_tof, "Fuse the downward ToF range as a height update when the log has it (F21)",
+              "no-tof"),
       real("tof_sigma_m", &P::tof_sigma_m, "m", kPositive, "ToF range noise std"),
       real("tof_offset_m", &P::tof_offset_m, "m", kFinite, "ToF sensor below the body origin along body z"),
       real("floor_z_m", &P::floor_z_m, "m", kFinite, "Height of the flat floor the ToF sees (world z)"),
@@ -418,6 +419,7 @@ std::string ekfParamMarkdownTable() {
   for (const EkfParamInfo& i : ekfParamRegistry()) {
     std::string flags = "`" + i.flag() + "`";
     if (!i.cli_alias.empty()) flags += ", `--" + i.cli_alias + "`";
+    if (!i.cli_negation.empty()) flags += ", `--" + i.cli_negation + "`";
     std::string valid;
     if (i.kind == EkfParamKind::kReal || i.kind == EkfParamKind::kInteger) valid = i.range.toString();
     if (i.kind == EkfParamKind::kChoice) valid = kindName(i);

@@ -97,6 +97,12 @@ constexpr double kLandingWindow_s = 3.0;
 /// sample on count (a touchdown ends a descent; a climb before a hover's dip is no landing) [s] (F18).
 constexpr double kLandingLowZLead_s = 0.5;
 constexpr double kContactSustained_s = 1.5;
+/// (F29b) The airborne shaking level is learned while tracking this long after leaving the ground [s] and this high
+/// above the floor [m] (the take-off's own transient and the floor's shaking excluded).
+constexpr double kAirShakeSettle_s = 2.0;
+constexpr double kAirShakeMinHeight_m = 0.5;
+/// (F29e) A floor check in contact runs at most this often [s].
+constexpr double kFloorCheckPeriod_s = 3.0;
 /// Below this estimated height above the floor TDoA are down-weighted as on the ground (F14) [m].
 constexpr double kLowFlight_m = 0.25;
 /// (F16h) a landing's TDoA are tested against the floor-level delays while the estimate is within this of the floor
@@ -105,6 +111,19 @@ constexpr double kLowFlight_m = 0.25;
 constexpr double kLandingBand_m = 0.5;
 /// (F16i) a landing's floor window ends without a fix after this long [s] (StartUp keeps 3 s of history)
 constexpr double kLandingFixMax_s = 3.0;
+/// (F30) The innovation consistency check: the TDoA's NIS averaged over kNisWindow_s (each clipped at kNisClip) and
+/// the share of them beyond kNisFar (2σ; 4.6 % for a consistent Gaussian filter). Inconsistent while that share exceeds
+/// kNisMaxFarFraction (the bulk disagrees, not a few pairs out of line of sight) over at least kNisMinSamples
+/// forgotten TDoA; held for kInconsistentHold_s, the reported position band is widened by the mean's excess over 1, at
+/// most kMaxWidening_m, fading with kWideningFade_s afterwards.
+constexpr double kNisClip = 25.0;
+constexpr double kNisWindow_s = 1.0;
+constexpr double kNisFar = 4.0;
+constexpr double kNisMaxFarFraction = 0.5;
+constexpr double kNisMinSamples = 20.0;
+constexpr double kInconsistentHold_s = 1.0;
+constexpr double kMaxWidening_m = 0.5;
+constexpr double kWideningFade_s = 2.0;
 /// Constant time of the take-off detector's leaky vertical-velocity integrator [s] (F15).
 constexpr double kTakeoffLeak_s = 1.0;
 /// (F25) whether the learned pattern's variance hᵀ P_θ h is added to the filter's TDoA variance.
@@ -148,6 +167,7 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
   box_max_ = box.max;
   centroid_ = box.centroid;
 
+  tdoa_model_.b_t_tag = params_.b_t_tag;
   track_opt_.sigma_m = params_.tdoa_sigma_m;
   track_opt_.gate_sigma = params_.gate_sigma;
   track_opt_.loss = params_.robust_loss;
@@ -242,6 +262,7 @@ void Estimator::initialize(double t_s, const Vec3& acc_mean_b, bool moving) {
 
 void Estimator::startAcquisition(double t_s, bool reacquisition) {
   landing_fix_ = false;  // the window begun here replaces a landing's (F16i)
+  floor_check_ = false;  // … and a floor check's (F29e)
   phase_ = FlightPhase::kAcquisition;
   descent_.clear();
   climb_.clear();
@@ -260,6 +281,7 @@ void Estimator::finishStart(double t_s, const StartFix& fix) {
   if (fix.floor_refuted && on_ground_) {
     // (F16j) floor contact before the first fix (a shaking burst in flight) is refuted by the TDoA: the body is in the
     // air and never was on the floor; the fix is the solve in motion of the same window
+    mode_.learnAirShake(rest_.gyroHighPassMeanSquare());  // (F29b) the burst was airborne shaking
     leaveGround(t_s, false);
     summary_.takeoff_t_s = std::numeric_limits<double>::quiet_NaN();
     summary_.start_floor_refuted = true;
@@ -369,13 +391,17 @@ void Estimator::handleTimeJump(double t_s, double gap_s) {
 
 void Estimator::leaveGround(double t_s, bool climbing) {
   on_ground_ = false;
+  if (mode_.onFloor()) mode_.reset(FlightMode::kAirborne);  // (F29) a start's TDoA refuted the floor (F16j)
+  if (floor_check_) start_.cancel();  // (F29e) the check's window holds the body on the floor
+  floor_check_ = false;
   endLandingFix();  // (F16i) the window holds the body at rest on the floor only
   replay_.stop();  // (F16g) the record holds predictions and TDoA only
   descent_.clear();  // (F26) the climb is not dead-reckoned from the floor: the detector's climb speed lags
   // (F16f) leaving rest (motors off) without a detected climb, the body still sits on the floor (rotors spun up
   // without floor shaking, or lifted by hand): its height is dead-reckoned from there for the fade of the floor-level
   // delays. Leaving floor contact (shaking with the motors running) or with a detected climb, it has already risen.
-  const bool from_rest = t_s - t_last_rest_ < kFromRest_s && t_s - t_last_shake_ >= kContactHold_s;
+  const bool from_rest =
+      (t_s - t_last_rest_ < kFromRest_s || left_rest_mode_) && t_s - t_last_shake_ >= kContactHold_s;
   if (floor_anchors_.hasDelays() && !climbing && from_rest) climb_.start(t_s);
   t_left_ground_ = t_s;
   if (summary_.ground_left_t_s.size() < summary_.ground_entered_t_s.size()) summary_.ground_left_t_s.push_back(t_s);
@@ -427,6 +453,17 @@ void Estimator::enterGround(double t_s) {
     landing_fix_ = true;
     t_landing_fix_s_ = t_s;
   }
+}
+
+void Estimator::finishFloorCheck(double t_s, const StartFix& fix) {
+  floor_check_ = false;
+  if (!fix.floor_refuted || !on_ground_) return;
+  // (F29e) the TDoA put the tag in the air, off the floor the IMU's contact held it to: the shaking is this flight's
+  // airborne shaking (F29b), the mode airborne, and the solve in the air the position
+  mode_.learnAirShake(rest_.gyroHighPassMeanSquare());
+  leaveGround(t_s, false);
+  ekf_.resetPositionVelocity(fix.w_p_b, fix.w_v_b, fix.cov);
+  ++summary_.n_floor_refutations;
 }
 
 void Estimator::endLandingFix() {
@@ -552,15 +589,18 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
   }
   if (params_.ground_phase == GroundPhase::kDetectTakeoff) {
     bool climbing = false;
+    // (F29b) floor shaking: the high-passed gyro far above the shaking this flight shows in the air
+    const double shake_ms = rest_.gyroHighPassMeanSquare();
+    const bool shaking = mode_.shakingStandsOut(shake_ms);
     if (on_ground_) {
       // (F15) take-off detector: leaky integral of the vertical specific-force excess over its level on the ground
       const double a_up = worldVertical(ekf_.state().w_q_b, imu.b_acc_mps2);
       v_climb_ = expNegative(dt_imu / kTakeoffLeak_s) * v_climb_ + dt_imu * (a_up - g_ref_);
       if (rest_.stillNow() || v_climb_ < 0.05) g_ref_ += (dt_imu / 2.0) * (a_up - g_ref_);
       // a body that shakes is still touching the floor (touchdown bounces, spin-up): no take-off
-      climbing = v_climb_ > params_.takeoff_climb_mps && !rest_.stillNow() && !rest_.shaking();
+      climbing = v_climb_ > params_.takeoff_climb_mps && !rest_.stillNow() && !shaking;
     }
-    if (rest_.shaking() && t_s - t_left_ground_ > kContactRearm_s) {
+    if (shaking && t_s - t_left_ground_ > kContactRearm_s) {
       if (t_s - t_last_shake_ >= kContactHold_s) t_shake_since_ = t_s;  // a new shaking episode
       t_last_shake_ = t_s;
     }
@@ -581,7 +621,10 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
       return z_low;
     };
     // shaking near the floor, or shaking for long wherever the estimate is (flight shakes only briefly)
+    // (F29b) and not entered from the air while the estimate climbs: shaking in a climb is rotors at thrust, not the
+    // floor (the climb after a take-off of a drone whose gyro shakes in flight)
     const bool contact = t_s - t_last_shake_ < kContactHold_s &&
+                         (on_ground_ || !ready_ || ekf_.state().w_v_b.z() < kRestMaxClimb_mps) &&
                          (!ready_ || t_s - t_shake_since_ >= kContactSustained_s ||
                           lowestRecentZ(kContactLowZSamples) - params_.ground_z_m < kContactMaxHeight_m);
     // rest enters the ground near the floor only: an IMU logged at a low rate or filtered reads as quiet in a still
@@ -603,14 +646,43 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
         (on_ground_ || !ready_ ||
          (x.w_p_b.z() - params_.ground_z_m < kContactMaxHeight_m && x.w_v_b.z() < kRestMaxClimb_mps) ||
          (t_s - t_last_descent_ < kLandingWindow_s && landingLowZ() - params_.ground_z_m < kContactMaxHeight_m));
-    const bool ground_now = (rest || contact) && !climbing;
+    // (F29) the IMU's evidence, weighed with the TDoA's by the flight-mode supervisor
+    const bool settled_in_air = !on_ground_ && ready_ && phase_ == FlightPhase::kTracking &&
+                                t_s - t_left_ground_ > kAirShakeSettle_s &&
+                                x.w_p_b.z() - params_.ground_z_m > kAirShakeMinHeight_m;
+    mode_.addImu(t_s, dt_imu, ImuModeEvidence{rest, contact, climbing, shake_ms}, settled_in_air);
+    left_rest_mode_ = mode_.mode() == FlightMode::kRest;  // (F16f) the mode the ground is left from
+    mode_.decide(t_s);
+    summary_.floor_doubted_s = mode_.doubtedFloorTime();
+    summary_.floor_doubted_max_height_m = mode_.doubtedFloorMaxHeight();
+    summary_.n_mode_overrules = static_cast<std::size_t>(mode_.tdoaOverrules());
+    summary_.air_shake_rms_radps = std::sqrt(mode_.airShakeLevel());
+    const bool ground_now = mode_.onFloor();
+    // (F29e) floor contact whose TDoA the floor explains worse than the air: the mode is examined by a solve of a
+    // fresh window on the floor against one in the air (F16j), at most every kFloorCheckPeriod_s
+    if (ground_now && on_ground_ && ready_ && !start_.active() && mode_.mode() == FlightMode::kContact && mode_.tdoaLogOdds() > 0.0 &&
+        t_s - t_floor_check_ >= kFloorCheckPeriod_s) {
+      t_floor_check_ = t_s;
+      floor_check_ = true;
+      landing_fix_ = false;
+      start_.begin(t_s, ekf_.state(), false, true);
+      ++summary_.n_floor_checks;
+    }
     if (ground_now && !on_ground_) {
       predictTo(t_s);
       propagate(true);
       enterGround(t_s);
     } else if (!ground_now && on_ground_) {
       predictTo(t_s);
+      const bool overruled = (mode_.status() & kTdoaOverrulesImu) != 0;
       leaveGround(t_s, climbing);
+      if (overruled) {
+        // (F29) the TDoA put the tag in the air against the IMU's floor evidence: the shaking seen now is this
+        // flight's airborne shaking (F29b), and the position held on the floor is found again from the TDoA (F16)
+        if (contact) mode_.learnAirShake(shake_ms);
+        if (ready_ && !start_.active()) startAcquisition(t_s, true);
+        mode_.clearTdoa();
+      }
     }
   }
 
@@ -742,10 +814,12 @@ void Estimator::addTdoa(const TdoaObservation& z) {
         on_ground_ && params_.floor_constraint ? std::optional<double>(params_.ground_z_m) : std::nullopt;
     if (replay_.recording()) replay_.recordTdoa(z);
     // (F16j) floor contact before the first fix may be refuted by the TDoA; rest (motors off) is not
-    const bool floor_refutable = floor_z && !ready_ && t_last_rest_ < t_entered_ground_;
+    // (F29e) and so is floor contact at a floor check
+    const bool floor_refutable = floor_z && ((!ready_ && t_last_rest_ < t_entered_ground_) || floor_check_);
     if (const std::optional<StartFix> fix = start_.add(z, ekf_.state(), floor_z, floor_refutable)) {
       propagate(true);
-      if (landing_fix_) finishLandingFix(*fix);
+      if (floor_check_) finishFloorCheck(t, *fix);
+      else if (landing_fix_) finishLandingFix(*fix);
       else finishStart(t, *fix);
     } else if (replay_.recording() && start_.referenceTime() != replay_.referenceTime()) {
       replay_.begin(ekf_, start_.referenceTime());  // (F16b) a failed solve moved the reference to now
@@ -782,6 +856,7 @@ void Estimator::addTdoa(const TdoaObservation& z) {
       zc.tdoa_m -= floor_anchors_.nearerPairDelay(z.id_a, z.id_b, r);
     }
   }
+  if (imu_mode_ && ready_ && params_.ground_phase == GroundPhase::kDetectTakeoff) superviseTdoa(t, z);
   if (antenna_) {
     antenna_->advance(t);
     antenna_predicted_ = false;
@@ -822,11 +897,15 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     case UpdateOutcome::kUnknownAnchor: ++summary_.n_tdoa_unknown_anchor; break;
     default: ++summary_.n_tdoa_degenerate; break;
   }
+  // (F30) in the air only: on and near the floor the TDoA carry the floor-level bias (F14), which their σ there covers
+  if (!acquiring && !near_floor &&
+      (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier))
+    checkConsistency(t, r.nis);
   // in flight only: on and near the floor the TDoA carry the floor-level bias (F14), and a body at rest or in ground
   // contact (F18: still, or shaking on the legs) is not flying even before the ground phase is entered
   const bool flying = !acquiring && !near_floor && std::min(t - t_acq_end_, t - t_left_ground_) >= kRejectionSettle_s &&
                       ekf_.state().w_p_b.z() - params_.ground_z_m > kRejectionMinHeight_m &&
-                      !(imu_mode_ && (rest_.stillNow() || rest_.shaking()));
+                      !(imu_mode_ && (rest_.stillNow() || mode_.shakingStandsOut(rest_.gyroHighPassMeanSquare())));
   last_tdoa_in_flight_ = flying;
   if (flying &&
       (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier)) {
@@ -892,6 +971,57 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     t_last_accept_ = t;
     n_rejected_streak_ = 0;
   }
+}
+
+void Estimator::checkConsistency(double t_s, double nis) {
+  // (F30) the TDoA's normalised innovation squared, clipped and averaged over kNisWindow_s
+  const double w = t_s >= t_nis_ ? expNegative((t_s - t_nis_) / kNisWindow_s) : 1.0;
+  const double dt = t_s > t_nis_ && t_nis_ > -1e299 ? std::min(t_s - t_nis_, 0.1) : 0.0;
+  t_nis_ = std::max(t_nis_, t_s);
+  nis_sum_ = w * nis_sum_ + std::min(std::isfinite(nis) ? nis : kNisClip, kNisClip);
+  nis_n_ = w * nis_n_ + 1.0;
+  nis_far_ = w * nis_far_ + (std::isfinite(nis) && nis <= kNisFar ? 0.0 : 1.0);
+  // the bulk of the TDoA disagrees: not a few pairs out of line of sight (those the gate and the robust loss take)
+  const bool beyond = nis_n_ >= kNisMinSamples && nis_far_ > kNisMaxFarFraction * nis_n_;
+  // (F30) the widening of the reported band fades with kWideningFade_s once the TDoA agree again
+  consistency_var_m2_ *= t_s > t_consistency_var_ ? expNegative((t_s - t_consistency_var_) / kWideningFade_s) : 1.0;
+  t_consistency_var_ = std::max(t_consistency_var_, t_s);
+  if (!beyond) {
+    t_consistent_ = t_s;
+    inconsistent_ = false;
+    return;
+  }
+  if (t_s - t_consistent_ < kInconsistentHold_s) return;
+  // beyond chance for kInconsistentHold_s: the estimate or its covariance is wrong, whatever the cause
+  if (!inconsistent_) ++summary_.n_inconsistent_periods;
+  inconsistent_ = true;
+  summary_.inconsistent_s += dt;
+  // the reported band is widened until the TDoA's spread is explained: the excess of the mean NIS over 1 in the
+  // TDoA's variance, at most kMaxWidening_m. The filter's own P is left alone: widening it lets the faulty or
+  // non-line-of-sight TDoA in that made the mean large (0426-traj12: 0.262 → 0.494 m) and hides a clock offset
+  // from the checks after the run.
+  const double excess = std::max(nis_sum_ / nis_n_ - 1.0, 0.0);
+  const double sigma = std::min(std::sqrt(excess) * track_opt_.sigma_m, kMaxWidening_m);
+  if (sigma * sigma > consistency_var_m2_) {
+    if (consistency_var_m2_ == 0.0 || t_s - t_last_widening_ >= kInconsistentHold_s) ++summary_.n_consistency_widenings;
+    consistency_var_m2_ = sigma * sigma;
+    t_last_widening_ = t_s;
+  }
+}
+
+void Estimator::superviseTdoa(double t_s, const TdoaObservation& z) {
+  // (F29c) the height at which this TDoA puts the tag: its residual at the estimate over its vertical sensitivity, as
+  // a TDoA in the air and as one on the floor (with the floor-level anchors' delays, F16f)
+  const Moments3* a = anchors_.find(z.id_a);
+  const Moments3* b = anchors_.find(z.id_b);
+  if (!a || !b) return;
+  const NavState& x = ekf_.state();
+  TdoaJacobians J;
+  const std::optional<double> h = evaluateTdoa(x.w_p_b, x.w_q_b, a->m, b->m, tdoa_model_, &J);
+  if (!h) return;
+  const double r_air = z.tdoa_m - *h;
+  const double floor_delay = floor_anchors_.hasDelays() ? floor_anchors_.pairDelay(z.id_a, z.id_b) : 0.0;
+  mode_.addTdoa(t_s, r_air, r_air - floor_delay, J.J_z_p_b(2), x.w_p_b.z() - params_.ground_z_m);
 }
 
 void Estimator::revertToHealthyMotion(double t_s) {
@@ -962,8 +1092,9 @@ void Estimator::alignHeading(double t_s, const ImuReading& imu, double dt_s) {
 
 Mat3 Estimator::reportedPositionCovariance() const {
   const Mat3 P = ekf_.covariance().block<3, 3>(kPos, kPos);
-  if (!(params_.output_bias_sigma_m > 0.0) || !ready_) return P;
-  return P + bias_floor_;
+  const Mat3 widened = P + consistency_var_m2_ * Mat3::Identity();  // (F30)
+  if (!(params_.output_bias_sigma_m > 0.0) || !ready_) return widened;
+  return widened + bias_floor_;
 }
 
 int Estimator::anchorsHeard(double window_s) const {
@@ -1043,6 +1174,7 @@ LocalizerEstimate Estimator::estimate() const {
   e.t_s = t_last_event_;
   e.x = ekf_.state();
   e.phase = phase_;
+  e.mode_status = mode_.status() | (inconsistent_ ? kInconsistent : 0u);
   const ErrMat& P = ekf_.covariance();
   e.cov_pose.block<3, 3>(0, 0) = reportedPositionCovariance();
   e.cov_pose.block<3, 3>(0, 3) = P.block<3, 3>(kPos, kAtt);

@@ -55,11 +55,14 @@ std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x
   const bool solvable = n_anchors >= minFixAnchors(floor_z_m.has_value());
   if (solvable && floor_z_m) {
     // (F16f) with floor-level anchors, their delays are solved for; without 3 other anchors in view, the plain solve
-    if (!floor_level_.empty())
+    // (F29e) not at a floor check: the floor's delays were solved at the start, and solving them again would let
+    // the floor explain any window
+    if (!floor_level_.empty() && !(floor_refutable && reacquisition_))
       r = multilaterateOnFloorWithDelays(samples_, anchors_, b_t_tag_, guesses_, *floor_z_m, floor_level_);
     if (!r) r = multilaterateOnFloor(samples_, anchors_, b_t_tag_, guesses_, *floor_z_m);
     // (F16j) at the first start, floor contact (F18) is tested against the TDoA (by a solve in the air: F16k)
-    if (r && floor_refutable && !reacquisition_ && n_anchors >= minFixAnchors(false)) {
+    // and at a floor check in floor contact (F29e): the caller says when the floor may be refuted
+    if (r && floor_refutable && n_anchors >= minFixAnchors(false)) {
       if (std::optional<MultilaterationResult> in_air = refuteFloor(*r, *floor_z_m, z.t_s)) {
         r = in_air;
         moving = floor_refuted = true;

@@ -103,18 +103,26 @@ TEST(StartUp, GivenRestRatherThanFloorContactWhenSolvedThenTheFloorIsNotTested) 
   EXPECT_EQ(fix->w_p_b.z(), 0.0);
 }
 
-TEST(StartUp, GivenAReacquisitionOnTheFloorWhenSolvedThenTheFloorIsNotTested) {
+TEST(StartUp, GivenAReacquisitionOnTheFloorTheFloorIsTestedOnlyWhenTheCallerAsks) {
   // GIVEN a window on the floor that is not the first start (a landing's floor window, F16i) with TDoA of a body in
   // the air: the ground evidence after a flight comes with a descent and is revised by the landing logic
   const AnchorTable anchors = boxAnchors();
   StartUp start(anchors, Vec3::Zero(), StartUpParams{});
   start.begin(0.0, NavState{}, false, true);
-  // WHEN the window is solved
-  const std::optional<StartFix> fix = runStart(start, anchors, Vec3(1.5, 2.5, 1.5), 0.0);
+  // WHEN the window is solved without a floor test
+  const std::optional<StartFix> fix = runStart(start, anchors, Vec3(1.5, 2.5, 1.5), 0.0, false);
   // THEN the fix stays on the floor
   ASSERT_TRUE(fix);
   EXPECT_FALSE(fix->floor_refuted);
   EXPECT_EQ(fix->w_p_b.z(), 0.0);
+  // WHEN the same window is a floor check of floor contact (filter.md F29e): the floor may be refuted
+  StartUp check(anchors, Vec3::Zero(), StartUpParams{});
+  check.begin(0.0, NavState{}, false, true);
+  const std::optional<StartFix> refuted = runStart(check, anchors, Vec3(1.5, 2.5, 1.5), 0.0, true);
+  // THEN the TDoA put the body in the air
+  ASSERT_TRUE(refuted);
+  EXPECT_TRUE(refuted->floor_refuted);
+  EXPECT_NEAR(refuted->w_p_b.z(), 1.5, 0.1);
 }
 
 TEST(StartUp, GivenTdoaOfFewerAnchorsThanAFixNeedsWhenSolvedThenThereIsNoFix) {

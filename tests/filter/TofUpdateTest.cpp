@@ -160,9 +160,9 @@ double heightRmse(const LocalizerResult& r, double t0, double t1) {
 TEST(TofLocalizer, FusionCorrectsTheHeightUnderHeightBiasedTdoa) {
   // GIVEN a flight whose TDoA put the drone 0.3 m too high, and a ToF stream
   const SensorLog log = makeLog(0.3, 12.0, 5);
-  EkfParams off;
-  EkfParams on = off;
-  on.fuse_tof = true;
+  EkfParams on;  // the default fuses the range when the log has it (F21)
+  EkfParams off = on;
+  off.fuse_tof = false;
   // WHEN localizing with and without ToF fusion
   const LocalizerResult r_off = TdoaLocalizer(off, arenaAnchors()).run(log);
   const LocalizerResult r_on = TdoaLocalizer(on, arenaAnchors()).run(log);
@@ -208,20 +208,28 @@ TEST(TofLocalizer, InvalidAndOutOfRangeReadingsAreIgnoredAndCounted) {
   EXPECT_GT(r_dirty.summary.n_tof_not_ready, 0u);
 }
 
-TEST(TofLocalizer, DefaultOffLeavesTheEstimatesUnchanged) {
+TEST(TofLocalizer, OffLeavesTheEstimatesUnchangedAndALogWithoutItIsUnchangedByDefault) {
   // GIVEN a log with and without the ToF stream
   const SensorLog with_tof = makeLog(0.3, 8.0, 7);
   SensorLog without_tof = with_tof;
   without_tof.tof.clear();
-  // WHEN running the default filter (fuse_tof = false)
-  EkfParams params;
-  ASSERT_FALSE(params.fuse_tof);
-  const LocalizerResult a = TdoaLocalizer(params, arenaAnchors()).run(with_tof);
-  const LocalizerResult b = TdoaLocalizer(params, arenaAnchors()).run(without_tof);
-  // THEN the outputs are identical
+  // WHEN running the filter with fuse_tof off (`--no-tof`), and the default (on) on the log without the stream
+  EkfParams off;
+  off.fuse_tof = false;
+  EkfParams defaults;
+  ASSERT_TRUE(defaults.fuse_tof);
+  const LocalizerResult a = TdoaLocalizer(off, arenaAnchors()).run(with_tof);
+  const LocalizerResult b = TdoaLocalizer(off, arenaAnchors()).run(without_tof);
+  const LocalizerResult c = TdoaLocalizer(defaults, arenaAnchors()).run(without_tof);
+  // THEN the outputs are identical: off ignores the stream, and on uses nothing a log does not hold
   ASSERT_EQ(a.estimates.size(), b.estimates.size());
-  for (std::size_t i = 0; i < a.estimates.size(); ++i) ASSERT_EQ(a.estimates[i].x.w_p_b, b.estimates[i].x.w_p_b);
+  ASSERT_EQ(b.estimates.size(), c.estimates.size());
+  for (std::size_t i = 0; i < a.estimates.size(); ++i) {
+    ASSERT_EQ(a.estimates[i].x.w_p_b, b.estimates[i].x.w_p_b);
+    ASSERT_EQ(b.estimates[i].x.w_p_b, c.estimates[i].x.w_p_b);
+  }
   EXPECT_EQ(a.summary.n_tof_used, 0u);
+  EXPECT_GT(a.summary.n_tof_total, 0u);
 }
 
 TEST(EkfParams, TofFieldsAreValidated) {

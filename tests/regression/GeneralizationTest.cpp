@@ -81,7 +81,8 @@ TEST(Generalization, RealLogBegunDuringAShakingBurstInFlightIsNotPutOnTheFloor) 
     // THEN the first fix refutes the ground evidence (F16j): the estimate is never on the floor (before: 2.1 and
     // 1.5 m off for a second, airborne RMSE 0.49 and 0.39 m), and no take-off is reported
     ASSERT_TRUE(run.metrics);
-    EXPECT_TRUE(run.summary.start_floor_refuted);
+    // (the flight-mode supervisor, filter.md F29, may not enter the floor at all for a burst this short)
+    EXPECT_TRUE(run.summary.start_floor_refuted || run.summary.ground_entered_t_s.empty());
     EXPECT_TRUE(std::isnan(run.summary.takeoff_t_s));
     EXPECT_LT(run.metrics->airborne.max_m, 0.8);
     EXPECT_LT(run.metrics->airborne.rmse_m, 0.35);
@@ -366,11 +367,14 @@ TEST(Generalization, RealFlightWithALargeBiasWidensItsReportedSigma) {
   // level measured in flight and once with the reported pair-bias std fixed at 0.2 m (F23c off); and with the defaults
   LocalizationOptions derived;
   derived.params.output_bias_vertical_scale = 1.0;
+  derived.params.fuse_tof = false;  // the TDoA's own band: the downward range (F21) would hold the height
   const LocalizationRun run = localizeFlight(flight, survey, derived);
   LocalizationOptions fixed = derived;
   fixed.params.output_bias_memory_s = 0.0;
   const LocalizationRun run_fixed = localizeFlight(flight, survey, fixed);
-  const LocalizationRun run_default = localizeFlight(flight, survey);
+  LocalizationOptions defaults_without_tof;
+  defaults_without_tof.params.fuse_tof = false;
+  const LocalizationRun run_default = localizeFlight(flight, survey, defaults_without_tof);
   // THEN the band measured in flight covers at least half of the errors on every axis at 1σ (fixed: 54 / 52 / 39 %)
   // and 85 % at 2σ, and the estimate itself is the same
   ASSERT_TRUE(run.metrics && run_fixed.metrics && run_default.metrics);

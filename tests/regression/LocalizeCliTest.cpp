@@ -46,11 +46,16 @@ class LocalizeCli : public ::testing::Test {
 
 TEST_F(LocalizeCli, TofFusionByFlagOrConfigUsesTheHeightSensorAndReportsItsCounters) {
   // GIVEN 0425-traj3, a flight with a Flow-deck ToF stream (airborne RMSE 0.169 m UWB-only, 0.095 m with ToF)
-  // WHEN it is localized without ToF, with --fuse-tof, and with fuse_tof in a config file
-  const nlohmann::json plain = localize("");
-  const nlohmann::json flag = localize("--fuse-tof");
-  const nlohmann::json config =
-      localize("--config " + writeConfig("tof.json", R"({"fuse_tof": true, "tof_sigma_m": 0.05})"));
+  // WHEN it is localized with --no-tof, with the default (ToF fused when the log has it, F21), and with the range's
+  // sigma in a config file
+  const nlohmann::json plain = localize("--no-tof");
+  const nlohmann::json flag = localize("");
+  const nlohmann::json config = localize("--config " + writeConfig("tof.json", R"({"tof_sigma_m": 0.05})"));
+  // AND --no-tof overrides a config that asks for it
+  const nlohmann::json overridden =
+      localize("--no-tof --config " + writeConfig("tof_on.json", R"({"fuse_tof": true})"));
+  EXPECT_EQ(overridden["n_tof_used"].get<int>(), 0);
+  EXPECT_FALSE(overridden["fuse_tof"].get<bool>());
   // THEN without it no reading is used; with it most readings are used and the height error collapses
   EXPECT_EQ(plain["n_tof_used"].get<int>(), 0);
   for (const nlohmann::json* j : {&flag, &config}) {

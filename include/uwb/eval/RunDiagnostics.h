@@ -73,6 +73,7 @@ struct EstimateResidual {
   double r_m = 0.0;
   RowVec3 J_a = RowVec3::Zero();  ///< ∂z/∂a_A = +u_Aᵀ
   RowVec3 J_b = RowVec3::Zero();  ///< ∂z/∂a_B = −u_Bᵀ
+  double w_z_est_m = 0.0;         ///< the estimate's height there [m]
 };
 
 /// The residuals of the TDoA in [t0_s, t1_s] whose pair contains `only_anchor` (−1: all) against the trajectory
@@ -125,7 +126,23 @@ struct ClockOffsetCheck {
   bool offset = false;              ///< |best_lag_s| > clock_min_lag_s and power_ratio ≥ clock_min_power_ratio
 };
 
+/// What the estimator assumed and doubted during the run (filter.md F29d, F30): read from its summary, before any
+/// check blames the survey.
+struct EstimateDoubts {
+  double floor_doubted_s = 0.0;             ///< on the floor by the IMU while the TDoA put the tag in the air [s]
+  double floor_doubted_max_height_m = 0.0;  ///< the TDoA's largest height meanwhile [m]
+  double inconsistent_s = 0.0;              ///< the TDoA's NIS beyond chance [s]
+  std::size_t n_inconsistent_periods = 0;
+  double air_shake_rms_radps = 0.0;         ///< the airborne shaking level learned in flight (F29b)
+  double duration_s = 0.0;
+  /// The survey checks would blame the survey for the estimator's own assumption: more than 2 s on the floor
+  /// against the TDoA (F29d).
+  bool doubtful() const;
+};
+EstimateDoubts estimateDoubts(const LocalizationRun& run);
+
 struct RunDiagnostics {
+  EstimateDoubts doubts;
   SurveyFitCheck survey;
   AnchorSurveyCheck anchors;
   ClockOffsetCheck clock;

@@ -44,6 +44,7 @@ struct EkfParamRange {
 struct EkfParamInfo {
   std::string name;       ///< struct field, config key and Python key
   std::string cli_alias;  ///< extra CLI flag without dashes ("tdoa-sigma"), or empty
+  std::string cli_negation;  ///< kBool: a CLI flag without dashes that sets it false ("no-tof"), or empty
   std::string unit;       ///< SI unit ("m", "m/s^2/sqrt(Hz)"), empty when dimensionless
   std::string doc;        ///< one sentence
   EkfParamKind kind = EkfParamKind::kReal;

@@ -220,8 +220,9 @@ struct EkfParams {
   double output_bias_vertical_scale = 0.8;
 
   // --- downward ToF range (Flow deck VL53L1x), docs/math/filter.md F21 ---
-  /// Fuse the ToF range as a height update while airborne (off by default: the published numbers are without).
-  bool fuse_tof = false;
+  /// Fuse the ToF range as a height update when the log has it, as the Crazyflie's estimator does with a Flow deck
+  /// (F21; `--no-tof` turns it off).
+  bool fuse_tof = true;
   double tof_sigma_m = 0.03;             ///< ToF range noise std [m] (0425: 7–10 mm spread about the Vicon height)
   double tof_offset_m = 0.037;           ///< sensor below the body origin along body z [m] (0425: ToF − z = −0.037)
   double floor_z_m = 0.0;                ///< height of the flat floor the ToF sees, world z [m]

@@ -21,6 +21,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <string>
@@ -31,6 +32,7 @@
 #include "uwb/filter/CooperativeRange.h"
 #include "uwb/filter/DescentBound.h"
 #include "uwb/filter/FloorLevelAnchors.h"
+#include "uwb/filter/FlightMode.h"
 #include "uwb/filter/Ekf.h"
 #include "uwb/filter/EkfParams.h"
 #include "uwb/filter/InMotionAlignment.h"
@@ -40,6 +42,7 @@
 #include "uwb/filter/StartUp.h"
 #include "uwb/filter/TdoaUpdate.h"
 #include "uwb/filter/TofUpdate.h"
+#include "uwb/model/TdoaModel.h"
 
 namespace uwb {
 
@@ -61,6 +64,7 @@ struct LocalizerEstimate {
   Eigen::Matrix<double, 6, 6> cov_pose = Eigen::Matrix<double, 6, 6>::Zero();
   Vec3 sigma_v_mps = Vec3::Zero();  ///< 1σ of the velocity per world axis [m/s]
   FlightPhase phase = FlightPhase::kGround;
+  std::uint32_t mode_status = 0;  ///< the flight-mode supervisor's status word (FlightModeStatus bits, F29)
 };
 
 struct LocalizerSummary {
@@ -125,6 +129,16 @@ struct LocalizerSummary {
   bool started_in_motion = false;
   /// When the estimator entered the ground (rest or floor contact, F18) and when it left it again (first 100 each,
   /// same order; one fewer left when the log ends on the ground). Its TDoA there carry the floor-level bias (F14).
+  // the flight-mode supervisor (F29) and the innovation consistency check (F30)
+  double floor_doubted_s = 0.0;           ///< on the floor by the IMU while the TDoA put the tag in the air [s]
+  double floor_doubted_max_height_m = 0.0;  ///< the largest TDoA height meanwhile [m]
+  std::size_t n_mode_overrules = 0;       ///< mode changes the TDoA forced against the IMU
+  double air_shake_rms_radps = 0.0;       ///< the airborne shaking level learned in flight (F29b) [rad/s]
+  std::size_t n_inconsistent_periods = 0; ///< times the TDoA's NIS stayed beyond chance for inconsistent_s (F30)
+  double inconsistent_s = 0.0;            ///< time the check failed [s] (F30)
+  std::size_t n_consistency_widenings = 0;  ///< covariance widenings by the check (F30)
+  std::size_t n_floor_checks = 0;         ///< floor contact examined by a solve on the floor against the air (F29e)
+  std::size_t n_floor_refutations = 0;    ///< … that put the tag in the air
   std::vector<double> ground_entered_t_s;
   std::vector<double> ground_left_t_s;
   double takeoff_t_s = std::numeric_limits<double>::quiet_NaN();  ///< first time it left rest
@@ -194,8 +208,11 @@ class Estimator {
   void finishStart(double t_s, const StartFix& fix);
   void finishLandingFix(const StartFix& fix);
   void endLandingFix();
+  void finishFloorCheck(double t_s, const StartFix& fix);
   /// F16d: position and velocity back to the recent motion recorded before a TDoA fault.
   void revertToHealthyMotion(double t_s);
+  void superviseTdoa(double t_s, const TdoaObservation& z);
+  void checkConsistency(double t_s, double nis);
   void applyFloorConstraint(bool on_ground);
   /// F26: the height bounded from above by the IMU's dead-reckoned descent while landing.
   void applyDescentBound(double t_s);
@@ -224,6 +241,12 @@ class Estimator {
   DescentBound descent_;  ///< dead-reckoned descent while landing (F26)
   Ekf ekf_;
   RestDetector rest_;
+  FlightModeSupervisor mode_;  ///< ground or air from all the evidence (F29)
+  TdoaModelParams tdoa_model_;  ///< the tag lever arm for the supervisor's TDoA heights (F29c)
+  // (F30) the innovation consistency check: forgotten sums of the clipped NIS and of the count
+  double nis_sum_ = 0.0, nis_n_ = 0.0, nis_far_ = 0.0, t_nis_ = -1e300, t_consistent_ = -1e300, t_last_widening_ = -1e300;
+  bool inconsistent_ = false;
+  double consistency_var_m2_ = 0.0, t_consistency_var_ = -1e300;  ///< the reported band's widening (F30) [m²]
   StartUp start_;
   StartReplay replay_;  ///< the first start in motion, run again from the fix (F16g)
   InMotionAlignment heading_align_;  ///< (F28) the attitude from the gyro-tracked specific force and the velocity
@@ -248,6 +271,9 @@ class Estimator {
   std::size_t i_low_z_ = 0, n_low_z_ = 0;
   double t_low_z_sample_ = -1e300;
   bool landing_fix_ = false;     ///< start_ collects the floor window of a landing (F16i)
+  bool floor_check_ = false;     ///< start_ collects a floor check's window (F29e)
+  bool left_rest_mode_ = false;  ///< the supervisor's mode was rest before its last decision (F16f, F29)
+  double t_floor_check_ = -1e300;
   double t_landing_fix_s_ = 0.0;  ///< when that window began
   bool moved_ = false;
   FlightPhase phase_ = FlightPhase::kAcquisition;

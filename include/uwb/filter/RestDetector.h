@@ -43,6 +43,8 @@ class RestDetector {
   double gyroMeanSquare() const { return gyro_ms_; }
   /// The shaking of ground contact with the motors running: high-passed gyro rms above its threshold (F18).
   bool shaking() const { return gyro_hp_ms_ > contact_ms_min_; }
+  /// The high-passed gyro mean square that shaking() tests [rad²/s²] (F18; its level in flight is learned, F29b).
+  double gyroHighPassMeanSquare() const { return gyro_hp_ms_; }
   /// Restarts the statistics from a sample (moving, not at rest); a gyro reference is kept.
   void reset(const ImuReading& imu);
   /// (F18) Starts the moving statistics from a window's sample moments instead (the levelling window of F15): the

@@ -1,0 +1,62 @@
+/** @file SignatureMatrix.h
+ *  @brief The sensor-signature matrix of `uwbtdoa protocol --signatures`: each flight localized with other drones'
+ *         IMU signatures (docs/math/simulation.md S24) against the same flight with its own (docs/robustness.md).
+ *
+ *  Flights: simulated flights from the floor (the simulator's plain IMU) and transplants of real development flights
+ *  (their own IMU low-passed, then the signature added by phase). Cells: in-flight gyro vibration 0–40 °/s, in-flight
+ *  accelerometer vibration 0.005–0.3 g, the floor with the motors off or idling at 10–40 °/s, the IMU at 100 and
+ *  500 Hz, a gyro bias of 3 °/s, an accelerometer bias of 0.1 g, IMU stamps 10 and 30 ms behind the TDoA, and the
+ *  signature of a drone whose floor is quiet and whose gyro shakes in flight.
+ */
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "uwb/eval/Localization.h"
+#include "uwb/io/AnchorSurvey.h"
+#include "uwb/io/Flight.h"
+#include "uwb/sim/ImuSignature.h"
+
+namespace uwb {
+
+struct SignatureCell {
+  std::string name;
+  sim::ImuSignature signature;
+};
+
+struct SignatureFlight {
+  std::string name;
+  Flight flight;
+  AnchorSurvey survey;
+  bool transplant = false;  ///< a real flight: its own in-flight vibration is replaced (S24)
+};
+
+/// What one cell did on one flight, against the same flight with its own signature.
+struct SignatureRow {
+  std::string flight, cell;
+  double rmse_plain_m = 0.0, rmse_cell_m = 0.0;  ///< airborne RMSE [m]
+  double ratio = 0.0;                            ///< rmse_cell / rmse_plain
+  /// Airborne TDoA (by the truth) that were not taken at the floor's σ: 1 − (at-floor TDoA in excess of the plain
+  /// run) / airborne TDoA
+  double in_flight_fraction = 0.0;
+  double longest_floor_stuck_s = 0.0;  ///< longest span with the estimate within 0.2 m of the floor, truth above 0.5 m
+  Vec3 coverage_2sigma = Vec3::Zero();
+  std::size_t mode_overrules = 0;      ///< mode changes the TDoA forced against the IMU (filter.md F29)
+  bool pass = false;                   ///< ratio ≤ 1.2, in-flight ≥ 95 %, stuck ≤ 1 s
+};
+
+/// The cells of the matrix; transplant cells replace the flight's own in-flight vibration.
+std::vector<SignatureCell> signatureCells(bool transplant);
+
+/// The flights: simulated circle and zigzag from the floor (seed 11, the paper's anchors) and the transplants of
+/// 0425-traj2, 0426-traj1 and 0426-traj11 when data_dir holds them. `only` keeps names containing it.
+std::vector<SignatureFlight> signatureFlights(const std::string& data_dir, const std::string& only = "");
+
+/// Localizes the flight with the cell's signature (seed fixed per cell) and compares it with `plain`, the run on the
+/// flight as it is.
+SignatureRow evaluateSignature(const SignatureFlight& flight, const SignatureCell& cell, const LocalizationRun& plain,
+                               const LocalizationOptions& options, std::uint64_t seed);
+
+}  // namespace uwb

@@ -1,0 +1,149 @@
+/** @file FlightMode.h
+ *  @brief The flight-mode supervisor: at rest on the floor, in floor contact with the motors running, or airborne, as
+ *         a discrete state whose evidence comes from every sensor (docs/math/filter.md F29).
+ *
+ *  Each sensor's evidence is a log-likelihood ratio of "airborne" against "on the floor", bounded by how far that
+ *  sensor can be trusted:
+ *   - the IMU (F29a): rest and floor shaking from RestDetector, the climb of the take-off detector; its log-odds move
+ *     at a bounded rate and never exceed ±imu_max_log_odds, so the IMU alone can hold a mode but never against strong
+ *     evidence of another sensor. Floor shaking counts only when it stands out against the shaking this flight shows
+ *     in the air, which the supervisor learns (F29b), not against a constant of one drone;
+ *   - the TDoA (F29c): the heights above the floor at which a window of recent TDoA puts the tag, from each TDoA's
+ *     residual and vertical sensitivity at the estimate, once as TDoA in the air and once corrected as on the floor
+ *     (the floor-level anchors' delays, F16f): whichever hypothesis explains its window more tightly (about a height
+ *     in the flight range, or about the floor) wins. Its log-likelihood ratio is bounded by tdoa_max_log_odds for
+ *     the air and by the smaller tdoa_max_floor_log_odds for the floor.
+ *  The mode is airborne while the sum is positive (with a hysteresis), on the floor otherwise; rest and contact are
+ *  told apart by the IMU. Nothing is decided for good: the evidence is re-weighed at every step.
+ *
+ *  One status word (status()) holds the mode and the evidence behind it, in the manner of the Crazyflie supervisor's
+ *  state and PX4's estimator control status; doubts (the IMU held the floor while the TDoA put the tag in the air)
+ *  are counted for the run's warnings. No allocation.
+ */
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace uwb {
+
+enum class FlightMode : unsigned char {
+  kRest,      ///< on the floor, motors off (still IMU)
+  kContact,   ///< on the floor with the motors running (shaking IMU)
+  kAirborne,  ///< flying, or carried
+};
+std::string toString(FlightMode mode);
+
+/// Bits of FlightModeSupervisor::status().
+enum FlightModeStatus : std::uint32_t {
+  kModeRest = 1u << 0,
+  kModeContact = 1u << 1,
+  kModeAirborne = 1u << 2,
+  kImuSaysRest = 1u << 3,          ///< the IMU's rest test holds now
+  kImuSaysContact = 1u << 4,       ///< floor shaking above the flight's learned airborne level
+  kImuSaysClimb = 1u << 5,         ///< the take-off detector sees a climb
+  kTdoaHeightValid = 1u << 6,      ///< the TDoA window holds enough vertical information
+  kTdoaSaysAirborne = 1u << 7,     ///< the TDoA's Bayes factor favours the air
+  kTdoaOverrulesImu = 1u << 8,     ///< the mode follows the TDoA against the IMU
+  kAirShakeLearned = 1u << 9,      ///< the flight's airborne shaking level has been measured
+  kInconsistent = 1u << 10,        ///< the innovation consistency check fails (set by the estimator, F30)
+};
+
+struct FlightModeParams {
+  double imu_max_log_odds = 4.0;        ///< bound of the IMU's log-odds from shaking and climbs (F29a) [nats]
+  /// … and towards the floor while the IMU reads rest (motors off: a body that cannot fly; entered from the air only
+  /// near the floor, F18), above the TDoA's bound: rest is not overruled by the TDoA (F29a) [nats]
+  double imu_rest_log_odds = 24.0;
+  double imu_rate_per_s = 100.0;        ///< rate at which the IMU's log-odds move (F29a) [nats/s]
+  double tdoa_max_log_odds = 20.0;      ///< bound of the TDoA's Bayes factor for the air (F29c) [nats]
+  /// … and for the floor: the TDoA near the floor carry the floor-level bias and their window lags a take-off, so
+  /// they can confirm the floor only weakly (F29c) [nats]
+  double tdoa_max_floor_log_odds = 2.0;
+  double tdoa_window_s = 0.5;           ///< forgetting time of the TDoA height window (F29c) [s]
+  double tdoa_min_effective = 30.0;     ///< forgotten TDoA count below which the window says nothing (F29c)
+  double tdoa_independent = 10.0;       ///< independent TDoA per window: their errors are correlated (F29c)
+  double min_vertical_gain = 0.2;       ///< |∂h/∂z| below which a TDoA says nothing of the height (F29c)
+  double height_floor_sigma_m = 0.3;    ///< spread added to both hypotheses' mean squares (F29c) [m]
+  double air_min_height_m = 0.3;        ///< flight heights above the floor: uniform over [min, max] (F29c) [m]
+  double air_max_height_m = 3.0;
+  double hysteresis_log_odds = 1.0;     ///< a mode is left when the sum passes ∓ this (F29) [nats]
+  double air_shake_ratio = 4.0;         ///< floor shaking: mean square above this × the airborne level (F29b)
+  double air_shake_prior_ms = 0.075 * 0.075;  ///< airborne shaking before it is measured (F29b) [rad²/s²]
+  double air_shake_tau_s = 3.0;         ///< time constant of the learned airborne level (F29b) [s]
+  void validate() const;
+};
+
+/// The IMU's evidence at one step (F29a), from RestDetector and the take-off detector.
+struct ImuModeEvidence {
+  bool rest = false;            ///< at rest (and near the floor, where the estimator asks for it)
+  bool shaking_near_floor = false;  ///< floor-contact shaking where contact is plausible
+  bool climbing = false;        ///< the take-off detector's climb
+  double shake_ms_radps2 = 0.0; ///< high-passed gyro mean square (RestDetector::gyroHighPassMeanSquare)
+};
+
+class FlightModeSupervisor {
+ public:
+  explicit FlightModeSupervisor(const FlightModeParams& params = {});
+
+  /// Starts in a mode, the evidence cleared; the learned airborne shaking level is kept.
+  void reset(FlightMode mode);
+  /// Floor shaking against the learned airborne level (F29b): is this mean square contact evidence?
+  bool shakingStandsOut(double shake_ms_radps2) const;
+  /// Folds in the IMU's evidence over dt_s (F29a) and learns the airborne shaking level while airborne (F29b).
+  void addImu(double t_s, double dt_s, const ImuModeEvidence& evidence, bool settled_in_air);
+  /// One TDoA (F29c): its residual at the estimate r = z̃ − h(x̂) [m] as a TDoA in the air and as one on the floor
+  /// (corrected by the floor-level delays; the same without them), its vertical sensitivity ∂h/∂z, and the
+  /// estimate's height above the floor [m].
+  void addTdoa(double t_s, double residual_air_m, double residual_floor_m, double dh_dz, double estimate_height_m);
+  /// The TDoA window is cleared (a re-acquisition: the estimate is not a linearization point).
+  void clearTdoa();
+  /// Re-decides the mode from the summed evidence (F29). Returns true when the mode changed.
+  bool decide(double t_s);
+  /// The TDoA put the tag in the air against the IMU's floor evidence: the shaking seen now is airborne shaking
+  /// (F29b); the level is raised to it.
+  void learnAirShake(double shake_ms_radps2);
+
+  FlightMode mode() const { return mode_; }
+  bool onFloor() const { return mode_ != FlightMode::kAirborne; }
+  double imuLogOdds() const { return imu_log_odds_; }
+  /// The TDoA's Bayes factor airborne : floor, 0 while the window is not valid (F29c) [nats].
+  double tdoaLogOdds() const { return tdoa_log_odds_; }
+  /// The TDoA window's mean height above the floor as TDoA in the air, and its spread [m] (NaN while not valid).
+  double tdoaHeight() const { return tdoa_height_m_; }
+  double tdoaHeightSpread() const { return tdoa_height_spread_m_; }
+  double airShakeLevel() const { return air_shake_ms_; }
+  std::uint32_t status() const;
+  /// Time the mode was on the floor while the TDoA window said airborne (log-odds above tdoa_max_floor_log_odds)
+  /// [s], and the largest TDoA height meanwhile [m]: what the run's warnings name before they blame the survey.
+  double doubtedFloorTime() const { return doubted_floor_s_; }
+  double doubtedFloorMaxHeight() const { return doubted_floor_max_height_m_; }
+  /// Mode changes the TDoA forced against the IMU.
+  int tdoaOverrules() const { return n_tdoa_overrules_; }
+
+ private:
+  void updateTdoaFactor();
+
+  FlightModeParams params_;
+  FlightMode mode_ = FlightMode::kAirborne;
+  double imu_log_odds_ = 0.0, tdoa_log_odds_ = 0.0;
+  bool imu_rest_ = false, imu_contact_ = false, imu_climb_ = false;
+  /// A window of heights: forgotten sums of w, w·h, w·h² with w = (∂h/∂z)² (F29c).
+  struct HeightWindow {
+    double sw = 0.0, swh = 0.0, swhh = 0.0;
+    void scale(double a) { sw *= a, swh *= a, swhh *= a; }
+    void add(double w, double h) { sw += w, swh += w * h, swhh += w * h * h; }
+    double mean() const { return swh / sw; }
+    double spread2() const;  ///< weighted variance about the mean
+  };
+  double t_tdoa_ = -1e300, n_ = 0.0;
+  HeightWindow air_, floor_;
+  double tdoa_height_m_, tdoa_height_spread_m_;
+  double air_shake_ms_;
+  bool air_shake_learned_ = false;
+  double t_last_ = -1e300;
+  double doubted_floor_s_ = 0.0, doubted_floor_max_height_m_ = 0.0;
+  int n_tdoa_overrules_ = 0;
+  bool overruled_ = false;
+};
+
+}  // namespace uwb

@@ -1,0 +1,171 @@
+/** @file FlightModeTest.cpp
+ *  @brief The flight-mode supervisor: every sensor's evidence, bounded by its trust (docs/math/filter.md F29).
+ */
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "uwb/filter/FlightMode.h"
+
+namespace uwb {
+namespace {
+
+constexpr double kImuDt_s = 0.001;
+constexpr double kTdoaDt_s = 0.0025;
+
+/// Feeds `duration_s` of IMU evidence (1 kHz) and TDoA (400 Hz) whose heights scatter about `tdoa_height_m` with
+/// `spread_m` (the estimate sits at `estimate_height_m`); the vertical gains cycle through ±0.4…0.8.
+void feed(FlightModeSupervisor& s, double* t, double duration_s, const ImuModeEvidence& imu, double tdoa_height_m,
+          double spread_m, double estimate_height_m, std::mt19937& rng, bool settled_in_air = false) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  const double gains[] = {0.8, -0.5, 0.4, -0.7, 0.6};
+  const double t_end = *t + duration_s;
+  double t_next_tdoa = *t;
+  int k = 0;
+  while (*t < t_end) {
+    *t += kImuDt_s;
+    s.addImu(*t, kImuDt_s, imu, settled_in_air);
+    if (std::isfinite(tdoa_height_m) && *t >= t_next_tdoa) {
+      const double g = gains[k++ % 5];
+      const double h = tdoa_height_m + spread_m * n(rng);
+      const double r = (h - estimate_height_m) * g;
+      s.addTdoa(*t, r, r, g, estimate_height_m);
+      t_next_tdoa += kTdoaDt_s;
+    }
+    s.decide(*t);
+  }
+}
+
+constexpr double kNoTdoa = std::numeric_limits<double>::quiet_NaN();
+
+TEST(FlightMode, TheImuAloneDecidesWithoutOtherEvidence) {
+  // GIVEN a supervisor in the air and an IMU at rest, then moving, then shaking on the floor
+  FlightModeSupervisor s;
+  s.reset(FlightMode::kAirborne);
+  std::mt19937 rng(1);
+  double t = 0.0;
+  // WHEN the IMU reads rest for 0.1 s
+  feed(s, &t, 0.1, ImuModeEvidence{true, false, false, 0.0}, kNoTdoa, 0.0, 0.0, rng);
+  // THEN the body is at rest on the floor
+  EXPECT_EQ(s.mode(), FlightMode::kRest);
+  EXPECT_TRUE(s.status() & kModeRest);
+  EXPECT_TRUE(s.status() & kImuSaysRest);
+  // WHEN it shakes with the motors running
+  feed(s, &t, 0.1, ImuModeEvidence{false, true, false, 0.1}, kNoTdoa, 0.0, 0.0, rng);
+  EXPECT_EQ(s.mode(), FlightMode::kContact);
+  // WHEN a climb is seen
+  feed(s, &t, 0.1, ImuModeEvidence{false, false, true, 0.0}, kNoTdoa, 0.0, 0.0, rng);
+  // THEN airborne, the IMU's log-odds at their bound
+  EXPECT_EQ(s.mode(), FlightMode::kAirborne);
+  EXPECT_DOUBLE_EQ(s.imuLogOdds(), FlightModeParams{}.imu_max_log_odds);
+  EXPECT_EQ(s.tdoaOverrules(), 0);
+}
+
+TEST(FlightMode, TdoaThatPutTheTagHighOverruleTheImusFloorContact) {
+  // GIVEN the IMU reads floor contact (a drone whose gyro shakes in flight) and the estimate sits on the floor
+  FlightModeSupervisor s;
+  s.reset(FlightMode::kContact);
+  std::mt19937 rng(2);
+  double t = 0.0;
+  const ImuModeEvidence contact{false, true, false, 0.3 * 0.3};
+  feed(s, &t, 0.3, contact, kNoTdoa, 0.0, 0.0, rng);
+  ASSERT_EQ(s.mode(), FlightMode::kContact);
+  // WHEN the TDoA put the tag 1.2 m above the floor (residual spread 0.15 m)
+  feed(s, &t, 1.0, contact, 1.2, 0.15, 0.0, rng);
+  // THEN the mode is airborne, against the IMU, and the status word says so
+  EXPECT_EQ(s.mode(), FlightMode::kAirborne);
+  EXPECT_NEAR(s.tdoaHeight(), 1.2, 0.1);
+  EXPECT_GT(s.tdoaLogOdds(), 10.0);
+  EXPECT_LT(s.imuLogOdds(), 0.0);
+  EXPECT_TRUE(s.status() & kTdoaOverrulesImu);
+  EXPECT_TRUE(s.status() & kTdoaSaysAirborne);
+  EXPECT_EQ(s.tdoaOverrules(), 1);
+}
+
+TEST(FlightMode, FloorTdoaThatScatterByMetresDoNotLiftTheBody) {
+  // GIVEN a body in floor contact whose TDoA carry a floor-level bias: heights about 0.4 m, scattered by 0.8 m
+  FlightModeSupervisor s;
+  s.reset(FlightMode::kContact);
+  std::mt19937 rng(3);
+  double t = 0.0;
+  // WHEN 3 s of them arrive
+  feed(s, &t, 3.0, ImuModeEvidence{false, true, false, 0.5 * 0.5}, 0.4, 0.8, 0.0, rng);
+  // THEN the IMU's floor holds: the scattered window's factor stays below the IMU's bound
+  EXPECT_EQ(s.mode(), FlightMode::kContact);
+  EXPECT_LT(s.tdoaLogOdds(), FlightModeParams{}.imu_max_log_odds - FlightModeParams{}.hysteresis_log_odds);
+  EXPECT_GT(s.tdoaHeightSpread(), 0.1);
+}
+
+TEST(FlightMode, FloorTdoaCannotHoldAClimbOnTheFloor) {
+  // GIVEN a body on the floor whose TDoA say so precisely
+  FlightModeSupervisor s;
+  s.reset(FlightMode::kContact);
+  std::mt19937 rng(4);
+  double t = 0.0;
+  feed(s, &t, 1.0, ImuModeEvidence{false, true, false, 0.5 * 0.5}, 0.0, 0.05, 0.0, rng);
+  EXPECT_DOUBLE_EQ(s.tdoaLogOdds(), -FlightModeParams{}.tdoa_max_floor_log_odds);
+  // WHEN the take-off detector sees a climb (the TDoA window still on the floor)
+  feed(s, &t, 0.05, ImuModeEvidence{false, false, true, 0.0}, 0.0, 0.05, 0.0, rng);
+  // THEN airborne at once: the floor's TDoA weigh at most tdoa_max_floor_log_odds
+  EXPECT_EQ(s.mode(), FlightMode::kAirborne);
+}
+
+TEST(FlightMode, DoubtIsCountedWhileTheImuHoldsTheFloorAgainstTheTdoa) {
+  // GIVEN a body at rest by the IMU whose TDoA put it 0.35 m up (not enough to overrule the IMU)
+  FlightModeSupervisor s;
+  s.reset(FlightMode::kRest);
+  std::mt19937 rng(5);
+  double t = 0.0;
+  feed(s, &t, 2.0, ImuModeEvidence{true, false, false, 0.0}, 0.35, 0.05, 0.0, rng);
+  // THEN it stays at rest, and the doubt is counted with the TDoA's height
+  EXPECT_EQ(s.mode(), FlightMode::kRest);
+  EXPECT_GT(s.tdoaLogOdds(), FlightModeParams{}.tdoa_max_floor_log_odds);
+  EXPECT_GT(s.doubtedFloorTime(), 1.0);
+  EXPECT_NEAR(s.doubtedFloorMaxHeight(), 0.35, 0.05);
+}
+
+TEST(FlightMode, TheAirborneShakingLevelIsLearnedFromTheFlight) {
+  // GIVEN the prior level: shaking of 0.3 rad/s rms stands out as floor contact
+  FlightModeSupervisor s;
+  s.reset(FlightMode::kAirborne);
+  EXPECT_TRUE(s.shakingStandsOut(0.3 * 0.3));
+  EXPECT_FALSE(s.status() & kAirShakeLearned);
+  std::mt19937 rng(6);
+  double t = 0.0;
+  // WHEN the flight shakes at 0.3 rad/s while settled in the air
+  feed(s, &t, 1.0, ImuModeEvidence{false, false, false, 0.3 * 0.3}, kNoTdoa, 0.0, 1.0, rng, true);
+  // THEN that shaking is the flight's, not floor contact; the idle shaking of another drone's floor (0.7) still is
+  EXPECT_FALSE(s.shakingStandsOut(0.3 * 0.3));
+  EXPECT_TRUE(s.shakingStandsOut(0.7 * 0.7));
+  EXPECT_TRUE(s.status() & kAirShakeLearned);
+  // AND the level decays back towards the prior when the flight is quiet, never below it
+  feed(s, &t, 30.0, ImuModeEvidence{false, false, false, 0.0}, kNoTdoa, 0.0, 1.0, rng, true);
+  EXPECT_DOUBLE_EQ(s.airShakeLevel(), FlightModeParams{}.air_shake_prior_ms);
+}
+
+TEST(FlightMode, ABadWindowSaysNothing) {
+  // GIVEN TDoA without vertical sensitivity or with non-finite values
+  FlightModeSupervisor s;
+  s.reset(FlightMode::kRest);
+  for (int k = 0; k < 200; ++k) {
+    s.addTdoa(0.001 * k, 1.0, 1.0, 0.05, 0.0);  // gain below min_vertical_gain
+    s.addTdoa(0.001 * k, std::nan(""), 0.0, 0.5, 0.0);
+  }
+  // THEN the window is not valid and its factor is 0
+  EXPECT_FALSE(s.status() & kTdoaHeightValid);
+  EXPECT_DOUBLE_EQ(s.tdoaLogOdds(), 0.0);
+  EXPECT_TRUE(std::isnan(s.tdoaHeight()));
+}
+
+TEST(FlightMode, ParamsAreValidated) {
+  FlightModeParams p;
+  p.air_max_height_m = p.air_min_height_m;
+  EXPECT_THROW(FlightModeSupervisor{p}, std::invalid_argument);
+  p = FlightModeParams{};
+  p.air_shake_ratio = 0.5;
+  EXPECT_THROW(FlightModeSupervisor{p}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace uwb
