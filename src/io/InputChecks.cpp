@@ -105,9 +105,12 @@ std::vector<InputIssue> checkSurveyGeometry(const AnchorSurvey& survey) {
     }
   }
   if (s(0) > kMaxAnchorSpread_m) {
-    out.push_back(issue(IssueSeverity::kWarning, file, "",
+    // an error: no position found against such a survey means anything (a survey scaled ×1e9 put the estimate 1.5e9 m
+    // up with exit 0)
+    out.push_back(issue(IssueSeverity::kError, file, "",
                         fmt::format("the anchors spread over {:.3g} m (principal std), more than one UWB arena "
-                                    "(< {} m); are the coordinates in metres?",
+                                    "(< {} m): no position found against it would mean anything; are the coordinates "
+                                    "in metres?",
                                     s(0), kMaxAnchorSpread_m)));
   }
   return out;

@@ -361,7 +361,8 @@ TEST_F(HostileCli, ARunThatNeverFindsAPositionFailsAndSaysWhy) {
   writeAll(case_ / "scaled.txt", scaled);
   const test::CliResult s = runArgs(case_, {"localize", flight_, "--anchors", "scaled.txt", "--json"});
   EXPECT_NE(s.exit_code, 0) << s.out;
-  EXPECT_THAT(s.err, HasSubstr("no position found"));
+  EXPECT_THAT(s.err, HasSubstr("no position found against it"));
+  EXPECT_THAT(s.err, HasSubstr("are the coordinates in metres"));
   EXPECT_TRUE(s.out.empty()) << s.out;
 }
 

@@ -42,7 +42,7 @@ inline constexpr double kMinAnchorWidth_m = 0.2;
 /// Third principal std below this: anchors (nearly) coplanar, the axis normal to their plane is poorly observed
 /// (warning) [m].
 inline constexpr double kMinAnchorDepth_m = 0.2;
-/// Largest principal std beyond this: not one UWB arena (warning) [m].
+/// Largest principal std beyond this: not one UWB arena (an error) [m].
 inline constexpr double kMaxAnchorSpread_m = 500.0;
 
 /// Two anchors closer than this are one place surveyed twice (a copy-paste error): warning naming both [m].
