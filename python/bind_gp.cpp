@@ -14,6 +14,8 @@
 #include "uwb/core/Error.h"
 #include "uwb/gp/Kernel.h"
 #include "uwb/gp/Svgp.h"
+#include "uwb/io/FileAccess.h"
+#include "uwb/io/JsonFile.h"
 
 namespace uwb::python {
 namespace {
@@ -101,21 +103,12 @@ py::dict predictionDict(const gp::SvgpPrediction& p) {
   return d;
 }
 
+/// The one JSON reader (io/JsonFile.h): located errors, nesting capped at kMaxJsonDepth before parsing.
 nlohmann::json parseJson(const std::string& text, const std::string& source) {
-  try {
-    return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(source + ": invalid JSON: " + e.what());
-  }
+  return parseJsonText(text, source, "JSON");
 }
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw FileError("cannot open model file '" + path + "'");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string readText(const std::string& path) { return readTextFile(path, "model file"); }
 
 void writeText(const std::string& text, const std::string& path) {
   std::ofstream out(path);

@@ -3,7 +3,16 @@
 
 #include <fmt/format.h>
 
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <fmt/ranges.h>
+
 #include <array>
+#include <cerrno>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -12,8 +21,11 @@
 
 #include "Command.h"
 #include "InputGuards.h"
+#include "StopSignal.h"
 #include "uwb/core/Error.h"
 #include "uwb/io/FileAccess.h"
+
+extern char** environ;
 
 namespace uwb::app {
 
@@ -58,16 +70,55 @@ EvaluationParams EvaluationCliOptions::toParams() const {
   return p;
 }
 
-std::string runPlots(const std::string& args) {
-  const std::string cmd = fmt::format("PYTHONPATH='{}' /usr/bin/python3 -m uwbtdoa.plots {}", UWB_PYTHON_DIR, args);
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (pipe == nullptr) throw FileError("cannot start python3 to render the figures: " + cmd);
+std::string runPlots(const std::vector<std::string>& args) {
+  // No shell: python3 is started with an argument vector, so no byte of a file name is ever interpreted (a name
+  // such as "x';touch PWNED;'.csv" stays a name). PYTHONPATH is set in the child's environment only.
+  std::vector<std::string> argv_text{"/usr/bin/python3", "-m", "uwbtdoa.plots"};
+  argv_text.insert(argv_text.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : argv_text) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::vector<std::string> env_text{std::string("PYTHONPATH=") + UWB_PYTHON_DIR};
+  for (char** e = environ; e != nullptr && *e != nullptr; ++e) {
+    if (std::strncmp(*e, "PYTHONPATH=", 11) != 0) env_text.emplace_back(*e);
+  }
+  std::vector<char*> envp;
+  for (std::string& e : env_text) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  const std::string shown = fmt::format("{}", fmt::join(argv_text, " "));
+
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) throw FileError("cannot start python3 to render the figures: " + shown);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, fds[1], STDOUT_FILENO);  // dup2 clears FD_CLOEXEC on the copy
+  pid_t pid = -1;
+  const int spawn_err = ::posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), envp.data());
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(fds[1]);
+  if (spawn_err == 0) setChildToStopOnSignal(pid);  // Ctrl-C stops it before the temporary files are removed
+  if (spawn_err != 0) {
+    ::close(fds[0]);
+    throw FileError(fmt::format("cannot start python3 to render the figures ({}): {}", std::strerror(spawn_err), shown));
+  }
   std::string output;
-  std::array<char, 512> buffer{};
-  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) output += buffer.data();
-  const int status = pclose(pipe);
-  if (status != 0) {
-    throw FileError(fmt::format("rendering the figures failed (exit status {}): {}", status, cmd));
+  std::array<char, 4096> buffer{};
+  for (;;) {
+    const ssize_t n = ::read(fds[0], buffer.data(), buffer.size());
+    if (n == 0) break;
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      break;
+    }
+    output.append(buffer.data(), static_cast<std::size_t>(n));
+  }
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  setChildToStopOnSignal(0);
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    throw FileError(fmt::format("rendering the figures failed (exit status {}): {}", status, shown));
   }
   return output;
 }
@@ -75,7 +126,7 @@ std::string runPlots(const std::string& args) {
 std::vector<std::string> renderFigures(const std::string& dir) {
   std::string output;
   try {
-    output = runPlots(fmt::format("report '{}'", dir));
+    output = runPlots({"report", dir});
   } catch (const FileError& e) {
     throw FileError(std::string(e.what()) + "\n(use --no-plots to skip)");
   }

@@ -31,9 +31,9 @@ struct EvaluationCliOptions {
   EvaluationParams toParams() const;
 };
 
-/// Runs `python3 -m uwbtdoa.plots ARGS` (ARGS shell-quoted by the caller); returns what it printed. Throws FileError
-/// on failure.
-std::string runPlots(const std::string& args);
+/// Runs `python3 -m uwbtdoa.plots ARGS...` with an argument vector (posix_spawn, no shell: no character of an
+/// argument is interpreted); returns what it printed on stdout. Throws FileError on failure.
+std::string runPlots(const std::vector<std::string>& args);
 
 /// Runs `python3 -m uwbtdoa.plots report DIR`; returns the PNG file names written. Throws on failure.
 std::vector<std::string> renderFigures(const std::string& dir);

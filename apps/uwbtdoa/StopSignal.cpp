@@ -3,7 +3,11 @@
  */
 #include "StopSignal.h"
 
+#include <signal.h>
+
 #include <cstring>
+
+#include "uwb/io/FileAccess.h"
 
 namespace uwb::app {
 namespace {
@@ -28,6 +32,34 @@ void installStopHandlers() {
   sigaddset(&set, SIGINT);
   sigaddset(&set, SIGTERM);
   sigprocmask(SIG_UNBLOCK, &set, nullptr);
+}
+
+namespace {
+
+volatile std::sig_atomic_t g_child = 0;
+
+extern "C" void onFatalSignal(int sig) {
+  if (const pid_t child = static_cast<pid_t>(g_child); child > 0) ::kill(child, SIGTERM);
+  uwb::removeTemporaryFilesOnSignal();
+  std::signal(sig, SIG_DFL);  // async-signal-safe; then die of the same signal (the parent sees it)
+  std::raise(sig);
+}
+
+}  // namespace
+
+void setChildToStopOnSignal(pid_t pid) { g_child = static_cast<std::sig_atomic_t>(pid); }
+
+void installCleanupHandlers() {
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction old;
+    if (sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;  // e.g. nohup
+    struct sigaction sa;
+    std::memset(&sa, 0, sizeof sa);
+    sa.sa_handler = onFatalSignal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESTART;
+    sigaction(sig, &sa, nullptr);
+  }
 }
 
 const volatile std::sig_atomic_t* stopFlag() { return &g_stop; }

@@ -52,7 +52,7 @@ void warnMissing(const uwb::Flight& flight, uwb::app::Warnings& warnings) {
 }
 
 void run(const Options& o) {
-  uwb::checkOutputFile(o.out, "flight file");
+  uwb::checkOutputFile(o.out, "flight file", {o.log});
   uwb::UsdReadOptions read_options;
   read_options.salvage = o.salvage;
   uwb::UsdReadReport read_report;

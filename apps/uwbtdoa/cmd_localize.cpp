@@ -13,6 +13,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,7 @@ json diagnosticsJson(const uwb::RunDiagnostics& d) {
                             : json{{"n", s.n},
                                    {"residual_rms_m", s.truncated_rms_m},
                                    {"gross_fraction", s.gross_fraction},
+                                   {"inlier_rms_m", s.inlier_rms_m},
                                    {"start_rms_residual_m", s.start_rms_residual_m},
                                    {"misfit", s.misfit},
                                    {"mean_error_vs_truth_m", s.has_truth ? vecJson(s.mean_error_m) : json(nullptr)},
@@ -118,14 +120,55 @@ uwb::Flight windowed(uwb::Flight flight, const std::vector<double>& window, cons
   return cut;
 }
 
+/// A run that never found a position has nothing to report (an RMSE over zero samples would read 0.000 m): an
+/// error that says why, from what the input shows.
+void requirePositionFound(const uwb::LocalizationRun& run, const uwb::Flight& flight, const uwb::AnchorSurvey& survey,
+                          const std::string& path) {
+  if (std::isfinite(run.summary.ready_t_s) && !run.trajectory.empty()) return;
+  const std::size_t n = flight.tdoa.size();
+  const double span_s = n > 1 ? flight.tdoa.back().t_s - flight.tdoa.front().t_s : 0.0;
+  const uwb::SurveyGeometry g = uwb::surveyGeometry(survey);
+  std::string why;
+  if (n > 1 && span_s == 0.0) {
+    why = fmt::format("all {} TDoA have the same time stamp (t = {:g} s)", n, flight.tdoa.front().t_s);
+  } else if (g.principal_std_m.x() > uwb::kMaxAnchorSpread_m) {
+    why = fmt::format("the anchors spread over {:.3g} m (principal std): the survey is not in metres or not this "
+                      "arena's", g.principal_std_m.x());
+  } else if (n < 50 || span_s < 1.0) {
+    why = fmt::format("only {} TDoA over {:.3g} s: too few for a first fix", n, span_s);
+  } else {
+    why = fmt::format("no position fitted the {} TDoA over {:.3g} s ({} rejected by the gate): is the survey this "
+                      "flight's?", n, span_s, run.summary.n_tdoa_rejected);
+  }
+  throw uwb::InputError(fmt::format("no position found in {}: {}; nothing written", path, why));
+}
+
+/// No non-finite estimate is written or summarised: an error naming how many and the first.
+void requireFiniteEstimates(const uwb::Trajectory& trajectory, const std::string& path) {
+  std::size_t bad = 0;
+  double first_t = 0.0;
+  for (const uwb::TrajectorySample& s : trajectory) {
+    const bool finite = std::isfinite(s.t_s) && s.w_p_b.allFinite() && s.sigma_p_m.allFinite() &&
+                        s.w_v_b.allFinite() && s.w_q_b.coeffs().allFinite();
+    if (!finite && bad++ == 0) first_t = s.t_s;
+  }
+  if (bad > 0) {
+    throw std::runtime_error(fmt::format("the estimate of {} diverged: {} of {} trajectory samples are not finite "
+                                         "(first at t = {:.3f} s); nothing written. Check the bias model and the "
+                                         "sensor values",
+                                         path, bad, trajectory.size(), first_t));
+  }
+}
+
 /// Largest --output-period [s]: one sample a minute still draws a trajectory.
 constexpr double kMaxOutputPeriod_s = 60.0;
 
 void runLocalize(const LocalizeArgs& a) {
   uwb::app::Warnings warnings;
   // Outputs first: a run of minutes must not end in "cannot write".
-  if (!a.out.empty()) uwb::checkOutputFile(a.out, "trajectory file");
-  if (!a.plot.empty()) uwb::checkOutputFile(a.plot, "plot file");
+  const std::vector<std::string> inputs{a.flight, a.anchors, a.filter.config, a.filter.bias_model};
+  if (!a.out.empty()) uwb::checkOutputFile(a.out, "trajectory file", inputs);
+  if (!a.plot.empty()) uwb::checkOutputFile(a.plot, "plot file", inputs);
   uwb::app::checkPeriod(a.output_period, "--output-period", kMaxOutputPeriod_s);
   uwb::app::FilterSetup setup = uwb::app::buildFilterParams(a.filter);
   uwb::EkfParams& params = setup.params;
@@ -167,6 +210,8 @@ void runLocalize(const LocalizeArgs& a) {
   uwb::LocalizationRun run = uwb::localizeFlight(flight, survey, opt, bias);
   const double cpu_s = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  requirePositionFound(run, flight, survey, a.flight);  // before the checks below, which need an estimate
+  requireFiniteEstimates(run.trajectory, a.flight);
   // the "wrong but plausible" checks: survey fit, one anchor mis-surveyed, TDoA/IMU clock offset (re-runs)
   std::optional<uwb::RunDiagnostics> diag;
   std::optional<uwb::LocalizationRun> fixed_run;
@@ -187,6 +232,7 @@ void runLocalize(const LocalizeArgs& a) {
     if (run.metrics && run.metrics->airborne.n) rmse_before_fix = run.metrics->airborne.rmse_m;
     run = std::move(*fixed_run);
   }
+  requireFiniteEstimates(run.trajectory, a.flight);  // also the re-run of --fix-survey
   const uwb::LocalizerSummary& s = run.summary;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   // the estimate lost the TDoA or diverged and was found again (docs/math/filter.md F16): the positions around
@@ -290,7 +336,7 @@ void runLocalize(const LocalizeArgs& a) {
   j["real_time_factor_cpu"] = cpu_s > 0 ? run.duration_s / cpu_s : nan;
   if (run.metrics) {
     const uwb::TrajectoryMetrics& m = *run.metrics;
-    j["rmse_m"] = m.whole.rmse_m;
+    j["rmse_m"] = m.whole.n ? json(m.whole.rmse_m) : json(nullptr);
     j["rmse_airborne_m"] = m.airborne.n ? json(m.airborne.rmse_m) : json(nullptr);
     j["whole"] = statsJson(m.whole);
     j["airborne"] = statsJson(m.airborne);
@@ -304,10 +350,12 @@ void runLocalize(const LocalizeArgs& a) {
   if (!a.out.empty()) uwb::writeTrajectoryCsv(run.trajectory, a.out);
   if (!a.plot.empty()) {
     // x, y, z against time with the ±2σ band and the ground truth (docs/math/filter.md F23); drawn to a temporary
-    // name beside the target and renamed, so the PNG appears complete or not at all
+    // name beside the target and renamed, so the PNG appears complete or not at all. The temporary names follow
+    // writeFileAtomically's pattern: removed on SIGINT/SIGTERM, swept by a later run after a SIGKILL.
     const std::filesystem::path png(a.plot);
-    const std::filesystem::path tmp_traj = png.parent_path() / (png.filename().string() + ".trajectory.tmp.csv");
-    const std::filesystem::path tmp_png = png.parent_path() / (png.filename().string() + ".tmp.png");
+    const std::filesystem::path tmp_traj = uwb::temporaryPathBeside(a.plot, ".trajectory.csv");
+    const std::filesystem::path tmp_png = uwb::temporaryPathBeside(a.plot, ".png");
+    const uwb::TemporaryFileGuard traj_guard(tmp_traj.string()), png_guard(tmp_png.string());
     const auto cleanup = [&] {
       std::error_code ec;
       std::filesystem::remove(tmp_traj, ec);
@@ -315,7 +363,8 @@ void runLocalize(const LocalizeArgs& a) {
     };
     try {
       uwb::writeTrajectoryCsv(run.trajectory, tmp_traj.string());
-      uwb::app::runPlots("position '" + tmp_traj.string() + "' '" + a.flight + "' '" + tmp_png.string() + "'");
+      uwb::app::runPlots({"position", tmp_traj.string(), a.flight, tmp_png.string()});
+      uwb::checkOutputFile(a.plot, "plot file");  // still a regular file (or absent) and no input
       std::filesystem::rename(tmp_png, png);
     } catch (...) {
       cleanup();
@@ -349,6 +398,11 @@ void runLocalize(const LocalizeArgs& a) {
   for (const std::string& n : notes) std::cout << "note: " << n << "\n";
   if (run.metrics) {
     const auto print = [](const char* name, const uwb::PositionErrorStats& st) {
+      if (st.n == 0) {  // never an RMSE over zero samples
+        std::printf("%-9s n=%6zu  no estimate to compare%s\n", name, st.n,
+                    std::string(name) == "airborne" ? " (the ground truth never leaves the floor)" : "");
+        return;
+      }
       std::printf("%-9s n=%6zu  RMSE 3D %.3f m  (x %.3f, y %.3f, z %.3f)  p50 %.3f  p90 %.3f  p99 %.3f m\n", name,
                   st.n, st.rmse_m, st.rmse_axis_m.x(), st.rmse_axis_m.y(), st.rmse_axis_m.z(), st.p50_m, st.p90_m,
                   st.p99_m);

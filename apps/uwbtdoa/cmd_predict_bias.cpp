@@ -13,7 +13,9 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <initializer_list>
 #include <iostream>
+#include <stdexcept>
 #include <nlohmann/json.hpp>
 
 #include "Command.h"
@@ -37,7 +39,7 @@ struct Options {
 };
 
 void run(const Options& o) {
-  uwb::checkOutputFile(o.out, "bias CSV");
+  uwb::checkOutputFile(o.out, "bias CSV", {o.flight, o.anchors, o.model});
   const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(o.anchors);
   uwb::app::Warnings().addIssues(uwb::checkSurveyGeometry(survey));  // errors stop, warnings go to stderr
   uwb::FlightReadOptions ro;
@@ -66,6 +68,16 @@ void run(const Options& o) {
       variance_m2.push_back(p.varianceM2());
     }
   };
+  // No row with a non-finite value is written: counted here, an error below.
+  std::size_t n_non_finite = 0;
+  std::string first_non_finite;
+  const auto checkRow = [&](double t_s, int id_a, int id_b, std::initializer_list<double> values) {
+    for (const double v : values) {
+      if (std::isfinite(v)) continue;
+      if (n_non_finite++ == 0) first_non_finite = fmt::format("t = {:.3f} s, pair {}-{}", t_s, id_a, id_b);
+      return;
+    }
+  };
   // (P43c) the flight's uncorrected bias level, measured by the filter that gives the GP inputs; unknown (nothing
   // added) with ground-truth inputs
   double flight_level_m = std::numeric_limits<double>::quiet_NaN(), mean_level_m = flight_level_m;
@@ -83,6 +95,8 @@ void run(const Options& o) {
       out += fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},1,{:.7g}\n", smp.t_s, smp.feature.id_a,
                          smp.feature.id_b, smp.measured_m, smp.error_m, p.mean_m, std::sqrt(p.latent_variance_m2),
                          std::sqrt(p.varianceM2()));
+      checkRow(smp.t_s, smp.feature.id_a, smp.feature.id_b,
+               {smp.measured_m, smp.error_m, p.mean_m, p.latent_variance_m2, p.varianceM2()});
       score(smp.error_m, p);
     }
     n_rows = data.samples.size();
@@ -97,7 +111,13 @@ void run(const Options& o) {
     const bool air = uwb::isAirborne(r.w_p_b.z(), o.min_z);
     out += fmt::format("{:.6f},{},{},{:.7g},{:.7g},{:.7g},{:.7g},{},{:.7g}\n", r.t_s, r.id_a, r.id_b, r.measured_m,
                        r.residual_m, p.mean_m, std::sqrt(p.latent_variance_m2), air ? 1 : 0, std::sqrt(p.varianceM2()));
+    checkRow(r.t_s, r.id_a, r.id_b, {r.measured_m, r.residual_m, p.mean_m, p.latent_variance_m2, p.varianceM2()});
     if (air && std::abs(r.residual_m) <= 1.0) score(r.residual_m, p);
+  }
+  if (n_non_finite > 0) {
+    throw std::runtime_error(fmt::format("{} of {} bias rows hold a value that is not finite (first at {}): the model {} or "
+                                         "the estimate of {} is broken; nothing written",
+                                         n_non_finite, n_rows, first_non_finite, o.model, o.flight));
   }
   const double before = n_air ? std::sqrt(se_b / n_air) : std::nan(""), after = n_air ? std::sqrt(se_a / n_air) : std::nan("");
   const uwb::BiasCalibration cal = uwb::biasCalibration(residual_m, variance_m2, model.predictiveShape());

@@ -58,8 +58,8 @@ double spanOf(const S& stream) {
 }
 
 void run(const Options& o, CLI::App& sub) {
-  uwb::checkOutputFile(o.out, "flight file");
-  uwb::checkOutputFile(o.survey_out, "anchor survey");
+  uwb::checkOutputFile(o.out, "flight file", {o.config, o.anchors_file, o.survey_out});
+  uwb::checkOutputFile(o.survey_out, "anchor survey", {o.config, o.anchors_file});
   if (!std::isfinite(o.duration_s) || !(o.duration_s > 0.0) || o.duration_s > kMaxDuration_s) {
     throw uwb::InputError(fmt::format("--duration must be in (0, {:g}] s, got {}", kMaxDuration_s, o.duration_s));
   }

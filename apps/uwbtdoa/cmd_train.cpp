@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -60,8 +61,7 @@ void progressBar(int model, int models, const uwb::gp::EpochReport& r) {
 void dumpArrays(const std::string& path, const uwb::BiasDataset& data, const uwb::BiasTrainParams& tp) {
   const uwb::BiasPreset preset = uwb::BiasPreset::byName(tp.preset);
   const std::vector<bool> hold = uwb::holdoutMask(data.samples, tp.holdout_fraction, tp.holdout_block_s);
-  std::ofstream out(path);
-  if (!out) throw uwb::FileError("cannot write training arrays to " + path);
+  std::ostringstream out;
   out << "flight,t_s,id_a,id_b";
   for (const auto& name : uwb::featureColumnNames(preset.features)) out << ',' << name;
   out << ",error_m,holdout\n";
@@ -75,11 +75,15 @@ void dumpArrays(const std::string& path, const uwb::BiasDataset& data, const uwb
     for (int d = 0; d < D; ++d) out << fmt::format(",{:.17g}", row[d]);
     out << fmt::format(",{:.17g},{}\n", s.error_m, hold[i] ? 1 : 0);
   }
-  if (!out) throw uwb::FileError("error while writing training arrays to " + path);
+  uwb::writeFileAtomically(path, out.str(), "training arrays");
 }
 
 void run(const TrainOptions& o) {
-  uwb::checkOutputFile(o.out, "bias model");  // before minutes of training
+  {  // before minutes of training; the model must not replace one of the inputs
+    std::vector<std::string> inputs = o.flights;
+    inputs.push_back(o.anchors);
+    uwb::checkOutputFile(o.out, "bias model", inputs);
+  }
   if (o.passes > 1 && o.inputs != "estimate") throw std::invalid_argument("--passes > 1 needs --inputs estimate");
   const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(o.anchors);
   uwb::app::Warnings().addIssues(uwb::checkSurveyGeometry(survey));  // errors stop, warnings go to stderr

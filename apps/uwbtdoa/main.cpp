@@ -7,6 +7,8 @@
 #include <iostream>
 
 #include "Command.h"
+#include "StopSignal.h"
+#include "uwb/io/FileAccess.h"
 #include "uwb/core/Error.h"
 
 namespace uwb::app {
@@ -51,6 +53,8 @@ std::string defaultDataDir() {
 
 int main(int argc, char** argv) {
   uwb::app::setCommandLine(argc, argv);
+  uwb::app::installCleanupHandlers();  // Ctrl-C or SIGTERM leave no temporary file beside an output
+  uwb::protectInputsFromOverwrite();   // no output replaces a file the run read
   CLI::App app{"uwbtdoa: UWB TDoA localization with Gaussian-process bias correction"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "uwbtdoa 0.1.0");

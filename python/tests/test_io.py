@@ -7,12 +7,13 @@ from conftest import pilot_flight, pilot_survey
 
 
 def _synthetic_flight(rng, n_tdoa=50, n_imu=200, n_pose=60):
+    id_a = rng.integers(0, 8, n_tdoa)  # and id_b another anchor: a TDoA needs two
     t_imu = np.sort(rng.uniform(0, 2, n_imu))
     q = rng.normal(size=(n_pose, 4))
     q /= np.linalg.norm(q, axis=1, keepdims=True)
     return u.Flight(
-        tdoa={"t": np.sort(rng.uniform(0, 2, n_tdoa)), "id_a": rng.integers(0, 8, n_tdoa),
-              "id_b": rng.integers(0, 8, n_tdoa), "tdoa": rng.normal(0, 2, n_tdoa)},
+        tdoa={"t": np.sort(rng.uniform(0, 2, n_tdoa)), "id_a": id_a,
+              "id_b": (id_a + rng.integers(1, 8, n_tdoa)) % 8, "tdoa": rng.normal(0, 2, n_tdoa)},
         acc={"t": t_imu, "value": rng.normal(0, 9.81, (n_imu, 3))},
         gyro={"t": t_imu, "value": rng.normal(0, 1.0, (n_imu, 3))},
         pose={"t": np.sort(rng.uniform(0, 2, n_pose)), "p": rng.normal(0, 2, (n_pose, 3)), "q": q})

@@ -5,6 +5,8 @@
 
 #include "uwb/eval/BiasCalibration.h"
 
+#include <fmt/format.h>
+
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -387,6 +389,26 @@ int modelAnchorId(const nlohmann::json& m, const std::string& key, const char* n
   return jsonInt(jsonMember(m, key, name), key + "." + name, -1, kMaxAnchorId);
 }
 
+/// Largest magnitude of any number of a model's SVGP block (kernel parameters, inducing points, variational mean and
+/// factor, input transform). Trained models stay orders of magnitude below; a value such as 1e300 passes the finite
+/// check but overflows the predictions to inf and NaN.
+constexpr double kMaxModelMagnitude = 1e6;
+
+/// Every number under `v` is finite and of magnitude ≤ kMaxModelMagnitude; std::invalid_argument naming the first
+/// that is not, by its path (e.g. `models[0].svgp.variational.m[3]`). The nesting is bounded by the reader's depth cap.
+void checkMagnitudes(const nlohmann::json& v, const std::string& key) {
+  if (v.is_number()) {
+    const double x = v.get<double>();
+    if (!std::isfinite(x) || std::abs(x) > kMaxModelMagnitude)
+      throw std::invalid_argument(fmt::format("{} = {:g} is not a plausible model value (|x| ≤ {:g})", key, x,
+                                              kMaxModelMagnitude));
+  } else if (v.is_array()) {
+    for (std::size_t i = 0; i < v.size(); ++i) checkMagnitudes(v[i], fmt::format("{}[{}]", key, i));
+  } else if (v.is_object()) {
+    for (const auto& [name, child] : v.items()) checkMagnitudes(child, key + "." + name);
+  }
+}
+
 /// Range checks of the SVGP block that the GP reader leaves to the caller (values it accepts but that make the
 /// model useless or its factorisation fail without naming the file).
 void checkSvgpValues(const nlohmann::json& svgp, const std::string& key) {
@@ -418,6 +440,10 @@ BiasModel BiasModel::fromJson(const nlohmann::json& j) {
     const FeatureMap map = featureMapFromString(jsonString(jsonMember(j, "", "features"), "features"));
     if (j.contains("feature_columns") && jsonInt(j.at("feature_columns"), "feature_columns", 0, 1000) != featureDim(map))
       throw std::invalid_argument("feature_columns does not match the feature map");
+    for (const char* key : {"extra_variance_m2", "mean_scale", "training_bias_level_m", "training_mean_level_m",
+                            "predictive_dof", "predictive_scale", "target_mean_square_m2"}) {
+      if (j.contains(key)) checkMagnitudes(j.at(key), key);
+    }
     std::vector<Entry> entries;
     const nlohmann::json& models = jsonMember(j, "", "models");
     if (!models.is_array()) throw std::invalid_argument("'models' must be an array");
@@ -428,6 +454,7 @@ BiasModel BiasModel::fromJson(const nlohmann::json& j) {
       if ((id_a < 0) != (id_b < 0))
         throw std::invalid_argument(key + ": id_a and id_b are both -1 (global model) or both anchor ids");
       checkSvgpValues(jsonMember(m, key, "svgp"), key + ".svgp");
+      checkMagnitudes(m.at("svgp"), key + ".svgp");
       entries.push_back({id_a, id_b, gp::Svgp::fromJson(m.at("svgp"))});
     }
     if (entries.empty()) throw std::invalid_argument("no models in the file");

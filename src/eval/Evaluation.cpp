@@ -14,6 +14,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <system_error>
 #include <thread>
 
 #include "uwb/core/Angle.h"
@@ -157,6 +158,12 @@ EvaluationResult runEvaluation(const std::vector<NamedFlight>& train, const std:
   params.validate();
   if (train.empty()) throw std::invalid_argument("evaluation: no training flight given");
   if (test.empty()) throw std::invalid_argument("evaluation: no test flight given");
+  for (std::size_t i = 0; i < test.size(); ++i) {  // results are keyed by name: two flights must never share one
+    for (std::size_t k = 0; k < i; ++k) {
+      if (test[i].name == test[k].name)
+        throw std::invalid_argument(fmt::format("evaluation: two test flights are named '{}'", test[i].name));
+    }
+  }
   const auto t0 = std::chrono::steady_clock::now();
   const auto say = [&](const std::string& line) {
     if (progress) progress(line);
@@ -246,7 +253,13 @@ EvaluationResult runEvaluation(const std::vector<NamedFlight>& train, const std:
   };
   const int n_threads = std::min<int>(params.threads, static_cast<int>(jobs.size()));
   std::vector<std::thread> pool;
-  for (int i = 1; i < n_threads; ++i) pool.emplace_back(worker);
+  for (int i = 1; i < n_threads; ++i) {
+    try {
+      pool.emplace_back(worker);
+    } catch (const std::system_error&) {
+      break;  // no more threads to be had: the jobs go to the threads started (results do not depend on which)
+    }
+  }
   worker();
   for (auto& t : pool) t.join();
   if (failure) std::rethrow_exception(failure);

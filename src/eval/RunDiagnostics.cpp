@@ -83,6 +83,16 @@ SurveyFitCheck checkSurveyFit(const Flight& flight, const AnchorSurvey& survey, 
   const auto n_gross = std::count_if(res.begin(), res.end(),
                                      [&](const EstimateResidual& r) { return std::abs(r.r_m) >= p.gross_residual_m; });
   c.gross_fraction = res.empty() ? 0.0 : static_cast<double>(n_gross) / static_cast<double>(res.size());
+  {
+    double sum = 0.0;
+    std::size_t n_in = 0;
+    for (const EstimateResidual& r : res) {
+      if (std::abs(r.r_m) >= p.gross_residual_m) continue;
+      sum += r.r_m * r.r_m;
+      ++n_in;
+    }
+    c.inlier_rms_m = n_in > 0 ? std::sqrt(sum / static_cast<double>(n_in)) : 0.0;
+  }
   c.start_rms_residual_m = run.summary.start_rms_residual_m;
   c.misfit = c.n > 0 && c.truncated_rms_m > p.survey_fit_max_rms_m;
   if (run.metrics) {

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <exception>
 #include <memory>
+#include <system_error>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -340,13 +341,17 @@ void runWorkers(Eigen::Index n, int num_threads, const Worker& worker) {
   std::vector<std::thread> workers;
   std::vector<std::exception_ptr> errors(static_cast<std::size_t>(parts));
   for (Eigen::Index t = 1; t < parts; ++t) {
-    workers.emplace_back([&, t] {
-      try {
-        worker();
-      } catch (...) {
-        errors[static_cast<std::size_t>(t)] = std::current_exception();
-      }
-    });
+    try {
+      workers.emplace_back([&, t] {
+        try {
+          worker();
+        } catch (...) {
+          errors[static_cast<std::size_t>(t)] = std::current_exception();
+        }
+      });
+    } catch (const std::system_error&) {
+      break;  // no more threads to be had: the started ones (and this one) take all the blocks, same result
+    }
   }
   try {
     worker();

@@ -14,6 +14,7 @@
 #include <numeric>
 #include <random>
 #include <stdexcept>
+#include <system_error>
 #include <thread>
 
 namespace uwb::gp {
@@ -21,7 +22,10 @@ namespace uwb::gp {
 namespace {
 
 int resolveThreads(int num_threads) {
-  if (num_threads < 0) throw std::invalid_argument("SVGP training: num_threads must be ≥ 0");
+  if (num_threads < 0 || num_threads > kMaxTrainThreads) {
+    throw std::invalid_argument("SVGP training: num_threads must be in [0, " + std::to_string(kMaxTrainThreads) +
+                                "], got " + std::to_string(num_threads));
+  }
   return num_threads == 0 ? static_cast<int>(std::max(1u, std::thread::hardware_concurrency())) : num_threads;
 }
 
@@ -30,18 +34,20 @@ int resolveThreads(int num_threads) {
 class ThreadTeam {
  public:
   explicit ThreadTeam(int size) : size_(std::max(1, size)), errors_(static_cast<std::size_t>(size_)) {
-    for (int t = 1; t < size_; ++t) workers_.emplace_back([this, t] { loop(t); });
+    try {
+      for (int t = 1; t < size_; ++t) workers_.emplace_back([this, t] { loop(t); });
+    } catch (const std::system_error& e) {
+      // The threads already started wait on start_: stop and join them before the members are destroyed (a
+      // throwing constructor runs no destructor), then report how far it got.
+      const std::size_t started = workers_.size() + 1;
+      stopAndJoin();
+      throw std::runtime_error("SVGP training: cannot start thread " + std::to_string(started + 1) + " of " +
+                               std::to_string(size_) + " (" + e.what() + "); use fewer threads");
+    }
   }
   ThreadTeam(const ThreadTeam&) = delete;
   ThreadTeam& operator=(const ThreadTeam&) = delete;
-  ~ThreadTeam() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-    }
-    start_.notify_all();
-    for (auto& w : workers_) w.join();
-  }
+  ~ThreadTeam() { stopAndJoin(); }
   int size() const { return size_; }
 
   void run(const std::function<void(int)>& task) {
@@ -74,6 +80,16 @@ class ThreadTeam {
   }
 
  private:
+  void stopAndJoin() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    start_.notify_all();
+    for (auto& w : workers_) w.join();
+    workers_.clear();
+  }
+
   void loop(int t) {
     std::uint64_t seen = 0;
     for (;;) {
@@ -148,7 +164,9 @@ void SvgpTrainParams::validate() const {
   if (!(lr >= 0) || !(lr_inducing >= 0) || !(lr_variational >= 0)) bad("learning rates must be ≥ 0");
   if (!(lr_final_fraction > 0) || lr_final_fraction > 1) bad("lr_final_fraction must be in (0, 1]");
   if (natgrad_step > 1) bad("natgrad_step must be ≤ 1");
-  if (num_threads < 0) bad("num_threads must be ≥ 0 (0: one per hardware thread)");
+  if (num_threads < 0 || num_threads > kMaxTrainThreads)
+    bad("num_threads must be in [0, " + std::to_string(kMaxTrainThreads) + "] (0: one per hardware thread), got " +
+        std::to_string(num_threads));
   if (!(min_noise_variance > 0)) bad("min_noise_variance must be > 0");
 }
 

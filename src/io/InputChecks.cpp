@@ -91,10 +91,26 @@ std::vector<InputIssue> checkSurveyGeometry(const AnchorSurvey& survey) {
                                     "normal to their plane is poorly observable",
                                     s(2), kMinAnchorDepth_m)));
   }
+  for (std::size_t i = 0; i < survey.anchors.size(); ++i) {
+    for (std::size_t k = i + 1; k < survey.anchors.size(); ++k) {
+      const Anchor& a = survey.anchors[i];
+      const Anchor& b = survey.anchors[k];
+      const double d = (a.w_p - b.w_p).norm();
+      if (d < kMinAnchorSeparation_m) {
+        out.push_back(issue(IssueSeverity::kWarning, file, "",
+                            fmt::format("anchors {} and {} are {:.3f} m apart (< {} m): one place surveyed twice? Their "
+                                        "TDoA carry no position information",
+                                        a.id, b.id, d, kMinAnchorSeparation_m)));
+      }
+    }
+  }
   if (s(0) > kMaxAnchorSpread_m) {
-    out.push_back(issue(IssueSeverity::kWarning, file, "",
+    // an error: no position found against such a survey means anything (a survey scaled ×1e9 put the estimate 1.5e9 m
+    // up with exit 0)
+    out.push_back(issue(IssueSeverity::kError, file, "",
                         fmt::format("the anchors spread over {:.3g} m (principal std), more than one UWB arena "
-                                    "(< {} m); are the coordinates in metres?",
+                                    "(< {} m): no position found against it would mean anything; are the coordinates "
+                                    "in metres?",
                                     s(0), kMaxAnchorSpread_m)));
   }
   return out;
@@ -116,10 +132,25 @@ std::vector<InputIssue> checkStreamRates(const Flight& flight) {
   const std::string& file = flight.source;
   const double tdoa_span_s = spanOf(flight.tdoa);
   const auto check = [&](Stream s, const auto& samples) {
-    if (samples.size() < 10) return;
     const std::string field = streamColumns(s).front();  // the stream's time column, e.g. t_acc
     const bool vital = s == Stream::kTdoa || s == Stream::kAcc || s == Stream::kGyro;
     const IssueSeverity severity = vital ? IssueSeverity::kError : IssueSeverity::kWarning;
+    if (samples.size() >= 2 && samples.front().t_s == samples.back().t_s) {  // sorted: every stamp the same
+      out.push_back(issue(severity, file, field,
+                          fmt::format("stream {}: all {} time stamps are equal (t = {:g} s): the time column does not "
+                                      "advance (a wrong column, or a logger that did not stamp)",
+                                      streamName(s), samples.size(), samples.front().t_s)));
+      return;
+    }
+    if (samples.size() < 10) return;
+    if ((s == Stream::kAcc || s == Stream::kGyro) && flight.tdoa.size() >= 10 &&
+        samples.back().t_s < flight.tdoa.back().t_s - kMaxImuEndGap_s) {
+      out.push_back(issue(IssueSeverity::kWarning, file, field,
+                          fmt::format("stream {} ends at t = {:.3f} s, {:.3f} s before the TDoA stream (t = {:.3f} s): "
+                                      "the rest of the flight has no IMU",
+                                      streamName(s), samples.back().t_s, flight.tdoa.back().t_s - samples.back().t_s,
+                                      flight.tdoa.back().t_s)));
+    }
     const double dt = medianSpacing(samples);
     const RateRange range = plausibleRate(s);
     const double span = spanOf(samples);

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "uwb/core/Error.h"
 #include "uwb/io/FileAccess.h"
@@ -30,27 +31,62 @@ std::string parseMessage(const nlohmann::json::parse_error& e) {
   return msg;
 }
 
+/// Line and column (1-based) of byte `at` of `text`.
+std::pair<std::size_t, std::size_t> lineColumn(std::string_view text, std::size_t at) {
+  std::size_t line = 1, column = 1;
+  for (std::size_t i = 0; i < at && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+  return {line, column};
+}
+
 }  // namespace
+
+std::size_t jsonNestingTooDeepAt(std::string_view text, int max_depth) {
+  // A scan of the brackets outside strings, before the parser sees the text: nothing deeper than max_depth is ever
+  // built, dumped or destroyed recursively.
+  int depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') {
+        ++i;  // the escaped character
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > max_depth) return i;
+    } else if (c == ']' || c == '}') {
+      if (depth > 0) --depth;
+    }
+  }
+  return std::string_view::npos;
+}
 
 nlohmann::json readJsonFile(const std::string& path, const char* what) {
   return parseJsonText(readTextFile(path, what), path, what);
 }
 
 nlohmann::json parseJsonText(std::string_view text, const std::string& path, const char* what) {
+  if (const std::size_t at = jsonNestingTooDeepAt(text); at != std::string_view::npos) {
+    const auto [line, column] = lineColumn(text, at);
+    throw InputError(SourceLocation{path, line, column, ""},
+                     fmt::format("invalid JSON in {}: nested deeper than {} levels of arrays and objects", what,
+                                 kMaxJsonDepth));
+  }
   try {
     return nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     // e.byte: 1-based offset of the character where parsing stopped; turn it into line and column.
-    const std::size_t at = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
-    std::size_t line = 1, column = 1;
-    for (std::size_t i = 0; i < at; ++i) {
-      if (text[i] == '\n') {
-        ++line;
-        column = 1;
-      } else {
-        ++column;
-      }
-    }
+    const auto [line, column] = lineColumn(text, std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size()));
     throw InputError(SourceLocation{path, line, column, ""}, fmt::format("invalid JSON in {}: {}", what, parseMessage(e)));
   } catch (const nlohmann::json::exception& e) {  // e.g. out_of_range: a number such as 1e400
     std::string msg = e.what();

@@ -396,7 +396,15 @@ class RowParser {
   void appendSample(Stream s, const double* v) {
     const double t = v[0];
     switch (s) {
-      case Stream::kTdoa: flight_.tdoa.push_back({t, anchorId(s, 1, v[1]), anchorId(s, 2, v[2]), v[3]}); break;
+      case Stream::kTdoa: {
+        const int id_a = anchorId(s, 1, v[1]), id_b = anchorId(s, 2, v[2]);
+        if (id_a == id_b) {  // a TDoA of an anchor against itself is no measurement (h = 0 for every position)
+          const int c = layout_.col[streamIndex(s)][2];
+          fail(c + 1, names_[c], fmt::format("idA and idB are the same anchor ({}): a TDoA needs two anchors", id_a));
+        }
+        flight_.tdoa.push_back({t, id_a, id_b, v[3]});
+        break;
+      }
       case Stream::kTwr: flight_.twr.push_back({t, anchorId(s, 1, v[1]), v[2]}); break;
       case Stream::kAcc:
         flight_.acc.push_back({t, Vec3(v[1] * kGravity_mps2, v[2] * kGravity_mps2, v[3] * kGravity_mps2)});

@@ -91,6 +91,7 @@ struct SurveyFitCheck {
   std::size_t n = 0;              ///< residuals used
   double truncated_rms_m = 0.0;   ///< truncatedRms over the moving phase
   double gross_fraction = 0.0;    ///< fraction of |r| ≥ gross_residual_m
+  double inlier_rms_m = 0.0;      ///< RMS of the residuals with |r| < gross_residual_m (0 for none)
   double start_rms_residual_m = 0.0;  ///< the start-up multilateration's residual RMS (LocalizerSummary)
   bool has_truth = false;
   Vec3 mean_error_m = Vec3::Zero();   ///< mean airborne estimate − truth (with ground truth)

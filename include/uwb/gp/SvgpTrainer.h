@@ -15,6 +15,9 @@
 
 namespace uwb::gp {
 
+/// Most threads one training may use (SvgpTrainParams::num_threads): more is refused before any is started.
+inline constexpr int kMaxTrainThreads = 256;
+
 struct SvgpTrainParams {
   int epochs = 30;                 ///< passes over the training data
   int batch_size = 1024;           ///< minibatch size B (clipped to N)
@@ -30,7 +33,7 @@ struct SvgpTrainParams {
   ElboMode mode = ElboMode::kFast;
   /// Threads that share each minibatch (0: one per hardware thread). Results depend on the seed and on this count
   /// (the order of the partial sums), not on scheduling.
-  int num_threads = 0;
+  int num_threads = 0;  ///< at most kMaxTrainThreads
   /// After the last step, set q(v) to its optimum for the final hyperparameters on the FULL data (P41): the returned
   /// model does not depend on which minibatch came last, and its full-data ELBO is never below the last iterate's.
   bool final_full_data_q = true;

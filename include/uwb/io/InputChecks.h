@@ -42,12 +42,17 @@ inline constexpr double kMinAnchorWidth_m = 0.2;
 /// Third principal std below this: anchors (nearly) coplanar, the axis normal to their plane is poorly observed
 /// (warning) [m].
 inline constexpr double kMinAnchorDepth_m = 0.2;
-/// Largest principal std beyond this: not one UWB arena (warning) [m].
+/// Largest principal std beyond this: not one UWB arena (an error) [m].
 inline constexpr double kMaxAnchorSpread_m = 500.0;
+
+/// Two anchors closer than this are one place surveyed twice (a copy-paste error): warning naming both [m].
+inline constexpr double kMinAnchorSeparation_m = 0.1;
+/// An IMU stream that ends this long before the TDoA stream leaves the rest of the flight without it (warning) [s].
+inline constexpr double kMaxImuEndGap_s = 1.0;
 
 SurveyGeometry surveyGeometry(const AnchorSurvey& survey);
 /// Errors: fewer than 2 anchors, all at one point, on one line. Warnings: fewer than 4 anchors (no 3-D
-/// multilateration), coplanar, spread beyond kMaxAnchorSpread_m.
+/// multilateration), coplanar, spread beyond kMaxAnchorSpread_m, two anchors closer than kMinAnchorSeparation_m.
 std::vector<InputIssue> checkSurveyGeometry(const AnchorSurvey& survey);
 
 /// Plausible sample-rate range of a stream [Hz] (IMU 20 Hz–10 kHz, TDoA and pose 1 Hz–10 kHz, others 0.2 Hz–10 kHz).
@@ -59,7 +64,9 @@ RateRange plausibleRate(Stream stream);
 
 /// Median sample rate of each present stream with ≥ 10 samples, checked against plausibleRate; a stream whose time
 /// span exceeds 50× the TDoA stream's (stamps in milliseconds) is flagged too. Errors for the TDoA stream and
-/// the IMU (acc, gyro), warnings for the other streams.
+/// the IMU (acc, gyro), warnings for the other streams. A stream of ≥ 2 samples whose stamps are all equal is an
+/// error for TDoA and IMU, a warning otherwise. An IMU stream (acc, gyro) that ends more than kMaxImuEndGap_s
+/// before the TDoA stream is a warning giving both end times.
 std::vector<InputIssue> checkStreamRates(const Flight& flight);
 
 /// True when any issue is an error.

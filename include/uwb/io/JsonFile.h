@@ -11,8 +11,16 @@
 
 namespace uwb {
 
+/// Deepest nesting of arrays and objects accepted in a JSON input (models and configs need fewer than 10 levels).
+inline constexpr int kMaxJsonDepth = 64;
+
+/// Byte offset of the first `[` or `{` (outside strings) that opens level max_depth + 1; npos when the text stays
+/// within max_depth levels. Linear, no recursion: run before parsing untrusted text.
+std::size_t jsonNestingTooDeepAt(std::string_view text, int max_depth = kMaxJsonDepth);
+
 /// Parses the JSON file at `path` (read with readTextFile: directories and devices are refused).
-/// FileError when it cannot be read; InputError "path:line:column: invalid JSON: ..." when it does not parse.
+/// FileError when it cannot be read; InputError "path:line:column: invalid JSON: ..." when it does not parse or
+/// nests deeper than kMaxJsonDepth (checked before parsing).
 nlohmann::json readJsonFile(const std::string& path, const char* what);
 /// Same on text already in memory; `source` names it in messages.
 nlohmann::json parseJsonText(std::string_view text, const std::string& source, const char* what);
