@@ -130,10 +130,10 @@ void runAgent(const AgentArgs& a) {
   bus_sub.connect(a.bus_out);
   bus_pub.set(zmq::sockopt::linger, 2000);
   bus_pub.connect(a.bus_in);
-  // estimates and the final report: a PUSH that blocks at the high-water mark and, at close, waits until all is
-  // delivered (the parent's PULL drains it; the agent dies with its parent, so this never hangs alone)
+  // estimates and the final report: a PUSH that blocks at the high-water mark and, at close, waits up to 60 s until
+  // all is delivered (the parent's PULL drains it; a stopped agent waits for nothing)
   zmq::socket_t report(ctx, zmq::socket_type::push);
-  report.set(zmq::sockopt::linger, -1);
+  report.set(zmq::sockopt::linger, 60000);
   report.connect(a.report);
   uwb::LatencyStats lat_event, lat_belief;
   std::size_t n_events = 0, n_beliefs_in = 0, n_beliefs_sent = 0, n_dropped = 0, n_est = 0, n_twr = 0;
@@ -208,7 +208,10 @@ void runAgent(const AgentArgs& a) {
     (void)t_arrival;
     lat_event.add(static_cast<double>(nowNs() - send_ns) * 1e-9);  // batch sent → last event of it handled
   }
-  if (*uwb::app::stopFlag() != 0) return;  // interrupted: no report
+  if (*uwb::app::stopFlag() != 0) {
+    report.set(zmq::sockopt::linger, 0);  // interrupted (or the parent died): no report, nothing to wait for
+    return;
+  }
   const uwb::LocalizerSummary& s = agent.cooperative().summary();
   json d = {{"agent", a.id},
             {"events", n_events},
