@@ -25,14 +25,15 @@ namespace {
 
 using ::testing::HasSubstr;
 
-/// `log` with every event type's id lowered by one (usdLogFromFlight numbers them from 1), events in file order.
+/// `log` with its event types numbered 0, 1, 2, … in header order (usdLogFromFlight numbers them from 1, leaving gaps
+/// for absent streams), events in file order: zeros then decode as events of the first type.
 UsdLog idsFromZero(const UsdLog& log) {
   UsdLog out;
   out.version = log.version;
-  for (const UsdEventType& t : log.types) {
+  for (std::size_t i = 0; i < log.types.size(); ++i) {
     std::vector<std::pair<std::string, UsdType>> fields;
-    for (const UsdField& f : t.fields) fields.emplace_back(f.name, f.type);
-    out.addType(static_cast<std::uint16_t>(t.id - 1), t.name, fields);
+    for (const UsdField& f : log.types[i].fields) fields.emplace_back(f.name, f.type);
+    out.addType(static_cast<std::uint16_t>(i), log.types[i].name, fields);
   }
   struct Ref {
     std::uint32_t number;
