@@ -169,4 +169,36 @@ put("config_json", "seed_localize_start.json", json.dumps({"start_w_p_b": [1.5, 
 put("config_json", "seed_simulate.json", json.dumps({"bias": {"enabled": True, "multipath_features": 8, "noise_std_m": 0.05},
                                                      "trajectory": {"radius_m": 1.0}, "imu": {"rate_hz": 500.0},
                                                      "b_t_tag": [0, 0, 0.02]}))
+
+# the stream's line protocol: a short synthetic flight at rest (IMU at 100 Hz, TDoA between the harness's 8 anchors),
+# the same with one stamp far ahead, and with a clock that restarts at 0 (a reboot)
+def stream_lines(t0, n, rebase_at=None, outlier_at=None):
+    lines = ["# uwbtdoa-events v1"]
+    for i in range(n):
+        t = t0 + 0.01 * i
+        if rebase_at is not None and i >= rebase_at:
+            t = 0.01 * (i - rebase_at)
+        if outlier_at == i:
+            t = 1e12
+        lines.append(f"imu,{t:.3f},0.01,-0.02,9.81,0.001,-0.002,0.0005")
+        if i % 2 == 0:
+            a, b = i % 8, (i + 3) % 8
+            lines.append(f"tdoa,{t + 0.004:.3f},{a},{b},{0.1 * ((i * 7) % 11) - 0.5:.3f}")
+        if i % 10 == 0:
+            lines.append(f"tof,{t + 0.006:.3f},0.03")
+    return "\n".join(lines) + "\n"
+
+
+put("stream_line", "seed_rest.txt", stream_lines(0.0, 60))
+put("stream_line", "seed_outlier.txt", stream_lines(20.0, 40, outlier_at=12))
+put("stream_line", "seed_reboot.txt", stream_lines(20.0, 40, rebase_at=20))
+put("stream_line", "seed_bad.txt", "imu,1,2\ntdoa,0.5,3,3,0.1\ntdoa,0.6,-1,300,0.2\nzzz\ntof,1e400,1\n")
+
+# JSON deep and wide (fuzz_json_deep with -max_len=300000): nesting of 100 000 levels, wide arrays and objects
+put("json_deep", "seed_deep_array.json", "[" * 100000 + "]" * 100000)
+put("json_deep", "seed_deep_object.json", '{"a":' * 40000 + "1" + "}" * 40000)
+put("json_deep", "seed_deep_config.json", '{"tdoa_sigma_m":' + "[" * 50000 + "]" * 50000 + "}")
+put("json_deep", "seed_wide_array.json", "[" + ",".join(["0.5"] * 60000) + "]")
+put("json_deep", "seed_wide_object.json", "{" + ",".join(f'"k{i}":{i}' for i in range(20000)) + "}")
+put("json_deep", "seed_config.json", json.dumps({"tdoa_sigma_m": 0.1, "robust_loss": "cauchy", "b_t_tag": [0, 0, 0.03]}))
 print(f"seed corpora written to {out}")

@@ -63,6 +63,7 @@ void run(const Options& o) {
   const uwb::FlightSummary summary = uwb::summarizeFlight(flight, nullptr);
 
   uwb::app::Warnings warnings;
+  for (const std::string& w : read_report.warnings) warnings.add(w);
   warnMissing(flight, warnings);
   for (const uwb::InputIssue& i : uwb::checkStreamRates(flight)) warnings.add(i.text());
 
@@ -84,6 +85,8 @@ void run(const Options& o) {
            {"n_bytes", read_report.n_bytes},
            {"n_events", read_report.n_events},
            {"crc_ok", read_report.crc_ok},
+           {"skipped_bytes", read_report.skipped_bytes},
+           {"dropped_events", read_report.dropped_events},
            {"t0_us", report.t0_us},
            {"t_start_s", summary.t_start_s},
            {"t_end_s", summary.t_end_s},

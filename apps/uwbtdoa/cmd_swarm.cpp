@@ -6,7 +6,9 @@
  *  This process simulates the swarm and publishes each agent's sensor stream (one topic per agent), runs the
  *  belief bus (ZeroMQ's built-in XSUB/XPUB proxy) and the collector, and fork/execs N `uwbtdoa swarm-agent`
  *  processes (a hidden subcommand). Each agent runs a cooperative and an independent Estimator, publishes its belief
- *  and its estimates on the bus and fuses its neighbours' beliefs with its TWR (message-passing.md G20–G22).
+ *  on the bus and fuses its neighbours' beliefs with its TWR (message-passing.md G20–G22). Its estimates and its
+ *  final report go to the parent on a reliable channel of their own (PUSH → PULL, never dropped), not over the lossy
+ *  bus; a run fails, naming each failed agent and why, when an agent dies, sends no report or scores no sample.
  *  SIGINT/SIGTERM: every agent is sent SIGTERM and reaped, nothing is written, exit 130.
  */
 #include <fmt/format.h>
@@ -19,6 +21,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -65,7 +68,7 @@ struct SwarmArgs {
 
 struct AgentArgs {
   int id = 0, agents = 0;
-  std::string scenario, fusion, events, bus_in, bus_out;
+  std::string scenario, fusion, events, bus_in, bus_out, report;
   double duration = 0.0;
 };
 
@@ -127,6 +130,11 @@ void runAgent(const AgentArgs& a) {
   bus_sub.connect(a.bus_out);
   bus_pub.set(zmq::sockopt::linger, 2000);
   bus_pub.connect(a.bus_in);
+  // estimates and the final report: a PUSH that blocks at the high-water mark and, at close, waits up to 60 s until
+  // all is delivered (the parent's PULL drains it; a stopped agent waits for nothing)
+  zmq::socket_t report(ctx, zmq::socket_type::push);
+  report.set(zmq::sockopt::linger, 60000);
+  report.connect(a.report);
   uwb::LatencyStats lat_event, lat_belief;
   std::size_t n_events = 0, n_beliefs_in = 0, n_beliefs_sent = 0, n_dropped = 0, n_est = 0, n_twr = 0;
   double t_next_est = 0.0;
@@ -193,13 +201,17 @@ void runAgent(const AgentArgs& a) {
         const uwb::LocalizerEstimate c = agent.cooperative().estimate(), i = agent.independent().estimate();
         uwb::SwarmEstimate se{a.id, t_now, c.x.w_p_b, i.x.w_p_b, c.cov_pose.topLeftCorner<3, 3>(),
                               i.cov_pose.topLeftCorner<3, 3>()};
-        if (publish(uwb::kSwarmEstimateTopic, uwb::formatSwarmEstimate(se))) ++n_est;
+        sendPair(report, uwb::kSwarmEstimateTopic, uwb::formatSwarmEstimate(se), true);
+        ++n_est;
       }
     }
     (void)t_arrival;
     lat_event.add(static_cast<double>(nowNs() - send_ns) * 1e-9);  // batch sent → last event of it handled
   }
-  if (*uwb::app::stopFlag() != 0) return;  // interrupted: no report
+  if (*uwb::app::stopFlag() != 0) {
+    report.set(zmq::sockopt::linger, 0);  // interrupted (or the parent died): no report, nothing to wait for
+    return;
+  }
   const uwb::LocalizerSummary& s = agent.cooperative().summary();
   json d = {{"agent", a.id},
             {"events", n_events},
@@ -216,12 +228,13 @@ void runAgent(const AgentArgs& a) {
             {"event_latency_p99_s", lat_event.quantile(0.99)},
             {"belief_latency_p50_s", lat_belief.quantile(0.5)},
             {"belief_latency_p99_s", lat_belief.quantile(0.99)}};
-  sendPair(bus_pub, uwb::kSwarmDoneTopic, d.dump(), true);
+  sendPair(report, uwb::kSwarmDoneTopic, d.dump(), true);
 }
 
 // ---------------------------------------------------------------- parent: simulator, bus, collector
 struct Children {
   std::vector<pid_t> pids;
+  std::vector<int> status;  ///< waitpid status of each agent once it exited; -1 while running
   void terminateAll() {
     for (pid_t p : pids)
       if (p > 0) ::kill(p, SIGTERM);
@@ -233,12 +246,15 @@ struct Children {
   /// Reaps exited children; returns how many are still running.
   std::size_t reap() {
     std::size_t running = 0;
-    for (pid_t& p : pids) {
+    status.resize(pids.size(), -1);
+    for (std::size_t i = 0; i < pids.size(); ++i) {
+      pid_t& p = pids[i];
       if (p <= 0) continue;
       int st = 0;
       const pid_t r = ::waitpid(p, &st, WNOHANG);
       if (r == p) {
         if (!(WIFEXITED(st) && WEXITSTATUS(st) == 0)) ++failed;
+        status[i] = st;
         p = 0;
       } else {
         ++running;
@@ -252,6 +268,19 @@ struct Children {
   }
   std::size_t failed = 0;
 };
+
+/// Why agent k's run has no result (empty: it has one).
+std::string agentFailure(const std::vector<int>& status, std::size_t k, bool reported, std::size_t samples) {
+  const int st = k < status.size() ? status[k] : -1;
+  if (st != -1 && WIFSIGNALED(st))
+    return fmt::format("killed by signal {} ({}){}", WTERMSIG(st), ::strsignal(WTERMSIG(st)),
+                       WTERMSIG(st) == SIGKILL ? "; out of memory?" : "");
+  if (st != -1 && WIFEXITED(st) && WEXITSTATUS(st) != 0)
+    return fmt::format("exited with code {} (its error is printed above)", WEXITSTATUS(st));
+  if (!reported) return st == -1 ? "still running without a report at the end" : "exited without sending its report";
+  if (samples == 0) return "no estimate in its scoring window (0 samples: no RMSE)";
+  return {};
+}
 
 std::string selfExe() { return std::filesystem::read_symlink("/proc/self/exe").string(); }
 
@@ -275,6 +304,9 @@ void runSwarm(const SwarmArgs& a) {
     o.belief_latency_s = 0.01;
     const uwb::SwarmScore sc_in = uwb::runSwarmInProcess(sc, sim, o);
     const uwb::SwarmScore::Row r = sc_in.overall();
+    if (r.n == 0)
+      throw std::runtime_error("swarm: no estimate of any agent fell in its scoring window (0 samples: no RMSE); "
+                               "a longer --duration?");
     json j = {{"scenario", a.scenario}, {"agents", a.agents}, {"fusion", a.fusion}, {"in_process", true},
               {"overall", {{"samples", r.n}, {"rmse_coop_m", r.rmse_coop_m}, {"rmse_indep_m", r.rmse_indep_m},
                            {"nees_coop", r.nees_coop}, {"nees_indep", r.nees_indep}}}};
@@ -291,7 +323,7 @@ void runSwarm(const SwarmArgs& a) {
                                      std::filesystem::path(dir_tmpl).parent_path().string()));
   const std::string dir = dir_tmpl;
   const std::string ep_events = "ipc://" + dir + "/events", ep_in = "ipc://" + dir + "/bus-in",
-                    ep_out = "ipc://" + dir + "/bus-out";
+                    ep_out = "ipc://" + dir + "/bus-out", ep_report = "ipc://" + dir + "/report";
   zmq::context_t ctx;
   zmq::socket_t events(ctx, zmq::socket_type::xpub), xsub(ctx, zmq::socket_type::xsub),
       xpub(ctx, zmq::socket_type::xpub);
@@ -307,10 +339,13 @@ void runSwarm(const SwarmArgs& a) {
   zmq::socket_t collector(ctx, zmq::socket_type::sub);
   collector.set(zmq::sockopt::rcvhwm, 0);
   collector.set(zmq::sockopt::linger, 0);
-  collector.set(zmq::sockopt::subscribe, std::string(uwb::kSwarmEstimateTopic));
-  collector.set(zmq::sockopt::subscribe, std::string(uwb::kSwarmDoneTopic));
   collector.set(zmq::sockopt::subscribe, std::string(uwb::kSwarmBeliefTopic));
   collector.connect(ep_out);
+  // estimates and reports: a reliable channel of their own (PULL, no high-water mark), not the lossy bus
+  zmq::socket_t reports(ctx, zmq::socket_type::pull);
+  reports.set(zmq::sockopt::rcvhwm, 0);
+  reports.set(zmq::sockopt::linger, 0);
+  reports.bind(ep_report);
   std::thread proxy([&] {
     try {
       zmq::proxy(xsub, xpub);
@@ -325,6 +360,7 @@ void runSwarm(const SwarmArgs& a) {
   uwb::SwarmScore score(a.agents);
   std::vector<json> done(static_cast<std::size_t>(a.agents));
   std::size_t n_done = 0, n_est = 0, n_beliefs = 0;
+  Clock::time_point t_progress = Clock::now();  ///< the last estimate or report received
   std::string collector_error;
   std::thread collect([&] {
     std::string topic, body;
@@ -333,9 +369,17 @@ void runSwarm(const SwarmArgs& a) {
     for (const auto& ag : sc.agents) truth.emplace_back(ag.trajectory);
     try {
       while (collecting.load()) {
-        if (!recvPair(collector, topic, body, 50)) continue;
+        zmq::pollitem_t items[2] = {{reports.handle(), 0, ZMQ_POLLIN, 0}, {collector.handle(), 0, ZMQ_POLLIN, 0}};
+        try {
+          zmq::poll(items, 2, std::chrono::milliseconds(50));
+        } catch (const zmq::error_t& e) {
+          if (e.num() == EINTR) continue;
+          throw;
+        }
+        if (!recvPair(reports, topic, body, 0) && !recvPair(collector, topic, body, 0)) continue;
         ++no;
         std::lock_guard<std::mutex> lock(mu);
+        if (topic != uwb::kSwarmBeliefTopic) t_progress = Clock::now();
         if (topic == uwb::kSwarmEstimateTopic) {
           const uwb::SwarmEstimate e = uwb::parseSwarmEstimate(body, no);
           ++n_est;
@@ -373,7 +417,8 @@ void runSwarm(const SwarmArgs& a) {
     const std::vector<std::string> argv_s = {exe, "swarm-agent", "--id", std::to_string(k), "--agents",
                                              std::to_string(a.agents), "--scenario", a.scenario, "--duration",
                                              fmt::format("{}", a.duration), "--fusion", a.fusion, "--events",
-                                             ep_events, "--bus-in", ep_in, "--bus-out", ep_out};
+                                             ep_events, "--bus-in", ep_in, "--bus-out", ep_out, "--report",
+                                             ep_report};
     const pid_t pid = ::fork();
     if (pid < 0) {
       children.terminateAll();
@@ -391,6 +436,14 @@ void runSwarm(const SwarmArgs& a) {
     children.pids.push_back(pid);
   }
   const auto interrupted = [&] { return *uwb::app::stopFlag() != 0; };
+  const auto exitedAgents = [&] {
+    std::string text;
+    for (std::size_t k = 0; k < children.status.size(); ++k)
+      if (children.status[k] != -1)
+        text += fmt::format("{}agent {} {}", text.empty() ? "" : "; ", k,
+                            agentFailure(children.status, k, false, 0));
+    return text;
+  };
   const auto abort = [&](const std::string& why) {
     children.terminateAll();
     shutdown();
@@ -403,11 +456,15 @@ void runSwarm(const SwarmArgs& a) {
   // wait until every agent subscribed to its event topic (XPUB sees the subscriptions)
   {
     std::set<std::string> subscribed;
-    const auto deadline = Clock::now() + std::chrono::seconds(30);
+    // 100 processes starting on a busy machine: 30 s, and 0.5 s more per agent
+    const auto wait_s = std::chrono::milliseconds(30000 + 500 * a.agents);
+    const auto deadline = Clock::now() + wait_s;
     while (static_cast<int>(subscribed.size()) < a.agents) {
       if (interrupted()) abort("");
-      if (Clock::now() > deadline) abort("agents did not subscribe within 30 s");
-      if (children.reap() < static_cast<std::size_t>(a.agents)) abort("an agent exited at start-up");
+      if (Clock::now() > deadline)
+        abort(fmt::format("{} of {} agents did not subscribe within {} s", a.agents - static_cast<int>(subscribed.size()),
+                          a.agents, std::chrono::duration_cast<std::chrono::seconds>(wait_s).count()));
+      if (children.reap() < static_cast<std::size_t>(a.agents)) abort("an agent exited at start-up: " + exitedAgents());
       zmq::pollitem_t item{events.handle(), 0, ZMQ_POLLIN, 0};
       try {
         if (zmq::poll(&item, 1, std::chrono::milliseconds(50)) == 0) continue;
@@ -445,7 +502,7 @@ void runSwarm(const SwarmArgs& a) {
       std::this_thread::sleep_until(due);
       lateness.add(std::chrono::duration<double>(Clock::now() - due).count());
     }
-    if (children.reap() < static_cast<std::size_t>(a.agents)) abort("an agent exited early");
+    if (children.reap() < static_cast<std::size_t>(a.agents)) abort("an agent exited early: " + exitedAgents());
     for (int k = 0; k < a.agents; ++k) {
       const uwb::SensorLog& log = logs[static_cast<std::size_t>(k)];
       Cursor& c = cur[static_cast<std::size_t>(k)];
@@ -478,31 +535,57 @@ void runSwarm(const SwarmArgs& a) {
   }
   for (int k = 0; k < a.agents; ++k) sendPair(events, uwb::swarmEventTopic(k), uwb::kEndOfEvents, true);
   const double publish_wall_s = std::chrono::duration<double>(Clock::now() - t_wall0).count();
-  // wait for every agent's report
-  const auto deadline = Clock::now() + std::chrono::seconds(60);
+  // wait for every agent's report: agents far behind the publisher (many agents at --speed max on a busy machine)
+  // still make progress (estimates arrive), so the wait ends only after 60 s without any
+  constexpr auto kNoProgress = std::chrono::seconds(60);
+  constexpr auto kLastReports = std::chrono::seconds(5);  // after every agent exited: reports still in the pipe
+  Clock::time_point all_exited{};
+  bool stalled = false;
+  {
+    std::lock_guard<std::mutex> lock(mu);
+    t_progress = std::max(t_progress, Clock::now());
+  }
   while (true) {
     if (interrupted()) abort("");
+    Clock::time_point last_progress;
     {
       std::lock_guard<std::mutex> lock(mu);
       if (n_done == static_cast<std::size_t>(a.agents) || !collector_error.empty()) break;
+      last_progress = t_progress;
     }
-    if (Clock::now() > deadline) abort("agents did not report within 60 s of the end");
+    if (Clock::now() - last_progress > kNoProgress) {
+      stalled = true;  // the agents still running are reported as such below
+      break;
+    }
     if (children.reap() == 0) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the last reports in flight
-      std::lock_guard<std::mutex> lock(mu);
-      if (n_done < static_cast<std::size_t>(a.agents)) {
-        children.failed += static_cast<std::size_t>(a.agents) - n_done;
-        break;
-      }
+      if (all_exited == Clock::time_point{}) all_exited = Clock::now();
+      else if (Clock::now() - all_exited > kLastReports) break;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   const double total_wall_s = std::chrono::duration<double>(Clock::now() - t_wall0).count();
+  children.reap();
+  const std::vector<int> status_at_end = children.status;  // -1: still running (then stopped below)
+  if (stalled) children.terminateAll();
   children.reapAll(10000);
   shutdown();
   if (!collector_error.empty()) throw uwb::InputError("swarm collector: " + collector_error);
-  if (children.failed > 0 || n_done < static_cast<std::size_t>(a.agents))
-    throw std::runtime_error(fmt::format("swarm: {} agent(s) failed or did not report", a.agents - static_cast<int>(n_done)));
+  {
+    // every agent has a result, or the run fails naming each one that has none and why
+    std::vector<std::string> why;
+    for (int k = 0; k < a.agents; ++k) {
+      const std::size_t kk = static_cast<std::size_t>(k);
+      const std::string w = agentFailure(status_at_end, kk, !done[kk].is_null(), score.agent(k).n);
+      if (!w.empty()) why.push_back(fmt::format("agent {}: {}", k, w));
+    }
+    if (!why.empty()) {
+      std::string text = fmt::format("swarm: {} of {} agent(s) failed{}", why.size(), a.agents,
+                                     stalled ? " (no estimate or report for 60 s)" : "");
+      for (std::size_t i = 0; i < why.size() && i < 20; ++i) text += "\n  " + why[i];
+      if (why.size() > 20) text += fmt::format("\n  … and {} more", why.size() - 20);
+      throw std::runtime_error(text);
+    }
+  }
 
   // ---- report
   uwb::LatencyStats ev50, ev99, bl50, bl99;
@@ -639,6 +722,7 @@ const bool kRegisteredAgent = uwb::app::registerCommand({"swarm-agent", "", [](C
                                                            sub.add_option("--events", a->events)->required();
                                                            sub.add_option("--bus-in", a->bus_in)->required();
                                                            sub.add_option("--bus-out", a->bus_out)->required();
+                                                           sub.add_option("--report", a->report)->required();
                                                            sub.callback([a] { runAgent(*a); });
                                                          }});
 

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <stdexcept>
 
 #include "uwb/eval/Localization.h"
@@ -89,7 +90,11 @@ void SwarmScore::add(int agent, const Vec3& truth, const Vec3& p_coop, const Mat
 SwarmScore::Row SwarmScore::toRow(const Acc& a) {
   Row r;
   r.n = a.n;
-  if (a.n == 0) return r;
+  if (a.n == 0) {
+    // no sample, no score: NaN, never a 0.000 that reads as perfect
+    r.rmse_coop_m = r.rmse_indep_m = r.nees_coop = r.nees_indep = std::numeric_limits<double>::quiet_NaN();
+    return r;
+  }
   const double n = static_cast<double>(a.n);
   r.rmse_coop_m = std::sqrt(a.se_coop / n);
   r.rmse_indep_m = std::sqrt(a.se_indep / n);

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 
 #include "uwb/core/Error.h"
 #include "uwb/io/FileAccess.h"
@@ -22,6 +23,14 @@ namespace {
 constexpr std::uint8_t kMagic = 0xBC;
 constexpr std::size_t kCrcBytes = 4;
 constexpr std::size_t kPreambleBytes = 5;  // magic, version, number of event types
+/// Salvage: the deck writes its events in time order (all types on one clock), so an event more than this behind the
+/// latest stamp of the log belongs to another time base (a zeroed or damaged block) [µs].
+constexpr std::uint64_t kMaxStampLag_us = 1'000'000;
+/// Salvage: an event further ahead of the latest stamp is kept only if the events after it confirm the jump [µs].
+constexpr std::uint64_t kMaxStampLead_us = 10'000'000;
+/// Salvage: events that must follow in a valid chain (declared ids, whole payloads, plausible stamps) at a place
+/// where reading resumes after damage, and after a stamp that jumps ahead.
+constexpr std::size_t kResyncChain = 4;
 
 std::size_t timestampBytes(int version) { return version == 1 ? 4 : 8; }
 
@@ -207,6 +216,75 @@ class Parser {
     duplicates_.assign(log_.types.size(), 0);
   }
 
+  /// Type index of event id `id`, or -1.
+  int typeOf(std::uint16_t id) const {
+    const auto it = std::lower_bound(ids_.begin(), ids_.end(), std::make_pair(id, std::size_t{0}));
+    return it == ids_.end() || it->first != id ? -1 : static_cast<int>(it->second);
+  }
+
+  /// The event at byte q, if it is whole: its type and stamp [µs] and the byte after it.
+  struct Peek {
+    std::size_t type = 0, next = 0;
+    std::uint64_t t_us = 0;
+  };
+  std::optional<Peek> peek(std::size_t q) const {
+    const std::size_t ts_bytes = timestampBytes(log_.version);
+    if (q >= end_ || end_ - q < 2 + ts_bytes) return std::nullopt;
+    const int type = typeOf(static_cast<std::uint16_t>(readLe(p_ + q, 2)));
+    if (type < 0) return std::nullopt;
+    const std::size_t payload = log_.types[static_cast<std::size_t>(type)].payload_bytes;
+    if (end_ - q - 2 - ts_bytes < payload) return std::nullopt;
+    std::uint64_t ts = readLe(p_ + q + 2, ts_bytes);
+    if (log_.version == 1) ts *= 1000;
+    return Peek{static_cast<std::size_t>(type), q + 2 + ts_bytes + payload, ts};
+  }
+
+  /// Salvage: true when kResyncChain whole events start at byte q (or fewer that end exactly at the end of the
+  /// events), each of a declared id, stamped on the clock of the log so far (t_ref_us: not more than kMaxStampLag_us
+  /// before it), and within kMaxStampLead_us of each other.
+  bool chainAt(std::size_t q, std::uint64_t t_ref_us) const {
+    std::uint64_t t_prev = 0;
+    for (std::size_t k = 0; k < kResyncChain; ++k) {
+      if (q == end_) return k > 0;
+      const std::optional<Peek> e = peek(q);
+      if (!e) return false;
+      if (have_stamp_ && e->t_us + kMaxStampLag_us < t_ref_us) return false;
+      if (k > 0 && (e->t_us + kMaxStampLag_us < t_prev || e->t_us > t_prev + kMaxStampLead_us)) return false;
+      t_prev = std::max(t_prev, e->t_us);
+      q = e->next;
+    }
+    return true;
+  }
+
+  /// Salvage: the next byte after `start` where a valid chain of events begins (end_ when none does).
+  std::size_t resync(std::size_t start) const {
+    for (std::size_t q = start + 1; q < end_; ++q)
+      if (chainAt(q, t_latest_us_)) return q;
+    return end_;
+  }
+
+  /// Salvage: the event kept just before damage may hold damaged bytes in its payload: it goes too.
+  void dropLastKept() {
+    if (last_type_ < 0) return;
+    UsdEventSeries& s = log_.events[static_cast<std::size_t>(last_type_)];
+    s.t_us.pop_back();
+    s.offset.pop_back();
+    s.number.pop_back();
+    s.payload.resize(s.payload.size() - log_.types[static_cast<std::size_t>(last_type_)].payload_bytes);
+    ++n_before_damage_;
+    last_type_ = -1;
+  }
+
+  /// Salvage: counts and notes an event dropped because its stamp jumps (and drops the event before it).
+  void dropJump(std::size_t type, std::uint64_t ts, bool back) {
+    dropLastKept();
+    ++n_jump_dropped_;
+    if (n_jump_dropped_ == 1)
+      first_jump_ = fmt::format("the first, {} at {:.6f} s, {} the log's clock at {:.6f} s", log_.types[type].name,
+                                static_cast<double>(ts) * 1e-6, back ? "is behind" : "jumps ahead of",
+                                static_cast<double>(t_latest_us_) * 1e-6);
+  }
+
   void readEvents() {
     const std::size_t ts_bytes = timestampBytes(log_.version);
     std::size_t number = 0;
@@ -215,19 +293,26 @@ class Parser {
       const std::size_t start = pos_;
       const std::size_t left = end_ - pos_;
       if (left < 2 + ts_bytes) {
+        if (options_.salvage && resyncFrom(start, true)) continue;
         truncated(start, number, left < 2 ? "id" : "timestamp",
                   fmt::format("truncated event: {} bytes left, an event header needs {}", left, 2 + ts_bytes));
         return;
       }
       const auto id = static_cast<std::uint16_t>(readLe(p_ + pos_, 2));
-      const auto it = std::lower_bound(ids_.begin(), ids_.end(), std::make_pair(id, std::size_t{0}));
-      if (it == ids_.end() || it->first != id) failEvent(start, number, "id", unknownId(id));
-      const std::size_t type = it->second;
+      const int type_or_none = typeOf(id);
+      if (type_or_none < 0) {
+        if (!options_.salvage) failEvent(start, number, "id", unknownId(id));
+        // salvage: a damaged block; resume at the next place where valid events follow
+        if (resyncFrom(start)) continue;
+        break;
+      }
+      const std::size_t type = static_cast<std::size_t>(type_or_none);
       const UsdEventType& t = log_.types[type];
       std::uint64_t ts = readLe(p_ + pos_ + 2, ts_bytes);
       if (log_.version == 1) ts *= 1000;  // ms → µs
       pos_ += 2 + ts_bytes;
       if (end_ - pos_ < t.payload_bytes) {
+        if (options_.salvage && resyncFrom(start, true)) continue;
         const std::size_t avail = end_ - pos_;
         std::string field = t.name;
         for (const UsdField& f : t.fields) {
@@ -241,10 +326,25 @@ class Parser {
         return;
       }
       UsdEventSeries& s = log_.events[type];
+      if (options_.salvage && have_stamp_) {
+        // salvage: an event off the log's clock (a zeroed block stamped 0, a damaged stamp) is dropped and counted,
+        // never allowed to move the flight's time zero
+        const bool back = ts + kMaxStampLag_us < t_latest_us_ || (!s.t_us.empty() && ts < s.t_us.back());
+        const bool ahead = ts > t_latest_us_ + kMaxStampLead_us && !chainAt(start, ts);
+        if (back || ahead) {
+          dropJump(type, ts, back);
+          pos_ += t.payload_bytes;
+          ++number;
+          continue;
+        }
+      }
       if (!s.t_us.empty() && ts < s.t_us.back()) {
         failEvent(start, number, t.name + ".timestamp",
                   fmt::format("time goes backwards within {}: {} µs after {} µs", t.name, ts, s.t_us.back()));
       }
+      t_latest_us_ = have_stamp_ ? std::max(t_latest_us_, ts) : ts;
+      have_stamp_ = true;
+      last_type_ = static_cast<int>(type);
       if (!s.t_us.empty() && ts == s.t_us.back()) ++duplicates_[type];
       s.t_us.push_back(ts);
       s.offset.push_back(static_cast<std::uint32_t>(start));
@@ -254,6 +354,19 @@ class Parser {
       ++number;
     }
     finish(number);
+  }
+
+  /// Salvage: skips the damaged bytes from `start` to the next valid chain; false when none follows (then the rest
+  /// is skipped too, unless keep_tail: then nothing is skipped or counted).
+  bool resyncFrom(std::size_t start, bool keep_tail = false) {
+    const std::size_t q = resync(start);
+    if (q == end_ && keep_tail) return false;  // nothing valid after: the caller reports a truncated tail
+    dropLastKept();
+    skipped_bytes_ += q - start;
+    ++n_resyncs_;
+    if (first_skip_.empty()) first_skip_ = fmt::format("the first at byte {}", start);
+    pos_ = q;
+    return q < end_;
   }
 
   std::string unknownId(std::uint16_t id) const {
@@ -275,6 +388,18 @@ class Parser {
 
   void finish(std::size_t number) {
     report_.n_events = number;
+    report_.skipped_bytes = skipped_bytes_;
+    report_.dropped_events = n_jump_dropped_ + n_before_damage_;
+    if (skipped_bytes_ > 0)
+      report_.warnings.push_back(fmt::format(
+          "salvage: {} damaged byte(s) skipped in {} place(s) ({}); reading resumed at the next valid event each time "
+          "({} event(s) just before damage dropped too)",
+          skipped_bytes_, n_resyncs_, first_skip_, n_before_damage_));
+    if (n_jump_dropped_ > 0)
+      report_.warnings.push_back(fmt::format(
+          "salvage: {} event(s) dropped because their time stamps jump off the log's clock ({}; a zeroed or damaged "
+          "block?); {} event(s) just before damage dropped too",
+          n_jump_dropped_, first_jump_, n_before_damage_));
     for (std::size_t i = 0; i < duplicates_.size(); ++i) {
       if (duplicates_[i] > 0) {
         report_.notes.push_back(fmt::format("{} events of {} share a timestamp with the previous one", duplicates_[i],
@@ -293,6 +418,11 @@ class Parser {
   std::size_t end_ = 0;
   std::vector<std::pair<std::uint16_t, std::size_t>> ids_;  ///< (id, type index), sorted
   std::vector<std::size_t> duplicates_;
+  bool have_stamp_ = false;
+  std::uint64_t t_latest_us_ = 0;  ///< the latest stamp kept, over all types
+  std::size_t skipped_bytes_ = 0, n_resyncs_ = 0, n_jump_dropped_ = 0, n_before_damage_ = 0;
+  int last_type_ = -1;  ///< type of the last event kept (salvage drops it when damage follows it)
+  std::string first_skip_, first_jump_;
 };
 
 std::size_t headerBytes(const UsdLog& log) {

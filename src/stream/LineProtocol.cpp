@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "uwb/core/Error.h"
+#include "uwb/io/AnchorSurvey.h"
 
 namespace uwb {
 namespace {
@@ -66,6 +67,8 @@ class LineDecoder {
     const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
     if (s.empty() || ec != std::errc() || ptr != s.data() + s.size())
       fail(i, name, fmt::format("'{}' is not an integer anchor id", s));
+    if (v < 0 || v > kMaxAnchorId)
+      fail(i, name, fmt::format("anchor id {} is outside [0, {}] (8-bit Loco Positioning ids)", v, kMaxAnchorId));
     return v;
   }
 
@@ -95,6 +98,8 @@ StreamEvent parseEventLine(std::string_view line, std::size_t line_no, const std
     ev.kind = StreamEvent::Kind::kTdoa;
     ev.t_s = d.real(1, "t");
     ev.tdoa = {ev.t_s, d.integer(2, "id_a"), d.integer(3, "id_b"), d.real(4, "tdoa_m")};
+    if (ev.tdoa.id_a == ev.tdoa.id_b)
+      d.fail(3, "id_b", fmt::format("id_a and id_b are both {}: a TDoA needs two anchors", ev.tdoa.id_a));
   } else if (type == "tof") {
     d.expectCount(3, "tof", "tof,t,range_m");
     ev.kind = StreamEvent::Kind::kTof;
@@ -104,6 +109,14 @@ StreamEvent parseEventLine(std::string_view line, std::size_t line_no, const std
     d.fail(0, "type", fmt::format("unknown event type '{}' (expected imu, tdoa or tof)", type));
   }
   return ev;
+}
+
+void checkEventAnchors(const StreamEvent& ev, const AnchorTable& anchors, std::size_t line_no,
+                       const std::string& source) {
+  if (ev.kind != StreamEvent::Kind::kTdoa) return;
+  for (const auto& [id, name] : {std::pair{ev.tdoa.id_a, "id_a"}, std::pair{ev.tdoa.id_b, "id_b"}})
+    if (anchors.find(id) == nullptr)
+      throw InputError(SourceLocation{source, line_no, 0, name}, fmt::format("anchor {} is not in the survey", id));
 }
 
 std::string formatImuLine(double t_s, const ImuReading& imu) {

@@ -19,10 +19,16 @@ ZmqLineSubscriber::ZmqLineSubscriber(zmq::context_t& ctx, const std::string& end
   // subscribe to the topic family ("uwb.events."), so another version is reported instead of ignored
   sock_.set(zmq::sockopt::subscribe, topic_.substr(0, topic_.rfind('.') + 1));
   sock_.connect(endpoint);
+  t_last_message_ = std::chrono::steady_clock::now();
 }
 
 bool ZmqLineSubscriber::next(std::string& line, const volatile std::sig_atomic_t* stop) {
   while (stop == nullptr || *stop == 0) {
+    if (idle_timeout_s_ > 0.0 &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t_last_message_).count() >= idle_timeout_s_) {
+      timed_out_ = true;
+      return false;
+    }
     zmq::pollitem_t item{sock_.handle(), 0, ZMQ_POLLIN, 0};
     try {
       if (zmq::poll(&item, 1, std::chrono::milliseconds(kPoll_ms)) == 0) continue;
@@ -32,6 +38,7 @@ bool ZmqLineSubscriber::next(std::string& line, const volatile std::sig_atomic_t
     }
     zmq::message_t topic, body;
     if (!sock_.recv(topic, zmq::recv_flags::dontwait)) continue;
+    t_last_message_ = std::chrono::steady_clock::now();
     ++n_;
     const SourceLocation where{"<zmq>", n_, 0, "topic"};
     if (!topic.more()) throw InputError(where, "a message must have two frames (topic, line), this one has one");

@@ -90,13 +90,13 @@ TEST_F(StreamCli, ReplayIntoStreamGivesTheBatchEstimates) {
   }
 }
 
-TEST_F(StreamCli, AMalformedLineIsAnErrorNamingItsLineAndField) {
+TEST_F(StreamCli, AMalformedLineIsAnErrorNamingItsLineAndFieldUnderStrict) {
   const std::string events = (dir_ / "bad.txt").string();
   {
     std::ofstream out(events);
     out << "# uwbtdoa-events v1\nimu,0,0,0,9.81,0,0,0\ntdoa,0.001,0,1,zz\n";
   }
-  const test::CliResult r = test::runCli("stream --anchors " + survey_ + " < " + events);
+  const test::CliResult r = test::runCli("stream --anchors " + survey_ + " --strict < " + events);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("<stdin>:3:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("tdoa_m"), std::string::npos) << r.err;

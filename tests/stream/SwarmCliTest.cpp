@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -73,10 +74,24 @@ TEST(SwarmCli, ThreeAgentsRunAndReportRmse) {
   EXPECT_GT(j.at("rates").at("event_lines_per_s").get<double>(), 0.0);
   EXPECT_TRUE(j.at("latency_s").contains("event_p50_median_over_agents"));
   // and the table form names the overall line
-  const test::CliResult t = test::runCli("swarm --agents 3 --duration 5 --speed max");
+  const test::CliResult t = test::runCli("swarm --agents 3 --duration 8 --speed max");
   ASSERT_EQ(t.exit_code, 0) << t.err;
   EXPECT_NE(t.out.find("overall"), std::string::npos);
   EXPECT_NE(t.out.find("RMSE coop"), std::string::npos);
+}
+
+TEST(SwarmCli, ARunWithNoScoredSampleFailsNamingEachAgentInsteadOfPrintingRmseZero) {
+  // GIVEN 4 s flights, whose scoring window (2 s after the take-off to the landing) is empty
+  // WHEN run over ZeroMQ and in process
+  const test::CliResult r = test::runCli("swarm --agents 2 --duration 4 --speed max 2>&1");
+  const test::CliResult in = test::runCli("swarm --agents 2 --duration 4 --in-process 2>&1");
+  // THEN both fail with a message saying why, per agent, and print no RMSE (it used to print 0.000 over 0 samples)
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_NE(r.out.find("agent 0: no estimate in its scoring window (0 samples: no RMSE)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("agent 1: no estimate in its scoring window"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("0.000"), std::string::npos) << r.out;
+  EXPECT_EQ(in.exit_code, 1) << in.out;
+  EXPECT_NE(in.out.find("0 samples: no RMSE"), std::string::npos) << in.out;
 }
 
 std::vector<pid_t> childrenOf(pid_t parent) {
@@ -96,6 +111,46 @@ std::vector<pid_t> childrenOf(pid_t parent) {
     if (ppid == parent) out.push_back(std::stoi(name));
   }
   return out;
+}
+
+TEST(SwarmCli, AKilledAgentIsNamedWithWhatKilledIt) {
+  // GIVEN a real-time swarm of 3 agents
+  const std::filesystem::path err = std::filesystem::temp_directory_path() / ("swarm_kill_" + std::to_string(::getpid()));
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string cli = test::cliPath();
+    std::freopen("/dev/null", "w", stdout);
+    std::freopen(err.c_str(), "w", stderr);
+    ::execl(cli.c_str(), cli.c_str(), "swarm", "--agents", "3", "--duration", "20", "--speed", "1",
+            static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  std::vector<pid_t> agents;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(15);
+  while (agents.size() < 3 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    agents = childrenOf(pid);
+  }
+  ASSERT_EQ(agents.size(), 3u) << "the agent processes did not start";
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  // WHEN one agent is killed (as the OOM killer would)
+  std::sort(agents.begin(), agents.end());
+  ASSERT_EQ(::kill(agents[1], SIGKILL), 0);
+  int status = 0;
+  bool exited = false;
+  for (int k = 0; k < 300 && !exited; ++k) {
+    exited = ::waitpid(pid, &status, WNOHANG) == pid;
+    if (!exited) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  if (!exited) ::kill(pid, SIGKILL);
+  std::ifstream e(err);
+  const std::string text{std::istreambuf_iterator<char>(e), std::istreambuf_iterator<char>()};
+  std::filesystem::remove(err);
+  // THEN the run fails at once, naming the agent and the signal (it used to say only "N agent(s) failed")
+  ASSERT_TRUE(exited);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << text;
+  EXPECT_NE(text.find("agent 1 killed by signal 9"), std::string::npos) << text;
 }
 
 TEST(SwarmCli, SigintStopsEveryAgentAndWritesNothing) {
@@ -138,6 +193,18 @@ TEST(SwarmCli, SigintStopsEveryAgentAndWritesNothing) {
   for (pid_t a : agents) EXPECT_NE(::kill(a, 0), 0) << "agent " << a << " still exists";
   EXPECT_TRUE(std::filesystem::is_empty(dir)) << "files left in " << dir;
   std::filesystem::remove_all(dir);
+}
+
+TEST(SlowSwarmCli, HundredAgentsAtMaxSpeedAllReport) {
+  // GIVEN 100 agents for 10 s as fast as possible (the reports used to travel on the lossy bus: most such runs
+  // failed with "N agent(s) failed or did not report")
+  // WHEN run
+  const test::CliResult r = test::runCli("swarm --agents 100 --duration 10 --speed max --json");
+  // THEN every agent reports and scores samples
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j.at("per_agent").size(), 100u);
+  for (const auto& a : j.at("per_agent")) EXPECT_GT(a.at("samples").get<int>(), 0) << a.at("agent");
 }
 
 }  // namespace

@@ -84,6 +84,7 @@ class SwarmScore {
   /// One sample: agent k's cooperative and independent estimates at t against the true body position.
   void add(int agent, const Vec3& truth, const Vec3& p_coop, const Mat3& cov_coop, const Vec3& p_indep,
            const Mat3& cov_indep);
+  /// Scores over n samples; with n = 0 every score is NaN (no sample, no score).
   struct Row {
     std::size_t n = 0;
     double rmse_coop_m = 0.0, rmse_indep_m = 0.0;  ///< 3-D position RMSE

@@ -91,8 +91,12 @@ struct UsdLog {
 };
 
 struct UsdReadOptions {
-  /// Salvage a log whose writing was cut (the deck lost power): a CRC mismatch and a truncated last event become
-  /// notes instead of errors, and the events are read up to the last complete one.
+  /// Salvage a log whose writing was cut (the deck lost power) or damaged: a CRC mismatch and a truncated last event
+  /// become notes instead of errors, and the events are read up to the last complete one. A damaged block (an
+  /// undeclared id, an event cut short) is skipped up to the next place where valid events follow (declared ids,
+  /// whole payloads, stamps on the log's clock), and reading resumes there; an event whose stamp jumps off the log's
+  /// clock (more than 1 s behind the latest stamp, as a zeroed block's stamps of 0 do, or more than 10 s ahead of it
+  /// with no events after it to confirm the jump) is dropped. Both are counted and reported as warnings.
   bool salvage = false;
 };
 
@@ -101,6 +105,9 @@ struct UsdReadReport {
   std::size_t n_events = 0;
   bool crc_ok = false;
   std::vector<std::string> notes;  ///< e.g. "12 events of estTDOA share a timestamp with the previous one"
+  std::size_t skipped_bytes = 0;   ///< salvage: damaged bytes skipped
+  std::size_t dropped_events = 0;  ///< salvage: events dropped (stamps that jump, the event just before damage)
+  std::vector<std::string> warnings;  ///< salvage: what was skipped or dropped (a user must see these)
 };
 
 /// Reads a cfusdlog file. FileError when it cannot be read; InputError (located as in the file comment) on a bad

@@ -33,8 +33,13 @@ struct StreamEvent {
 /// Decodes one line (without its newline; a trailing '\r' is ignored). Throws InputError naming `source`, the
 /// 1-based `line_no`, the column and the field ("type", "t", "ax", ..., "id_a", "tdoa_m", "range_m") when the line
 /// is malformed: unknown type, wrong number of fields, a number that does not parse or is not finite, an id that is
-/// not an integer.
+/// not an integer in [0, kMaxAnchorId], id_a equal to id_b.
 StreamEvent parseEventLine(std::string_view line, std::size_t line_no, const std::string& source = "<stdin>");
+
+/// Throws InputError naming `source`, `line_no` and the field ("id_a", "id_b") when a TDoA event names an anchor
+/// that `anchors` (the survey) does not hold. Other events pass.
+void checkEventAnchors(const StreamEvent& ev, const AnchorTable& anchors, std::size_t line_no,
+                       const std::string& source = "<stdin>");
 
 /// The line of one event (no newline).
 std::string formatImuLine(double t_s, const ImuReading& imu);

@@ -11,6 +11,7 @@
  */
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <csignal>
 #include <string>
@@ -27,15 +28,23 @@ inline constexpr std::string_view kEndOfEvents = "# end";
 class ZmqLineSubscriber {
  public:
   ZmqLineSubscriber(zmq::context_t& ctx, const std::string& endpoint, std::string_view topic);
-  /// The next message's line; false at "# end" or when *stop is set (checked every 100 ms). Throws InputError
-  /// naming the message number on a message that is not two frames or whose topic is another version.
+  /// The next message's line; false at "# end", when *stop is set (checked every 100 ms) or when no message came for
+  /// the idle timeout (then timedOut()). Throws InputError naming the message number on a message that is not two
+  /// frames or whose topic is another version.
   bool next(std::string& line, const volatile std::sig_atomic_t* stop);
   std::size_t messageNumber() const { return n_; }
+  /// Seconds without a message after which next() gives up (a producer that was killed never sends "# end");
+  /// ≤ 0: wait forever. The clock starts at construction and restarts at every message.
+  void setIdleTimeout(double seconds) { idle_timeout_s_ = seconds; }
+  bool timedOut() const { return timed_out_; }
 
  private:
   zmq::socket_t sock_;
   std::string topic_;
   std::size_t n_ = 0;
+  double idle_timeout_s_ = 0.0;
+  bool timed_out_ = false;
+  std::chrono::steady_clock::time_point t_last_message_;
 };
 
 /// Sends lines of one topic on a PUB socket bound to `endpoint`.
