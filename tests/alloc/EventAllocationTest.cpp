@@ -192,7 +192,9 @@ TEST(EventAllocation, TheEstimatorAllocatesNothingPerEventOnceRunning) {
     Estimator est(v.params, anchorTableFromSurvey(flight().sim.survey));
     // WHEN every event after the first 10 s is pushed, THEN none of them touched the heap
     expectNoAllocationPerEvent(est, v.name, v.params.fuse_tof ? flight().log_with_tof : flight().log);
-    if (v.params.fuse_tof) EXPECT_GT(est.summary().n_tof_used, 500u);
+    if (v.params.fuse_tof) {
+      EXPECT_GT(est.summary().n_tof_used, 500u);
+    }
   }
 }
 

@@ -29,6 +29,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::ContainsRegex;
 
 /// A 30 s simulated circle, its survey and its events in the line protocol, shared by the tests of this file.
 class StreamFaults : public ::testing::Test {
@@ -135,7 +136,7 @@ TEST_F(StreamFaults, AClockThatRestartsAtZeroIsWarnedAndTheEstimatorStartsAgain)
   // THEN a loud warning names the jump, the estimator starts again, and estimates come on the new clock to the end
   // (they used to stop at 15 s)
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_THAT(r.err, HasSubstr("THE SENSOR CLOCK JUMPED from 15"));
+  EXPECT_THAT(r.err, ContainsRegex("THE SENSOR CLOCK JUMPED from 1[45]\\.[0-9]+ s to 0 s"));
   EXPECT_EQ(countOf(r.err, "clock jumps"), 1u) << r.err;
   std::size_t after = 0;
   for (std::size_t i = 1; i < t_out.size(); ++i)
@@ -188,7 +189,7 @@ TEST_F(StreamFaults, AnchorsOutsideTheSurveyAndEqualIdsAreRefusedPerLine) {
     std::vector<double> t_strict;
     const test::CliResult strict = stream(write("one.txt", {"# uwbtdoa-events v1", s}), "--strict", &t_strict);
     EXPECT_EQ(strict.exit_code, 2) << s;
-    EXPECT_THAT(strict.err, HasSubstr("<stdin>:2:")) << s;
+    EXPECT_THAT(strict.err, ContainsRegex("<stdin>:2[: ]")) << s;
   }
 }
 

@@ -83,15 +83,16 @@ TEST(SwarmCli, ThreeAgentsRunAndReportRmse) {
 TEST(SwarmCli, ARunWithNoScoredSampleFailsNamingEachAgentInsteadOfPrintingRmseZero) {
   // GIVEN 4 s flights, whose scoring window (2 s after the take-off to the landing) is empty
   // WHEN run over ZeroMQ and in process
-  const test::CliResult r = test::runCli("swarm --agents 2 --duration 4 --speed max 2>&1");
-  const test::CliResult in = test::runCli("swarm --agents 2 --duration 4 --in-process 2>&1");
+  const test::CliResult r = test::runCli("swarm --agents 2 --duration 4 --speed max");
+  const test::CliResult in = test::runCli("swarm --agents 2 --duration 4 --in-process");
   // THEN both fail with a message saying why, per agent, and print no RMSE (it used to print 0.000 over 0 samples)
-  EXPECT_EQ(r.exit_code, 1) << r.out;
-  EXPECT_NE(r.out.find("agent 0: no estimate in its scoring window (0 samples: no RMSE)"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("agent 1: no estimate in its scoring window"), std::string::npos) << r.out;
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("agent 0: no estimate in its scoring window (0 samples: no RMSE)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("agent 1: no estimate in its scoring window"), std::string::npos) << r.err;
   EXPECT_EQ(r.out.find("0.000"), std::string::npos) << r.out;
-  EXPECT_EQ(in.exit_code, 1) << in.out;
-  EXPECT_NE(in.out.find("0 samples: no RMSE"), std::string::npos) << in.out;
+  EXPECT_EQ(r.err.find("0.000"), std::string::npos) << r.err;
+  EXPECT_EQ(in.exit_code, 1) << in.err;
+  EXPECT_NE(in.err.find("0 samples: no RMSE"), std::string::npos) << in.err;
 }
 
 std::vector<pid_t> childrenOf(pid_t parent) {
