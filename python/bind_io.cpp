@@ -403,7 +403,7 @@ void bindIo(py::module_& m) {
                                return toNumpy(q);
                              },
                              "(N, 4) anchor orientations (x, y, z, w)")
-      .def_readwrite("source", &AnchorSurvey::source)
+      .def_readwrite("source", &AnchorSurvey::source, "the file it was read from (named in messages)")
       .def("position", [](const AnchorSurvey& s, int id) { return toNumpy(s.position(id), true); }, py::arg("id"),
            "World position [m] of one anchor; KeyError when the id is absent.")
       .def("positions_of",
@@ -448,9 +448,10 @@ void bindIo(py::module_& m) {
       .def_property("pose", [](const Flight& f) { return poseDict(f.pose); },
                     [](Flight& f, const py::dict& d) { setStream(f, "pose", d); },
                     "dict: t [s], p (N, 3) [m, world], q (N, 4) body→world (x, y, z, w)")
-      .def_readwrite("pose_has_orientation", &Flight::pose_has_orientation)
+      .def_readwrite("pose_has_orientation", &Flight::pose_has_orientation,
+                     "the pose stream carries a quaternion (False: position only)")
       .def_readwrite("columns", &Flight::columns, "header columns of the source file (the writer reproduces them)")
-      .def_readwrite("source", &Flight::source)
+      .def_readwrite("source", &Flight::source, "the file it was read from (named in messages)")
       .def("streams", &allStreams, "All non-empty streams: {name: stream dict}.")
       .def_property_readonly("present",
                              [](const Flight& f) {
@@ -538,9 +539,9 @@ void bindIo(py::module_& m) {
                                return d;
                              },
                              "rejected samples {index, t, kind ('attitude'|'position'), magnitude}")
-      .def_property_readonly("start_time", &PoseTrack::startTime)
-      .def_property_readonly("end_time", &PoseTrack::endTime)
-      .def_property_readonly("has_orientation", &PoseTrack::hasOrientation)
+      .def_property_readonly("start_time", &PoseTrack::startTime, "first pose time [s]")
+      .def_property_readonly("end_time", &PoseTrack::endTime, "last pose time [s]")
+      .def_property_readonly("has_orientation", &PoseTrack::hasOrientation, "the track carries attitudes")
       .def("__len__", [](const PoseTrack& t) { return t.samples().size(); });
 
   m.def(

@@ -67,8 +67,10 @@ TEST_F(StreamCli, ReplayIntoStreamGivesTheBatchEstimates) {
     const test::CliResult r = test::runCli("replay " + short_ + " --speed max | " + test::cliPath() +
                                            " stream --anchors " + survey_ + " --output-period 0.01 --format " + format);
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    const std::string fs = format;
-    const EstimateFormat f = fs == "csv" ? EstimateFormat::kCsv : fs == "tum" ? EstimateFormat::kTum : EstimateFormat::kJson;
+    const std::string format_name = format;
+    const EstimateFormat f = format_name == "csv"   ? EstimateFormat::kCsv
+                             : format_name == "tum" ? EstimateFormat::kTum
+                                                    : EstimateFormat::kJson;
     const std::vector<LocalizerEstimate> streamed = parseLines(r.out, f, f != EstimateFormat::kJson);
     // WHEN the batch path runs on the same flight's events
     const EkfParams p;
