@@ -71,7 +71,10 @@ TEST_F(SlowCrazyflieGuide, TheGuidesCommandsFromTheUsdLogToTheFigure) {
   // THEN import found TDoA, IMU, ToF and the pose, and noted nothing left out
   const nlohmann::json ji = nlohmann::json::parse(imp.out);
   for (const char* s : {"tdoa", "acc", "gyro", "tof", "pose"}) EXPECT_TRUE(ji["streams"].contains(s)) << s;
-  EXPECT_TRUE(ji["notes"].empty()) << ji["notes"].dump();
+  for (const auto& n : ji["notes"]) {  // nothing of the log left out (equal stamps may be noted)
+    EXPECT_EQ(n.get<std::string>().find("ignored"), std::string::npos) << n;
+    EXPECT_EQ(n.get<std::string>().find("lacks"), std::string::npos) << n;
+  }
   // AND the survey has the 8 anchors and no warning on this flight
   const nlohmann::json js = nlohmann::json::parse(sur.out);
   EXPECT_EQ(js["n_anchors"], 8);
