@@ -289,7 +289,7 @@ void bindEval(py::module_& m) {
                                return l;
                              },
                              "per-flight exclusion counts")
-      .def("report_text", &BiasDataset::reportText);
+      .def("report_text", &BiasDataset::reportText, "Text summary: samples per flight and pair, and what was excluded.");
 
   m.def(
       "build_bias_dataset",
@@ -373,7 +373,7 @@ void bindEval(py::module_& m) {
                     "free-form JSON text stored with the model (training flights, options)")
       .def("save", &BiasModel::save, py::arg("path"), "Writes the model file (the CLI's --bias-model format).")
       .def_static("load", &BiasModel::load, py::arg("path"), "Reads a model file written by save() or the CLI.")
-      .def("to_json", [](const BiasModel& b) { return b.toJson().dump(); })
+      .def("to_json", [](const BiasModel& b) { return b.toJson().dump(); }, "The model file's JSON text.")
       .def("__repr__", [](const BiasModel& b) {
         return "<BiasModel preset=" + b.preset() + " features=" + toString(b.features()) + " models=" +
                std::to_string(b.entries().size()) + ">";

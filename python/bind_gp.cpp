@@ -143,8 +143,9 @@ void bindGp(py::module_& m) {
       .def_property_readonly("param_names", &Kernel::paramNames, "names of the entries of theta")
       .def("params", [](const Kernel& k) { return paramsDict(k.params()); }, "{name: (value, trainable)}")
       .def("param", &Kernel::param, py::arg("name"), "Value of one named hyperparameter.")
-      .def("set_param", &Kernel::setParam, py::arg("name"), py::arg("value"))
-      .def("set_trainable", &Kernel::setTrainable, py::arg("name"), py::arg("trainable"))
+      .def("set_param", &Kernel::setParam, py::arg("name"), py::arg("value"), "Sets one named hyperparameter.")
+      .def("set_trainable", &Kernel::setTrainable, py::arg("name"), py::arg("trainable"),
+           "Fixes (False) or frees (True) one named hyperparameter for training.")
       .def("__call__",
            [](const Kernel& k, const py::handle& x, const py::handle& xp) {
              const RowMat a = toMatrix(x, 0, "x"), b = toMatrix(xp, 0, "x'");
@@ -159,9 +160,10 @@ void bindGp(py::module_& m) {
       .def("gram", [](const Kernel& k, const py::handle& X) { return toNumpy(k.gram(toMatX(X, "X"))); }, py::arg("X"),
            "K(X, X): (n, n)")
       .def("diag", [](const Kernel& k, const py::handle& X) { return toNumpy(k.diag(toMatX(X, "X")), true); },
-           py::arg("X"))
-      .def("to_json", [](const Kernel& k) { return k.toJson().dump(); })
-      .def_static("from_json", [](const std::string& s) { return Kernel::fromJson(parseJson(s, "kernel JSON")); })
+           py::arg("X"), "diag K(X, X): (n,)")
+      .def("to_json", [](const Kernel& k) { return k.toJson().dump(); }, "The kernel as JSON text.")
+      .def_static("from_json", [](const std::string& s) { return Kernel::fromJson(parseJson(s, "kernel JSON")); },
+                  py::arg("text"), "A kernel from the JSON text of to_json().")
       .def("__add__", &combineSum, py::is_operator())
       .def("__mul__", &combineProduct, py::is_operator())
       .def("__repr__", [](const Kernel& k) { return "<Kernel " + k.name() + ">"; });
@@ -232,7 +234,7 @@ void bindGp(py::module_& m) {
                              "scale of the input transform (empty: none)")
       .def("params", [](const Svgp& g) { return paramsDict(g.params()); }, "{name: (value, trainable)}")
       .def("set_param", &Svgp::setParam, py::arg("name"), py::arg("value"), "Sets one named parameter (see params()).")
-      .def("kl", &Svgp::kl)
+      .def("kl", &Svgp::kl, "KL(q(u) ‖ p(u)) [nats], the ELBO's regularizer.")
       .def(
           "elbo",
           [](const Svgp& g, const py::handle& X, const py::handle& y, double num_data) {
@@ -260,8 +262,9 @@ void bindGp(py::module_& m) {
           py::arg("X"), py::arg("threads") = 1,
           "Predictions at raw inputs X (N, D): {mean, var_f (latent), var_y (= var_f + noise)}. threads > 1 splits "
           "the rows over that many threads (0: one per core); the result does not depend on it.")
-      .def("to_json", [](const Svgp& g) { return g.toJson().dump(); })
-      .def_static("from_json", [](const std::string& s) { return Svgp::fromJson(parseJson(s, "SVGP JSON")); })
+      .def("to_json", [](const Svgp& g) { return g.toJson().dump(); }, "The model as JSON text (Svgp::toJson).")
+      .def_static("from_json", [](const std::string& s) { return Svgp::fromJson(parseJson(s, "SVGP JSON")); },
+                  py::arg("text"), "A model from the JSON text of to_json().")
       .def("save", [](const Svgp& g, const std::string& path) { writeText(g.toJson().dump(1), path); },
            py::arg("path"), "Writes the model as JSON (Svgp::toJson); OSError when the file cannot be written.")
       .def_static(

@@ -385,7 +385,8 @@ void bindIo(py::module_& m) {
                                auto o = out.mutable_unchecked<1>();
                                for (std::size_t i = 0; i < s.anchors.size(); ++i) o(i) = s.anchors[i].id;
                                return out;
-                             })
+                             },
+                             "(N,) anchor ids, ascending")
       .def_property_readonly("positions",
                              [](const AnchorSurvey& s) {
                                RowMat p(static_cast<Eigen::Index>(s.anchors.size()), 3);
