@@ -289,7 +289,7 @@ void bindEval(py::module_& m) {
                                return l;
                              },
                              "per-flight exclusion counts")
-      .def("report_text", &BiasDataset::reportText);
+      .def("report_text", &BiasDataset::reportText, "Text summary: samples per flight and pair, and what was excluded.");
 
   m.def(
       "build_bias_dataset",
@@ -328,8 +328,9 @@ void bindEval(py::module_& m) {
            }),
            py::arg("svgp"), py::arg("feature_map"), py::arg("preset") = "custom",
            "Wraps one global SVGP trained in Python (inputs given by feature_map) as a bias model.")
-      .def_property_readonly("preset", &BiasModel::preset)
-      .def_property_readonly("feature_map", [](const BiasModel& b) { return toString(b.features()); })
+      .def_property_readonly("preset", &BiasModel::preset, "name of the training preset the model was made with")
+      .def_property_readonly("feature_map", [](const BiasModel& b) { return toString(b.features()); },
+                             "the feature map of its inputs (feature_matrix names)")
       .def_property_readonly("entries",
                              [](const BiasModel& b) {
                                py::list l;
@@ -368,10 +369,11 @@ void bindEval(py::module_& m) {
            "Variance [m²] a flight at TDoA bias level flight_level_m (and level flight_mean_level_m of the model's mean\n"
            "on it; NaN unknown) shows beyond the training flights (docs/math/gp.md P43c); 0 when a level is unknown.")
       .def_property("metadata_json", [](const BiasModel& b) { return b.metadata_json; },
-                    [](BiasModel& b, const std::string& s) { b.metadata_json = s; })
+                    [](BiasModel& b, const std::string& s) { b.metadata_json = s; },
+                    "free-form JSON text stored with the model (training flights, options)")
       .def("save", &BiasModel::save, py::arg("path"), "Writes the model file (the CLI's --bias-model format).")
       .def_static("load", &BiasModel::load, py::arg("path"), "Reads a model file written by save() or the CLI.")
-      .def("to_json", [](const BiasModel& b) { return b.toJson().dump(); })
+      .def("to_json", [](const BiasModel& b) { return b.toJson().dump(); }, "The model file's JSON text.")
       .def("__repr__", [](const BiasModel& b) {
         return "<BiasModel preset=" + b.preset() + " features=" + toString(b.features()) + " models=" +
                std::to_string(b.entries().size()) + ">";

@@ -126,18 +126,19 @@ void bindGp(py::module_& m) {
                      "ledergerber() with + and *.")
       .def_static("preset", &Kernel::preset, py::arg("name"),
                   "Paper kernels on the bias-model feature columns: 'z1' (eq. 7), 'z2' (eq. 8), 'tdoa' (eq. 9).")
-      .def_property_readonly("name", &Kernel::name)
-      .def_property_readonly("input_dim", &Kernel::inputDim)
-      .def_property_readonly("num_params", &Kernel::numParams)
-      .def_property_readonly("terms", &Kernel::terms)
+      .def_property_readonly("name", &Kernel::name, "kernel expression, e.g. 'periodic(0)*matern52(1)'")
+      .def_property_readonly("input_dim", &Kernel::inputDim, "number of input columns the kernel reads")
+      .def_property_readonly("num_params", &Kernel::numParams, "number of hyperparameters (len(theta))")
+      .def_property_readonly("terms", &Kernel::terms, "the kernels of a sum or product (itself for a single kernel)")
       .def_property("theta", [](const Kernel& k) { return toNumpy(k.theta(), true); },
                     [](Kernel& k, const py::handle& v) { k.setTheta(toVecX(v, "theta")); },
                     "flat vector of positive hyperparameter values (names: param_names)")
-      .def_property_readonly("param_names", &Kernel::paramNames)
+      .def_property_readonly("param_names", &Kernel::paramNames, "names of the entries of theta")
       .def("params", [](const Kernel& k) { return paramsDict(k.params()); }, "{name: (value, trainable)}")
-      .def("param", &Kernel::param, py::arg("name"))
-      .def("set_param", &Kernel::setParam, py::arg("name"), py::arg("value"))
-      .def("set_trainable", &Kernel::setTrainable, py::arg("name"), py::arg("trainable"))
+      .def("param", &Kernel::param, py::arg("name"), "Value of one named hyperparameter.")
+      .def("set_param", &Kernel::setParam, py::arg("name"), py::arg("value"), "Sets one named hyperparameter.")
+      .def("set_trainable", &Kernel::setTrainable, py::arg("name"), py::arg("trainable"),
+           "Fixes (False) or frees (True) one named hyperparameter for training.")
       .def("__call__",
            [](const Kernel& k, const py::handle& x, const py::handle& xp) {
              const RowMat a = toMatrix(x, 0, "x"), b = toMatrix(xp, 0, "x'");
@@ -152,9 +153,10 @@ void bindGp(py::module_& m) {
       .def("gram", [](const Kernel& k, const py::handle& X) { return toNumpy(k.gram(toMatX(X, "X"))); }, py::arg("X"),
            "K(X, X): (n, n)")
       .def("diag", [](const Kernel& k, const py::handle& X) { return toNumpy(k.diag(toMatX(X, "X")), true); },
-           py::arg("X"))
-      .def("to_json", [](const Kernel& k) { return k.toJson().dump(); })
-      .def_static("from_json", [](const std::string& s) { return Kernel::fromJson(parseJson(s, "kernel JSON")); })
+           py::arg("X"), "diag K(X, X): (n,)")
+      .def("to_json", [](const Kernel& k) { return k.toJson().dump(); }, "The kernel as JSON text.")
+      .def_static("from_json", [](const std::string& s) { return Kernel::fromJson(parseJson(s, "kernel JSON")); },
+                  py::arg("text"), "A kernel from the JSON text of to_json().")
       .def("__add__", &combineSum, py::is_operator())
       .def("__mul__", &combineProduct, py::is_operator())
       .def("__repr__", [](const Kernel& k) { return "<Kernel " + k.name() + ">"; });
@@ -196,32 +198,36 @@ void bindGp(py::module_& m) {
            py::arg("kernel"), py::arg("Z"), py::arg("jitter") = Svgp::kDefaultJitter,
            "SVGP with inducing points Z (M, D); q(u) = prior, mean 0, noise variance 0.1.")
       .def_property("kernel", [](const Svgp& g) { return g.kernel(); },
-                    [](Svgp& g, const Kernel& k) { g.kernel() = k; })
+                    [](Svgp& g, const Kernel& k) { g.kernel() = k; }, "the covariance function (a Kernel)")
       .def_property("inducing", [](const Svgp& g) { return toNumpy(g.inducing()); },
                     [](Svgp& g, const py::handle& Z) { g.setInducing(toMatX(Z, "Z")); },
                     "(M, D) inducing points (in the transformed input space)")
-      .def_property_readonly("variational_mean", [](const Svgp& g) { return toNumpy(g.variationalMean(), true); })
-      .def_property_readonly("variational_cholesky", [](const Svgp& g) { return toNumpy(g.variationalCholesky()); })
+      .def_property_readonly("variational_mean", [](const Svgp& g) { return toNumpy(g.variationalMean(), true); },
+                             "(M,) mean m of q(u)")
+      .def_property_readonly("variational_cholesky", [](const Svgp& g) { return toNumpy(g.variationalCholesky()); },
+                             "(M, M) lower Cholesky factor L of the covariance of q(u) = N(m, L Lᵀ)")
       .def("set_variational",
            [](Svgp& g, const py::handle& mean, const py::handle& L) {
              g.setVariational(toVecX(mean, "m"), toMatX(L, "L"));
            },
-           py::arg("m"), py::arg("L"))
-      .def_property("mean_constant", &Svgp::meanConstant, &Svgp::setMean)
-      .def_property("noise_variance", &Svgp::noiseVariance, &Svgp::setNoiseVariance)
-      .def_property_readonly("jitter", &Svgp::jitter)
-      .def_property_readonly("num_inducing", &Svgp::numInducing)
-      .def_property_readonly("input_dim", &Svgp::inputDim)
+           py::arg("m"), py::arg("L"), "Sets q(u) = N(m, L Lᵀ): mean m (M,) and lower Cholesky factor L (M, M).")
+      .def_property("mean_constant", &Svgp::meanConstant, &Svgp::setMean, "constant prior mean of the GP")
+      .def_property("noise_variance", &Svgp::noiseVariance, &Svgp::setNoiseVariance, "Gaussian likelihood variance σ_n²")
+      .def_property_readonly("jitter", &Svgp::jitter, "diagonal jitter added to K_uu")
+      .def_property_readonly("num_inducing", &Svgp::numInducing, "number of inducing points M")
+      .def_property_readonly("input_dim", &Svgp::inputDim, "input dimension D")
       .def("set_input_transform",
            [](Svgp& g, const py::handle& shift, const py::handle& scale) {
              g.setInputTransform(toVecX(shift, "shift"), toVecX(scale, "scale"));
            },
            py::arg("shift"), py::arg("scale"), "x̃ = (x − shift) / scale before the kernel (empty = identity)")
-      .def_property_readonly("input_shift", [](const Svgp& g) { return toNumpy(g.inputShift(), true); })
-      .def_property_readonly("input_scale", [](const Svgp& g) { return toNumpy(g.inputScale(), true); })
+      .def_property_readonly("input_shift", [](const Svgp& g) { return toNumpy(g.inputShift(), true); },
+                             "shift of the input transform (empty: none)")
+      .def_property_readonly("input_scale", [](const Svgp& g) { return toNumpy(g.inputScale(), true); },
+                             "scale of the input transform (empty: none)")
       .def("params", [](const Svgp& g) { return paramsDict(g.params()); }, "{name: (value, trainable)}")
-      .def("set_param", &Svgp::setParam, py::arg("name"), py::arg("value"))
-      .def("kl", &Svgp::kl)
+      .def("set_param", &Svgp::setParam, py::arg("name"), py::arg("value"), "Sets one named parameter (see params()).")
+      .def("kl", &Svgp::kl, "KL(q(u) ‖ p(u)) [nats], the ELBO's regularizer.")
       .def(
           "elbo",
           [](const Svgp& g, const py::handle& X, const py::handle& y, double num_data) {
@@ -249,8 +255,9 @@ void bindGp(py::module_& m) {
           py::arg("X"), py::arg("threads") = 1,
           "Predictions at raw inputs X (N, D): {mean, var_f (latent), var_y (= var_f + noise)}. threads > 1 splits "
           "the rows over that many threads (0: one per core); the result does not depend on it.")
-      .def("to_json", [](const Svgp& g) { return g.toJson().dump(); })
-      .def_static("from_json", [](const std::string& s) { return Svgp::fromJson(parseJson(s, "SVGP JSON")); })
+      .def("to_json", [](const Svgp& g) { return g.toJson().dump(); }, "The model as JSON text (Svgp::toJson).")
+      .def_static("from_json", [](const std::string& s) { return Svgp::fromJson(parseJson(s, "SVGP JSON")); },
+                  py::arg("text"), "A model from the JSON text of to_json().")
       .def("save", [](const Svgp& g, const std::string& path) { writeText(g.toJson().dump(1), path); },
            py::arg("path"), "Writes the model as JSON (Svgp::toJson); OSError when the file cannot be written.")
       .def_static(

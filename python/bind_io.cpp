@@ -20,6 +20,8 @@
 #include "uwb/io/Flight.h"
 #include "uwb/io/FlightWindow.h"
 #include "uwb/io/PoseTrack.h"
+#include "uwb/io/SurveyCheck.h"
+#include "uwb/io/TrajectoryCsv.h"
 #include "uwb/io/UsdImport.h"
 #include "uwb/io/UtilCsv.h"
 
@@ -383,7 +385,8 @@ void bindIo(py::module_& m) {
                                auto o = out.mutable_unchecked<1>();
                                for (std::size_t i = 0; i < s.anchors.size(); ++i) o(i) = s.anchors[i].id;
                                return out;
-                             })
+                             },
+                             "(N,) anchor ids, ascending")
       .def_property_readonly("positions",
                              [](const AnchorSurvey& s) {
                                RowMat p(static_cast<Eigen::Index>(s.anchors.size()), 3);
@@ -401,7 +404,7 @@ void bindIo(py::module_& m) {
                                return toNumpy(q);
                              },
                              "(N, 4) anchor orientations (x, y, z, w)")
-      .def_readwrite("source", &AnchorSurvey::source)
+      .def_readwrite("source", &AnchorSurvey::source, "the file it was read from (named in messages)")
       .def("position", [](const AnchorSurvey& s, int id) { return toNumpy(s.position(id), true); }, py::arg("id"),
            "World position [m] of one anchor; KeyError when the id is absent.")
       .def("positions_of",
@@ -446,9 +449,10 @@ void bindIo(py::module_& m) {
       .def_property("pose", [](const Flight& f) { return poseDict(f.pose); },
                     [](Flight& f, const py::dict& d) { setStream(f, "pose", d); },
                     "dict: t [s], p (N, 3) [m, world], q (N, 4) body→world (x, y, z, w)")
-      .def_readwrite("pose_has_orientation", &Flight::pose_has_orientation)
+      .def_readwrite("pose_has_orientation", &Flight::pose_has_orientation,
+                     "the pose stream carries a quaternion (False: position only)")
       .def_readwrite("columns", &Flight::columns, "header columns of the source file (the writer reproduces them)")
-      .def_readwrite("source", &Flight::source)
+      .def_readwrite("source", &Flight::source, "the file it was read from (named in messages)")
       .def("streams", &allStreams, "All non-empty streams: {name: stream dict}.")
       .def_property_readonly("present",
                              [](const Flight& f) {
@@ -536,9 +540,9 @@ void bindIo(py::module_& m) {
                                return d;
                              },
                              "rejected samples {index, t, kind ('attitude'|'position'), magnitude}")
-      .def_property_readonly("start_time", &PoseTrack::startTime)
-      .def_property_readonly("end_time", &PoseTrack::endTime)
-      .def_property_readonly("has_orientation", &PoseTrack::hasOrientation)
+      .def_property_readonly("start_time", &PoseTrack::startTime, "first pose time [s]")
+      .def_property_readonly("end_time", &PoseTrack::endTime, "last pose time [s]")
+      .def_property_readonly("has_orientation", &PoseTrack::hasOrientation, "the track carries attitudes")
       .def("__len__", [](const PoseTrack& t) { return t.samples().size(); });
 
   m.def(
@@ -639,6 +643,37 @@ void bindIo(py::module_& m) {
       [](const py::dict& trajectory, const std::string& path) { writeTrajectoryCsv(trajectoryFromDict(trajectory), path); },
       py::arg("trajectory"), py::arg("path"),
       "Writes a trajectory dict {t, p[, q, sigma_p, v]} as the trajectory CSV (missing fields: identity / zeros).");
+  m.def(
+      "write_trajectory_tum",
+      [](const py::dict& trajectory, const std::string& path) { writeTrajectoryTum(trajectoryFromDict(trajectory), path); },
+      py::arg("trajectory"), py::arg("path"),
+      "Writes the poses of a trajectory dict {t, p, q} as TUM text (timestamp tx ty tz qx qy qz qw, space-\n"
+      "separated, shortest round-trip numbers): the format evo and the SLAM trajectory tools read.");
+  m.def(
+      "read_cfclient_anchors", &readCfclientAnchors, py::arg("path"),
+      "Reads the anchor positions the Crazyflie client's Loco Positioning tab saves (YAML: one {x, y, z} per\n"
+      "anchor id) as an AnchorSurvey (`uwbtdoa survey`, docs/crazyflie.md).");
+  m.def(
+      "check_survey",
+      [](const AnchorSurvey& survey, const Flight* flight, const py::object& positions) {
+        std::vector<Vec3> p;
+        if (!positions.is_none()) {
+          const RowMat m = toMatrix(positions, 3, "positions");
+          for (Eigen::Index i = 0; i < m.rows(); ++i) p.push_back(m.row(i).transpose());
+        } else if (flight) {
+          for (const PoseSample& s : flight->pose) p.push_back(s.w_p_b);
+        }
+        const std::vector<InputIssue> issues =
+            checkSurvey(survey, flight, p, !positions.is_none() ? "positions" : flight ? flight->source : "");
+        throwOnError(issues);
+        std::vector<std::string> out;
+        for (const InputIssue& i : issues) out.push_back(i.text());
+        return out;
+      },
+      py::arg("survey"), py::arg("flight") = nullptr, py::arg("positions") = py::none(),
+      "The checks of `uwbtdoa survey` as a list of warnings with their numbers: colocated anchors, anchors in one\n"
+      "plane, ids of the flight's TDoA missing from the survey, positions (N, 3) (default: the flight's motion\n"
+      "capture) outside the anchors' box. ValueError for a survey no position can be computed from.");
   m.def("read_anchor_survey", &readAnchorSurvey, py::arg("path"), "Reads a UTIL anchor survey text file.");
   m.def("write_anchor_survey", &writeAnchorSurvey, py::arg("survey"), py::arg("path"),
         "Writes a survey that read_anchor_survey reads back exactly.");

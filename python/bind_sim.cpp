@@ -149,7 +149,7 @@ py::dict imuTruthArrays(const std::vector<ImuTruth>& v) {
 }  // namespace
 
 void bindSim(py::module_& m) {
-  m.def("anchor_preset_names", &anchorPresetNames);
+  m.def("anchor_preset_names", &anchorPresetNames, "Names anchor_preset accepts.");
   m.def("anchor_preset", &anchorPreset, py::arg("name"), py::arg("data_dir") = "",
         "Anchor constellation by name ('paper' built in; 'util-const1'..4 read below data_dir).");
   m.def(

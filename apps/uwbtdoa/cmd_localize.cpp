@@ -94,6 +94,7 @@ json statsJson(const uwb::PositionErrorStats& s) {
 
 struct LocalizeArgs {
   std::string flight, anchors, out, plot;
+  std::string format = "csv";  ///< --format: the trajectory file's format (csv, or tum for evo)
   bool json_out = false, tdoa_only = false, no_ground_detect = false;
   bool no_diagnostics = false, fix_survey = false;
   double output_period = 0.01;
@@ -347,7 +348,12 @@ void runLocalize(const LocalizeArgs& a) {
   }
   // The JSON text is made before the trajectory file appears, so a failure here leaves no output behind.
   const std::string json_text = uwb::app::dumpJson(j);
-  if (!a.out.empty()) uwb::writeTrajectoryCsv(run.trajectory, a.out);
+  if (!a.out.empty()) {
+    if (a.format == "tum")
+      uwb::writeTrajectoryTum(run.trajectory, a.out);
+    else
+      uwb::writeTrajectoryCsv(run.trajectory, a.out);
+  }
   if (!a.plot.empty()) {
     // x, y, z against time with the ±2σ band and the ground truth (docs/math/filter.md F23); drawn to a temporary
     // name beside the target and renamed, so the PNG appears complete or not at all. The temporary names follow
@@ -421,7 +427,11 @@ const bool kRegistered = uwb::app::registerCommand(
        auto a = std::make_shared<LocalizeArgs>();
        sub.add_option("flight", a->flight, "Flight CSV (UTIL layout)")->required();
        sub.add_option("--anchors", a->anchors, "Anchor survey (UTIL survey text)")->required();
-       sub.add_option("--out", a->out, "Write the estimated trajectory CSV here");
+       sub.add_option("--out", a->out, "Write the estimated trajectory here (CSV, or TUM with --format tum)");
+       sub.add_option("--format", a->format,
+                      "Trajectory file format: csv (pose, σ, velocity, IMU biases) or tum (timestamp x y z qx qy qz "
+                      "qw, space-separated, for evo)")
+           ->check(CLI::IsMember({"csv", "tum"}));
        sub.add_option("--plot", a->plot,
                       "Draw x, y, z against time with the ±2σ band and the ground truth to this PNG (python3)");
        sub.add_flag("--json", a->json_out, "Print one JSON object with the results");

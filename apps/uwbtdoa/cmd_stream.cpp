@@ -73,9 +73,11 @@ class LineSink {
 
 void runStream(const StreamArgs& a) {
   if (a.output_period != 0.0) uwb::app::checkPeriod(a.output_period, "--output-period", kMaxOutputPeriod_s);
-  if (a.format != "json" && a.format != "csv")
-    throw uwb::InputError("--format: expected json or csv, got '" + a.format + "'");
-  const uwb::EstimateFormat format = a.format == "csv" ? uwb::EstimateFormat::kCsv : uwb::EstimateFormat::kJson;
+  if (a.format != "json" && a.format != "csv" && a.format != "tum")
+    throw uwb::InputError("--format: expected json, csv or tum, got '" + a.format + "'");
+  const uwb::EstimateFormat format = a.format == "csv"   ? uwb::EstimateFormat::kCsv
+                                     : a.format == "tum" ? uwb::EstimateFormat::kTum
+                                                         : uwb::EstimateFormat::kJson;
   uwb::app::FilterSetup setup = uwb::app::buildFilterParams(a.filter);
   const uwb::BiasPredictor bias = uwb::app::loadBiasPredictor(a.filter, &setup.params);
   const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(a.anchors);
@@ -100,7 +102,7 @@ void runStream(const StreamArgs& a) {
     if (pub) pub->send(line);  // never blocks: a slow consumer loses estimates (counted), never sensor events
     else sink.write(line);
   };
-  if (format == uwb::EstimateFormat::kCsv) emit(uwb::estimateCsvHeader());
+  if (format != uwb::EstimateFormat::kJson) emit(uwb::estimateHeader(format));
   uwb::FdLineReader reader(STDIN_FILENO, uwb::app::stopFlag(), [&sink] { sink.flush(); });
   const auto next = [&](std::string& line) {
     if (sub) {
@@ -191,8 +193,10 @@ const bool kRegistered = uwb::app::registerCommand(
      [](CLI::App& sub) {
        auto a = std::make_shared<StreamArgs>();
        sub.add_option("--anchors", a->anchors, "Anchor survey (UTIL survey text)")->required();
-       sub.add_option("--format", a->format, "Estimate lines: json (one object per line) or csv")
-           ->check(CLI::IsMember({"json", "csv"}));
+       sub.add_option("--format", a->format,
+                      "Estimate lines: json (one object per line), csv, or tum (t x y z qx qy qz qw, pose only, for "
+                      "evo)")
+           ->check(CLI::IsMember({"json", "csv", "tum"}));
        sub.add_option("--output-period", a->output_period,
                       "Minimum spacing of estimates [s] (0: one per IMU/TDoA event)");
        sub.add_option("--in", a->in, "Read sensor events from this ZeroMQ PUB endpoint (SUB), e.g. tcp://127.0.0.1:5555");

@@ -709,6 +709,8 @@ def render_report(out_dir: str, log=sys.stderr) -> list[str]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Command line: ``report DIR`` renders every figure of an evaluation report; ``position TRAJECTORY.csv
+    FLIGHT.csv OUT.png`` draws position_vs_time (what ``uwbtdoa localize --plot`` runs). Returns the exit code."""
     argv = list(sys.argv[1:] if argv is None else argv)
     if len(argv) == 4 and argv[0] == "position":
         # python3 -m uwbtdoa.plots position TRAJECTORY.csv FLIGHT.csv OUT.png

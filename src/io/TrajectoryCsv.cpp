@@ -129,4 +129,71 @@ Trajectory parseTrajectoryCsv(std::string_view text, const std::string& path) {
   return out;
 }
 
+namespace {
+constexpr std::array<const char*, 8> kTumColumns{"timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
+}  // namespace
+
+std::string formatTrajectoryTum(const Trajectory& trajectory) {
+  std::string out = "# timestamp tx ty tz qx qy qz qw\n";
+  out.reserve(trajectory.size() * 8 * 20 + out.size());
+  for (const TrajectorySample& s : trajectory) {
+    const double v[8] = {s.t_s,       s.w_p_b.x(), s.w_p_b.y(), s.w_p_b.z(),
+                         s.w_q_b.x(), s.w_q_b.y(), s.w_q_b.z(), s.w_q_b.w()};
+    for (std::size_t k = 0; k < 8; ++k) {
+      if (k > 0) out.push_back(' ');
+      io_detail::appendDouble(out, v[k]);
+    }
+    out.push_back('\n');
+  }
+  return out;
+}
+
+void writeTrajectoryTum(const Trajectory& trajectory, const std::string& path) {
+  io_detail::writeWholeFile(path, formatTrajectoryTum(trajectory), "TUM trajectory file");
+}
+
+Trajectory readTrajectoryTum(const std::string& path) {
+  return parseTrajectoryTum(io_detail::readWholeFile(path, "TUM trajectory file"), path);
+}
+
+Trajectory parseTrajectoryTum(std::string_view text, const std::string& path) {
+  io_detail::LineCursor lines(text);
+  Trajectory out;
+  const char* b = nullptr;
+  const char* e = nullptr;
+  while (lines.next(b, e)) {
+    const std::size_t line = lines.line();
+    io_detail::trim(b, e);
+    if (b == e || *b == '#') continue;
+    double v[8];
+    std::size_t n = 0;
+    const char* p = b;
+    while (p < e) {
+      const char* q = p;
+      while (q < e && !io_detail::isBlank(*q)) ++q;
+      if (n == 8) {
+        throw InputError(SourceLocation{path, line, n + 1, ""}, "more than 8 numbers (timestamp tx ty tz qx qy qz qw)");
+      }
+      const auto st = io_detail::parseDouble(p, q, v[n]);
+      if (st != io_detail::NumberStatus::kOk) {
+        throw InputError(SourceLocation{path, line, n + 1, kTumColumns[n]},
+                         fmt::format("{}: '{}'", io_detail::describe(st), std::string_view(p, static_cast<std::size_t>(q - p))));
+      }
+      ++n;
+      p = q;
+      while (p < e && io_detail::isBlank(*p)) ++p;
+    }
+    if (n != 8) {
+      throw InputError(SourceLocation{path, line, n + 1, n < 8 ? kTumColumns[n] : ""},
+                       fmt::format("{} numbers, expected 8 (timestamp tx ty tz qx qy qz qw)", n));
+    }
+    TrajectorySample s;
+    s.t_s = v[0];
+    s.w_p_b = Vec3(v[1], v[2], v[3]);
+    s.w_q_b = Quat(v[7], v[4], v[5], v[6]);
+    out.push_back(s);
+  }
+  return out;
+}
+
 }  // namespace uwb

@@ -258,6 +258,12 @@ class Converter {
 
 }  // namespace
 
+std::vector<UsdRecording> usdRecordings() {
+  std::vector<UsdRecording> out;
+  for (const Recording& r : recordings()) out.push_back({r.stream, r.event, std::vector<std::string>(r.fields.begin(), r.fields.end())});
+  return out;
+}
+
 Flight flightFromUsdLog(const UsdLog& log, UsdImportReport* report) {
   UsdImportReport local;
   UsdImportReport& rep = report != nullptr ? *report : local;

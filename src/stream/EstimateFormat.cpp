@@ -37,7 +37,21 @@ std::string estimateCsvHeader() {
   return h + ",phase";
 }
 
+std::string estimateHeader(EstimateFormat format) {
+  switch (format) {
+    case EstimateFormat::kCsv: return estimateCsvHeader();
+    case EstimateFormat::kTum: return "# timestamp tx ty tz qx qy qz qw";
+    case EstimateFormat::kJson: break;
+  }
+  return "";
+}
+
 std::string formatEstimate(const LocalizerEstimate& e, EstimateFormat format) {
+  if (format == EstimateFormat::kTum) {
+    const Vec3& p = e.x.w_p_b;
+    const Quat& q = e.x.w_q_b;
+    return fmt::format("{} {} {} {} {} {} {} {}", e.t_s, p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w());
+  }
   const bool json = format == EstimateFormat::kJson;
   const Vec3& p = e.x.w_p_b;
   const Vec3& v = e.x.w_v_b;
@@ -77,6 +91,29 @@ LocalizerEstimate parseEstimate(const std::string& line, EstimateFormat format, 
   };
   std::vector<double> v;  // t, p, q(w,x,y,z), v, cov
   std::string phase;
+  if (format == EstimateFormat::kTum) {  // t px py pz qx qy qz qw
+    std::size_t start = 0;
+    while (start < line.size()) {
+      while (start < line.size() && line[start] == ' ') ++start;
+      if (start >= line.size()) break;
+      std::size_t end = line.find(' ', start);
+      if (end == std::string::npos) end = line.size();
+      double x = 0.0;
+      const auto [ptr, ec] = std::from_chars(line.data() + start, line.data() + end, x);
+      if (ec != std::errc() || ptr != line.data() + end) throw bad("'" + line.substr(start, end - start) + "' is not a number");
+      v.push_back(x);
+      start = end;
+    }
+    if (v.size() != 8) throw bad(fmt::format("{} numbers, expected 8 (t px py pz qx qy qz qw)", v.size()));
+    e.t_s = v[0];
+    e.x.w_p_b = Vec3(v[1], v[2], v[3]);
+    e.x.w_q_b = Quat(v[7], v[4], v[5], v[6]);
+    e.x.w_v_b.setZero();
+    e.cov_pose.setConstant(NAN);
+    e.sigma_p_m.setConstant(NAN);
+    e.phase = FlightPhase::kTracking;
+    return e;
+  }
   if (format == EstimateFormat::kJson) {
     const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
     if (j.is_discarded() || !j.is_object()) throw bad("not a JSON object");

@@ -138,5 +138,42 @@ TEST(TrajectoryCsv, MalformedInputNamesTheLocation) {
   EXPECT_THROW((void)readTrajectoryCsv(dir.file("none.csv")), FileError);
 }
 
+TEST(TrajectoryTum, PosesReadBackExactlyAndEvoStyleFilesRead) {
+  // GIVEN a trajectory with arbitrary doubles (seed 5)
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0.0, 1.0);
+  Trajectory traj;
+  for (int i = 0; i < 50; ++i) {
+    TrajectorySample s;
+    s.t_s = 0.01 * i + 1e-7 * n(rng);
+    s.w_p_b = Vec3(n(rng), n(rng), n(rng));
+    s.w_q_b = Quat(n(rng), n(rng), n(rng), n(rng)).normalized();
+    traj.push_back(s);
+  }
+  // WHEN written as TUM and read back
+  TempDir dir;
+  writeTrajectoryTum(traj, dir.file("t.tum"));
+  const Trajectory back = readTrajectoryTum(dir.file("t.tum"));
+  // THEN every time and pose is the same double; the first line names the columns
+  ASSERT_EQ(back.size(), traj.size());
+  for (std::size_t i = 0; i < traj.size(); ++i) {
+    EXPECT_EQ(back[i].t_s, traj[i].t_s);
+    EXPECT_EQ(back[i].w_p_b, traj[i].w_p_b);
+    EXPECT_EQ(back[i].w_q_b.coeffs(), traj[i].w_q_b.coeffs());
+  }
+  const std::string text = formatTrajectoryTum(traj);
+  EXPECT_EQ(text.substr(0, text.find('\n')), "# timestamp tx ty tz qx qy qz qw");
+  // AND a file as other tools write it (tabs, several spaces, comments, blank lines) reads
+  const Trajectory other = parseTrajectoryTum("# evo\n\n1.5\t1 2  3 0 0 0 1\n", "other.txt");
+  ASSERT_EQ(other.size(), 1u);
+  EXPECT_EQ(other[0].w_p_b, Vec3(1, 2, 3));
+  EXPECT_EQ(other[0].w_q_b.w(), 1.0);
+  // AND a bad line names the file, line and column
+  EXPECT_THAT([] { (void)parseTrajectoryTum("# c\n1 2 3 4 5 6 7\n", "f.txt"); },
+              ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("f.txt:2")));
+  EXPECT_THAT([] { (void)parseTrajectoryTum("1 2 x 4 5 6 7 8\n", "f.txt"); },
+              ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("ty")));
+}
+
 }  // namespace
 }  // namespace uwb

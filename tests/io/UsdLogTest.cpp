@@ -5,6 +5,7 @@
  */
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -16,6 +17,7 @@
 #include <string>
 
 #include "io/IoTestHelpers.h"
+#include "support/UsdDeckConfig.h"
 #include "uwb/core/Error.h"
 #include "uwb/io/FlightWindow.h"
 #include "uwb/io/UsdImport.h"
@@ -446,6 +448,48 @@ TEST(UsdImport, RealUtilFlightSurvivesTheRoundTripThroughEvents) {
   }
   // AND the imported flight's CSV reads back as the same flight
   EXPECT_TRUE(test::flightsIdentical(back, parseFlightCsv(formatFlightCsv(back), "roundtrip.csv")));
+}
+
+TEST(UsdDeckConfig, TheShippedConfigNamesOnlyWhatImportReadsAndItsLogImports) {
+  // GIVEN examples/usd/config.txt, read as the uSD deck's firmware reads it
+  const test::UsdDeckConfig config = test::readShippedUsdConfig();
+  EXPECT_EQ(config.version, 1);  // the only version the firmware accepts
+  EXPECT_GE(config.buffer_bytes, 1024);
+  EXPECT_LE(config.file_prefix.size(), 10u);  // the firmware's 13-byte name holds the prefix and two digits
+  std::vector<std::string> events;
+  for (const auto& e : config.events) events.push_back(e.first);
+  EXPECT_EQ(events, (std::vector<std::string>{"estTDOA", "estAcceleration", "estGyroscope", "estTOF", "estPose"}));
+  // THEN every event and variable it names is one that import reads: payload + variables are a recording's fields
+  const std::vector<UsdRecording> table = usdRecordings();
+  for (const auto& [event, variables] : config.events) {
+    std::vector<std::string> fields = test::firmwarePayload(event);
+    fields.insert(fields.end(), variables.begin(), variables.end());
+    const bool read = std::any_of(table.begin(), table.end(), [&](const UsdRecording& r) {
+      return r.event == event && r.fields == fields;
+    });
+    EXPECT_TRUE(read) << event << " with " << fields.size() << " fields is not a recording import reads";
+    for (const std::string& v : variables) {
+      const bool known = std::any_of(table.begin(), table.end(), [&](const UsdRecording& r) {
+        return r.event == event && std::find(r.fields.begin(), r.fields.end(), v) != r.fields.end();
+      });
+      EXPECT_TRUE(known) << event << " variable " << v;
+    }
+  }
+  // AND a log written with exactly those names (the utilStyleLog flight through the config) imports: TDoA, IMU,
+  // downward range and the mocap pose with its orientation, nothing left out
+  const Flight flight = flightFromUsdLog(utilStyleLog());
+  const UsdLog log = test::usdLogThroughConfig(flight, config);
+  EXPECT_EQ(log.types.size(), 5u);
+  UsdImportReport report;
+  const Flight back = flightFromUsdLog(parseUsdLog(formatUsdLog(log), "config.log"), &report);
+  EXPECT_EQ(back.tdoa.size(), 2u);
+  EXPECT_EQ(back.acc.size(), 2u);
+  EXPECT_EQ(back.gyro.size(), 2u);
+  EXPECT_EQ(back.tof.size(), 2u);
+  EXPECT_EQ(back.pose.size(), 2u);
+  EXPECT_TRUE(back.pose_has_orientation);
+  EXPECT_TRUE(report.notes.empty()) << report.notes.front();
+  EXPECT_EQ(report.sources.size(), 5u);
 }
 
 // ------------------------------------------------------------------------------------------------ CLI

@@ -1,10 +1,12 @@
 /** @file LocalizeCliTest.cpp
  *  @brief `uwbtdoa localize` on a real flight through the command line: the ToF option by flag and by config file
  *         (docs/math/filter.md F21), its counters in --json, a config key that does not exist, and --window (a
- *         part of a log, started in the air).
+ *         part of a log, started in the air), and --format tum (the poses of the CSV, for evo).
  */
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -13,6 +15,7 @@
 #include <unistd.h>
 
 #include "support/TestSupport.h"
+#include "uwb/io/TrajectoryCsv.h"
 
 namespace uwb {
 namespace {
@@ -118,6 +121,38 @@ TEST_F(LocalizeCli, AWindowThatIsReversedOrHoldsNoTdoaIsAClearError) {
   const test::CliResult r = test::runCli("localize " + flight_->string() + " --anchors " +
                                          test::pilotSurvey("0425").string() + " --window 500,600");
   EXPECT_NE(r.err.find("0.000 to 31.845 s"), std::string::npos) << r.err;
+}
+
+TEST_F(LocalizeCli, TumOutputHoldsTheSamePosesAsTheCsv) {
+  // GIVEN the trajectory of a real flight written as CSV and, by a second run, as TUM (`--format tum`, for evo)
+  const std::string csv = (dir_ / "traj.csv").string(), tum = (dir_ / "traj.tum").string();
+  localize("--no-diagnostics --out " + csv);
+  localize("--no-diagnostics --format tum --out " + tum);
+  // WHEN both are read back
+  const Trajectory a = readTrajectoryCsv(csv);
+  const Trajectory b = readTrajectoryTum(tum);
+  // THEN the same samples: times, positions and quaternions agree to 1e-9
+  ASSERT_GT(a.size(), 1000u);
+  ASSERT_EQ(a.size(), b.size());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    worst = std::max(worst, std::abs(a[i].t_s - b[i].t_s));
+    worst = std::max(worst, (a[i].w_p_b - b[i].w_p_b).cwiseAbs().maxCoeff());
+    worst = std::max(worst, (a[i].w_q_b.coeffs() - b[i].w_q_b.coeffs()).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LE(worst, 1e-9);
+  // AND every TUM line is 8 space-separated numbers after the column comment
+  std::ifstream in(tum);
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line, "# timestamp tx ty tz qx qy qz qw");
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(std::count(line.begin(), line.end(), ' '), 7) << line;
+  EXPECT_EQ(line.find(','), std::string::npos) << line;
+  // AND an unknown format is refused before anything runs
+  const test::CliResult r = test::runCli("localize " + flight_->string() + " --anchors " +
+                                         test::pilotSurvey("0425").string() + " --format kitti --out " + csv);
+  EXPECT_NE(r.exit_code, 0);
 }
 
 }  // namespace

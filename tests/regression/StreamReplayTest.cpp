@@ -62,13 +62,16 @@ std::vector<LocalizerEstimate> parseLines(const std::string& text, EstimateForma
 }
 
 TEST_F(StreamCli, ReplayIntoStreamGivesTheBatchEstimates) {
-  for (const char* format : {"json", "csv"}) {
+  for (const char* format : {"json", "csv", "tum"}) {
     // GIVEN 5 s of a real flight, replayed at full speed into `stream`
     const test::CliResult r = test::runCli("replay " + short_ + " --speed max | " + test::cliPath() +
                                            " stream --anchors " + survey_ + " --output-period 0.01 --format " + format);
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    const EstimateFormat f = std::string(format) == "csv" ? EstimateFormat::kCsv : EstimateFormat::kJson;
-    const std::vector<LocalizerEstimate> streamed = parseLines(r.out, f, f == EstimateFormat::kCsv);
+    const std::string format_name = format;
+    const EstimateFormat f = format_name == "csv"   ? EstimateFormat::kCsv
+                             : format_name == "tum" ? EstimateFormat::kTum
+                                                    : EstimateFormat::kJson;
+    const std::vector<LocalizerEstimate> streamed = parseLines(r.out, f, f != EstimateFormat::kJson);
     // WHEN the batch path runs on the same flight's events
     const EkfParams p;
     const LocalizerResult batch =
@@ -81,6 +84,8 @@ TEST_F(StreamCli, ReplayIntoStreamGivesTheBatchEstimates) {
     for (std::size_t i = 0; i < streamed.size(); ++i) {
       ASSERT_EQ(streamed[i].t_s, batch.estimates[i].t_s) << i;
       worst_m = std::max(worst_m, (streamed[i].x.w_p_b - batch.estimates[i].x.w_p_b).norm());
+      worst_m = std::max(worst_m, (streamed[i].x.w_q_b.coeffs() - batch.estimates[i].x.w_q_b.coeffs()).norm());
+      if (f == EstimateFormat::kTum) continue;  // TUM carries the pose only
       worst_cov = std::max(worst_cov, (streamed[i].cov_pose - batch.estimates[i].cov_pose).cwiseAbs().maxCoeff());
       EXPECT_EQ(streamed[i].phase, batch.estimates[i].phase) << i;
     }

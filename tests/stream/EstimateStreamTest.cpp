@@ -4,8 +4,10 @@
  */
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
+#include "uwb/core/Error.h"
 #include "uwb/eval/Localization.h"
 #include "uwb/filter/TdoaLocalizer.h"
 #include "uwb/sim/FlightSimulator.h"
@@ -123,6 +125,15 @@ TEST(EstimateFormat, JsonAndCsvLinesReadBackBitForBit) {
     EXPECT_EQ(back.cov_pose, e.cov_pose);
     EXPECT_EQ(back.phase, e.phase);
   }
+  // AND a TUM line (t x y z qx qy qz qw, for evo) gives back the same time and pose
+  const std::string tum = formatEstimate(e, EstimateFormat::kTum);
+  EXPECT_EQ(std::count(tum.begin(), tum.end(), ' '), 7);
+  const LocalizerEstimate pose = parseEstimate(tum, EstimateFormat::kTum);
+  EXPECT_EQ(pose.t_s, e.t_s);
+  EXPECT_EQ(pose.x.w_p_b, e.x.w_p_b);
+  EXPECT_EQ(pose.x.w_q_b.coeffs(), e.x.w_q_b.coeffs());
+  EXPECT_EQ(estimateHeader(EstimateFormat::kTum), "# timestamp tx ty tz qx qy qz qw");
+  EXPECT_THROW((void)parseEstimate("1 2 3", EstimateFormat::kTum), InputError);
   // AND the CSV header has as many columns as a row
   const std::string row = formatEstimate(e, EstimateFormat::kCsv);
   const std::string header = estimateCsvHeader();

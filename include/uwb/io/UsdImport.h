@@ -39,6 +39,16 @@ struct UsdImportReport {
   double t0_us = 0.0;              ///< the log timestamp taken as t = 0 [µs]
 };
 
+/// One way a stream can be recorded in a log: the event type and the fields the import reads from it.
+struct UsdRecording {
+  Stream stream = Stream::kTdoa;
+  std::string event;                ///< e.g. "estTOF"
+  std::vector<std::string> fields;  ///< e.g. {"range.zrange"}
+};
+/// Every recording the import reads, in the order it tries them (the table above; docs/io.md §6). A uSD-deck
+/// config.txt that names only these event types and variables gives a log `import` reads (examples/usd/config.txt).
+std::vector<UsdRecording> usdRecordings();
+
 /// The flight held by a log. InputError ("file: byte B, event K (type.field): ...") on a value the flight CSV
 /// would refuse: NaN/Inf, an anchor id that is not an integer in [0, kMaxAnchorId], a pose quaternion far from unit
 /// norm; and when no event type of the table above carries data. Event types outside the table are noted.
