@@ -658,8 +658,8 @@ void bindIo(py::module_& m) {
       [](const AnchorSurvey& survey, const Flight* flight, const py::object& positions) {
         std::vector<Vec3> p;
         if (!positions.is_none()) {
-          const RowMat m = toMatrix(positions, 3, "positions");
-          for (Eigen::Index i = 0; i < m.rows(); ++i) p.push_back(m.row(i).transpose());
+          const RowMat rows = toMatrix(positions, 3, "positions");
+          for (Eigen::Index i = 0; i < rows.rows(); ++i) p.push_back(rows.row(i).transpose());
         } else if (flight) {
           for (const PoseSample& s : flight->pose) p.push_back(s.w_p_b);
         }

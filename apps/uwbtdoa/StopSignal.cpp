@@ -4,8 +4,10 @@
 #include "StopSignal.h"
 
 #include <signal.h>
+#include <sys/wait.h>
 
 #include <cstring>
+#include <ctime>
 
 #include "uwb/io/FileAccess.h"
 
@@ -38,8 +40,21 @@ namespace {
 
 volatile std::sig_atomic_t g_child = 0;
 
+/// Stops the child and waits for it (up to 2 s, then SIGKILL), so that it cannot create a file after the temporary
+/// files are removed. Only async-signal-safe calls.
+void stopChild(pid_t child) {
+  ::kill(child, SIGTERM);
+  const struct timespec step{0, 10'000'000};  // 10 ms
+  for (int i = 0; i < 200; ++i) {
+    if (::waitpid(child, nullptr, WNOHANG) != 0) return;  // reaped, or not ours to wait for
+    ::nanosleep(&step, nullptr);
+  }
+  ::kill(child, SIGKILL);
+  ::waitpid(child, nullptr, 0);
+}
+
 extern "C" void onFatalSignal(int sig) {
-  if (const pid_t child = static_cast<pid_t>(g_child); child > 0) ::kill(child, SIGTERM);
+  if (const pid_t child = static_cast<pid_t>(g_child); child > 0) stopChild(child);
   uwb::removeTemporaryFilesOnSignal();
   std::signal(sig, SIG_DFL);  // async-signal-safe; then die of the same signal (the parent sees it)
   std::raise(sig);

@@ -14,6 +14,7 @@
 #include "uwb/io/JsonFile.h"
 #include "uwb/io/PoseTrack.h"
 #include "uwb/io/ResidualStats.h"
+#include "uwb/io/SurveyCheck.h"
 #include "uwb/io/TrajectoryCsv.h"
 #include "uwb/io/UsdImport.h"
 #include "uwb/io/UsdLog.h"

@@ -59,6 +59,23 @@ SurveyGeometry surveyGeometry(const AnchorSurvey& survey) {
   return g;
 }
 
+std::vector<InputIssue> checkAnchorSeparation(const AnchorSurvey& survey, double min_separation_m) {
+  std::vector<InputIssue> out;
+  const auto& a = survey.anchors;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (std::size_t j = i + 1; j < a.size(); ++j) {
+      const double d = (a[i].w_p - a[j].w_p).norm();
+      if (d < min_separation_m) {
+        out.push_back(issue(IssueSeverity::kWarning, survey.source, "",
+                            fmt::format("anchors {} and {} are {:.3f} m apart (< {} m): colocated, or one place "
+                                        "surveyed twice; their TDoA carry almost no position information",
+                                        a[i].id, a[j].id, d, min_separation_m)));
+      }
+    }
+  }
+  return out;
+}
+
 std::vector<InputIssue> checkSurveyGeometry(const AnchorSurvey& survey) {
   std::vector<InputIssue> out;
   const SurveyGeometry g = surveyGeometry(survey);
@@ -91,19 +108,8 @@ std::vector<InputIssue> checkSurveyGeometry(const AnchorSurvey& survey) {
                                     "normal to their plane is poorly observable",
                                     s(2), kMinAnchorDepth_m)));
   }
-  for (std::size_t i = 0; i < survey.anchors.size(); ++i) {
-    for (std::size_t k = i + 1; k < survey.anchors.size(); ++k) {
-      const Anchor& a = survey.anchors[i];
-      const Anchor& b = survey.anchors[k];
-      const double d = (a.w_p - b.w_p).norm();
-      if (d < kMinAnchorSeparation_m) {
-        out.push_back(issue(IssueSeverity::kWarning, file, "",
-                            fmt::format("anchors {} and {} are {:.3f} m apart (< {} m): one place surveyed twice? Their "
-                                        "TDoA carry no position information",
-                                        a.id, b.id, d, kMinAnchorSeparation_m)));
-      }
-    }
-  }
+  const std::vector<InputIssue> close = checkAnchorSeparation(survey);
+  out.insert(out.end(), close.begin(), close.end());
   if (s(0) > kMaxAnchorSpread_m) {
     // an error: no position found against such a survey means anything (a survey scaled ×1e9 put the estimate 1.5e9 m
     // up with exit 0)

@@ -195,22 +195,6 @@ std::string formatCfclientAnchors(const AnchorSurvey& survey) {
   return out;
 }
 
-std::vector<InputIssue> checkAnchorSeparation(const AnchorSurvey& survey, double min_separation_m) {
-  std::vector<InputIssue> out;
-  const auto& a = survey.anchors;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    for (std::size_t j = i + 1; j < a.size(); ++j) {
-      const double d = (a[i].w_p - a[j].w_p).norm();
-      if (d < min_separation_m) {
-        out.push_back(warning(survey.source,
-                              fmt::format("anchors {} and {} are {:.3f} m apart (< {} m): colocated, their TDoA carry "
-                                          "almost no position information; is one of them mis-entered?",
-                                          a[i].id, a[j].id, d, min_separation_m)));
-      }
-    }
-  return out;
-}
-
 std::vector<InputIssue> checkAnchorPlane(const AnchorSurvey& survey) {
   std::vector<InputIssue> out;
   const std::size_t n = survey.anchors.size();
@@ -306,7 +290,6 @@ std::vector<InputIssue> checkSurvey(const AnchorSurvey& survey, const Flight* fl
     return i.severity == IssueSeverity::kWarning && i.message.find("coplanar") != std::string::npos;
   });
   const auto add = [&](const std::vector<InputIssue>& v) { out.insert(out.end(), v.begin(), v.end()); };
-  add(checkAnchorSeparation(survey));
   add(checkAnchorPlane(survey));
   if (flight != nullptr) add(checkFlightAnchorIds(survey, *flight));
   add(checkFlightInsideAnchors(survey, w_p_flight, positions_source));

@@ -45,12 +45,16 @@ inline constexpr double kMinAnchorDepth_m = 0.2;
 /// Largest principal std beyond this: not one UWB arena (an error) [m].
 inline constexpr double kMaxAnchorSpread_m = 500.0;
 
-/// Two anchors closer than this are one place surveyed twice (a copy-paste error): warning naming both [m].
-inline constexpr double kMinAnchorSeparation_m = 0.1;
+/// Two anchors closer than this are colocated or one place surveyed twice: their TDoA carry almost no position
+/// information (warning naming both) [m].
+inline constexpr double kMinAnchorSeparation_m = 0.3;
 /// An IMU stream that ends this long before the TDoA stream leaves the rest of the flight without it (warning) [s].
 inline constexpr double kMaxImuEndGap_s = 1.0;
 
 SurveyGeometry surveyGeometry(const AnchorSurvey& survey);
+/// Pairs of anchors closer than min_separation_m: a warning each, with the distance.
+std::vector<InputIssue> checkAnchorSeparation(const AnchorSurvey& survey,
+                                              double min_separation_m = kMinAnchorSeparation_m);
 /// Errors: fewer than 2 anchors, all at one point, on one line. Warnings: fewer than 4 anchors (no 3-D
 /// multilateration), coplanar, spread beyond kMaxAnchorSpread_m, two anchors closer than kMinAnchorSeparation_m.
 std::vector<InputIssue> checkSurveyGeometry(const AnchorSurvey& survey);

@@ -35,17 +35,12 @@ AnchorSurvey readCfclientAnchors(const std::string& path);
 /// The same file format, as cfclient writes it (block style), for tests and round trips.
 std::string formatCfclientAnchors(const AnchorSurvey& survey);
 
-/// Anchors closer than this are "colocated": their TDoA carry almost no position information [m].
-inline constexpr double kMinAnchorSeparation_m = 0.3;
 /// A flight position outside the anchors' box by more than this counts as outside [m] (a drone on the floor below
 /// anchors mounted 0.2 m high is not).
 inline constexpr double kFlightOutsideMargin_m = 0.25;
 /// Share of the flight's positions outside the anchors' box above which it is a warning.
 inline constexpr double kMaxShareOutside = 0.01;
 
-/// Pairs of anchors closer than min_separation_m (warning each, with the distance).
-std::vector<InputIssue> checkAnchorSeparation(const AnchorSurvey& survey,
-                                              double min_separation_m = kMinAnchorSeparation_m);
 /// All anchors within ±kMinAnchorDepth_m of one plane: a warning naming the plane, its normal and the axis that is
 /// poorly observed (the vertical when the plane is near horizontal). Nothing for fewer than 4 anchors.
 std::vector<InputIssue> checkAnchorPlane(const AnchorSurvey& survey);
@@ -57,7 +52,7 @@ std::vector<InputIssue> checkFlightInsideAnchors(const AnchorSurvey& survey, con
                                                  const std::string& source);
 
 /// Every check of `uwbtdoa survey`, in its order: checkSurveyGeometry (errors: fewer than 2 anchors, all at one
-/// point, on one line; its coplanar warning replaced by checkAnchorPlane's), checkAnchorSeparation,
+/// point, on one line; its coplanar warning replaced by checkAnchorPlane's), with checkAnchorSeparation,
 /// checkAnchorPlane, then with a flight checkFlightAnchorIds, and checkFlightInsideAnchors on `w_p_flight` (none:
 /// no volume check) named `positions_source`.
 std::vector<InputIssue> checkSurvey(const AnchorSurvey& survey, const Flight* flight,
