@@ -22,6 +22,7 @@
 #include "uwb/io/PoseTrack.h"
 #include "uwb/io/UsdImport.h"
 #include "uwb/io/UtilCsv.h"
+#include "uwb/sim/TdoaResiduals.h"
 
 namespace uwb::python {
 namespace {

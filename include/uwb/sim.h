@@ -11,4 +11,5 @@
 #include "uwb/sim/SimParams.h"
 #include "uwb/sim/SimulatedBias.h"
 #include "uwb/sim/Swarm.h"
+#include "uwb/sim/TdoaResiduals.h"
 #include "uwb/sim/Trajectory.h"
