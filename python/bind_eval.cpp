@@ -6,6 +6,7 @@
  *    id_a, id_b (int32), yaw_a, yaw_b [rad], b_p_a, b_p_b (N, 3) [m, body frame], w_p_b (N, 3) [m, world],
  *    w_p_anchor_a, w_p_anchor_b (N, 3) [m, world]. A key that the model's feature map reads must be present.
  */
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <map>
@@ -200,7 +201,7 @@ py::object jsonToPythonKeepingNan(const nlohmann::json& j) {
     }
     case nlohmann::json::value_t::object: {
       py::dict d;
-      for (const auto& [k, v] : j.items()) d[py::str(k)] = jsonToPythonKeepingNan(v);
+      for (auto it = j.begin(); it != j.end(); ++it) d[py::str(it.key())] = jsonToPythonKeepingNan(it.value());
       return d;
     }
     default: return py::none();
