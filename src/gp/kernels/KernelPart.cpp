@@ -66,6 +66,12 @@ MatX activeColumns(const MatX& X, const std::vector<int>& dims) {
 
 // ---- radial parts (rbf, matern52): ρ² = Σ_d ((a_d − b_d)/l_d)² (P2, P3) ----
 
+LengthscalePart::LengthscalePart(const PartSpec& spec, const std::string& prefix, ParamList& params)
+    : KernelPart(spec.active_dims, static_cast<int>(params.values.size())) {
+  params.add(prefix, "sigma2", spec.sigma2, true);
+  n_l_ = params.addList(prefix, "l", spec.l, static_cast<int>(spec.active_dims.size()), true);
+}
+
 PartSpec LengthscalePart::lengthscaleSpec(const VecX& theta) const {
   PartSpec s;
   s.type = type();

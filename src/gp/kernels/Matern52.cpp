@@ -25,10 +25,7 @@ struct Matern52Prepared final : PreparedBlock {
 }  // namespace
 
 Matern52Part::Matern52Part(const PartSpec& spec, const std::string& prefix, ParamList& params)
-    : LengthscalePart(spec.active_dims, static_cast<int>(params.values.size()), 0) {
-  params.add(prefix, "sigma2", spec.sigma2, true);
-  n_l_ = params.addList(prefix, "l", spec.l, static_cast<int>(spec.active_dims.size()), true);
-}
+    : LengthscalePart(spec, prefix, params) {}
 
 PartSpec Matern52Part::spec(const VecX& theta, const std::vector<bool>&) const { return lengthscaleSpec(theta); }
 
@@ -39,12 +36,12 @@ MatX Matern52Part::block(const MatX& A, const MatX& B, const VecX& theta) const 
   return K;
 }
 
-std::unique_ptr<PreparedBlock> Matern52Part::prepare(const MatX& A, const MatX& B, const VecX& theta) const {
+std::unique_ptr<PreparedBlock> Matern52Part::prepare(MatX A, MatX B, const VecX& theta) const {
   auto q = std::make_unique<Matern52Prepared>();
-  q->A = A;
-  q->B = B;
+  q->A = std::move(A);
+  q->B = std::move(B);
   divideByLengthscales(q->A, q->B, theta);
-  q->scratch.resize(A.rows());
+  q->scratch.resize(q->A.rows());
   return q;
 }
 

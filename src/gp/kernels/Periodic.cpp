@@ -24,11 +24,8 @@ struct PeriodicPrepared final : PreparedBlock {
 }  // namespace
 
 PeriodicPart::PeriodicPart(const PartSpec& spec, const std::string& prefix, ParamList& params)
-    : LengthscalePart(spec.active_dims, static_cast<int>(params.values.size()), 0) {
-  const int nd = static_cast<int>(spec.active_dims.size());
-  params.add(prefix, "sigma2", spec.sigma2, true);
-  n_l_ = params.addList(prefix, "l", spec.l, nd, true);
-  n_T_ = params.addList(prefix, "T", spec.T, nd, spec.train_period);
+    : LengthscalePart(spec, prefix, params) {
+  n_T_ = params.addList(prefix, "T", spec.T, static_cast<int>(spec.active_dims.size()), spec.train_period);
 }
 
 PartSpec PeriodicPart::spec(const VecX& theta, const std::vector<bool>& trainable) const {
@@ -53,10 +50,10 @@ MatX PeriodicPart::block(const MatX& A, const MatX& B, const VecX& theta) const 
   return K;
 }
 
-std::unique_ptr<PreparedBlock> PeriodicPart::prepare(const MatX& A, const MatX& B, const VecX&) const {
+std::unique_ptr<PreparedBlock> PeriodicPart::prepare(MatX A, MatX B, const VecX&) const {
   auto q = std::make_unique<PeriodicPrepared>();
-  q->A = A;
-  q->B = B;
+  q->A = std::move(A);
+  q->B = std::move(B);
   return q;
 }
 

@@ -72,10 +72,7 @@ struct RbfPrepared final : PreparedBlock {
 }  // namespace
 
 RbfPart::RbfPart(const PartSpec& spec, const std::string& prefix, ParamList& params)
-    : LengthscalePart(spec.active_dims, static_cast<int>(params.values.size()), 0) {
-  params.add(prefix, "sigma2", spec.sigma2, true);
-  n_l_ = params.addList(prefix, "l", spec.l, static_cast<int>(spec.active_dims.size()), true);
-}
+    : LengthscalePart(spec, prefix, params) {}
 
 PartSpec RbfPart::spec(const VecX& theta, const std::vector<bool>&) const { return lengthscaleSpec(theta); }
 
@@ -85,12 +82,11 @@ MatX RbfPart::block(const MatX& A, const MatX& B, const VecX& theta) const {
   return K;
 }
 
-std::unique_ptr<PreparedBlock> RbfPart::prepare(const MatX& A, const MatX& B, const VecX& theta) const {
+std::unique_ptr<PreparedBlock> RbfPart::prepare(MatX A, MatX B, const VecX& theta) const {
   auto q = std::make_unique<RbfPrepared>();
-  q->A = A;
-  MatX Bs = B;
-  divideByLengthscales(q->A, Bs, theta);
-  q->Bt = Bs.transpose();
+  q->A = std::move(A);
+  divideByLengthscales(q->A, B, theta);
+  q->Bt = B.transpose();
   q->cf = ScaledExpCoefs(theta[offset_]);
   return q;
 }

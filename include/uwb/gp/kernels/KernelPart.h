@@ -87,11 +87,22 @@ class KernelPart {
   int offset_ = 0;
 };
 
+/// The overrides every part type declares; each part's own file defines them (kernels/Rbf.cpp, ...).
+#define UWB_KERNEL_PART_OVERRIDES                                                                                    \
+  PartSpec spec(const VecX& theta, const std::vector<bool>& trainable) const override;                             \
+  MatX block(const MatX& A, const MatX& B, const VecX& theta) const override;                                      \
+  std::unique_ptr<PreparedBlock> prepare(MatX A, MatX B, const VecX& theta) const override;                        \
+  void column(const PreparedBlock& prepared, Eigen::Index j, const VecX& theta, double* out) const override;       \
+  void multiplyChunk(const MatX& X1, Eigen::Index i0, const Eigen::Ref<const RowVecX>& x, const VecX& theta,        \
+                     Chunk& prod) const override;                                                                  \
+  void accumulateGradient(const MatX& A, const MatX& B, const MatX& H, const MatX& W, const VecX& theta,           \
+                          VecX& grad_theta, MatX* grad_X1) const override;
+
 /// Shared by the parts with lengthscales (rbf, matern52, periodic): σ² at offset, then n_l lengthscales.
 class LengthscalePart : public KernelPart {
  protected:
-  LengthscalePart(std::vector<int> active_dims, int offset, int n_l)
-      : KernelPart(std::move(active_dims), offset), n_l_(n_l) {}
+  /// Appends sigma2 and l (1 or one per active dim) to params.
+  LengthscalePart(const PartSpec& spec, const std::string& prefix, ParamList& params);
   /// θ index of the lengthscale of active dimension d (one shared, or one per dimension).
   Eigen::Index lengthscaleIndex(Eigen::Index d) const { return offset_ + 1 + (n_l_ == 1 ? 0 : d); }
   /// σ² and l of the spec.

@@ -13,14 +13,7 @@ class PeriodicPart final : public LengthscalePart {
   /// Parameters: sigma2, l, T (1 or one per active dim each; T trainable only with spec.train_period).
   PeriodicPart(const PartSpec& spec, const std::string& prefix, ParamList& params);
   PartType type() const override { return PartType::kPeriodic; }
-  PartSpec spec(const VecX& theta, const std::vector<bool>& trainable) const override;
-  MatX block(const MatX& A, const MatX& B, const VecX& theta) const override;
-  std::unique_ptr<PreparedBlock> prepare(MatX A, MatX B, const VecX& theta) const override;
-  void column(const PreparedBlock& prepared, Eigen::Index j, const VecX& theta, double* out) const override;
-  void multiplyChunk(const MatX& X1, Eigen::Index i0, const Eigen::Ref<const RowVecX>& x, const VecX& theta,
-                     Chunk& prod) const override;
-  void accumulateGradient(const MatX& A, const MatX& B, const MatX& H, const MatX& W, const VecX& theta,
-                          VecX& grad_theta, MatX* grad_X1) const override;
+  UWB_KERNEL_PART_OVERRIDES
 
   static void specToJson(const PartSpec& spec, nlohmann::json& jp);
   static void specFromJson(const nlohmann::json& src, const nlohmann::json& jp, PartSpec& spec);
