@@ -15,26 +15,10 @@
 namespace uwb {
 namespace {
 
-Quat yaw(double rad) { return Quat(Eigen::AngleAxisd(rad, Vec3::UnitZ())); }
-Quat roll(double rad) { return Quat(Eigen::AngleAxisd(rad, Vec3::UnitX())); }
-
-/// A circle at 1.5 m height, radius 1.5 m, ω rad/s, sampled at `rate_hz`, yawing slowly.
-std::vector<PoseSample> circle(double rate_hz, double duration_s, double omega = 1.0) {
-  std::vector<PoseSample> out;
-  for (int i = 0; i * (1.0 / rate_hz) <= duration_s; ++i) {
-    const double t = i / rate_hz;
-    out.push_back({t, Vec3(1.5 * std::cos(omega * t), 1.5 * std::sin(omega * t), 1.5), yaw(0.1 * t)});
-  }
-  return out;
-}
-
-AnchorSurvey cornerSurvey() {
-  AnchorSurvey s;
-  const double z[8] = {0.2, 2.9, 0.2, 3.2, 3.0, 0.2, 3.1, 0.2};
-  const double xy[8][2] = {{-3, -4}, {-3.2, 3.8}, {3.7, 3.7}, {4.1, -4.3}, {-3, -4.4}, {3.9, -3.8}, {4, 3.9}, {-3.2, 3.3}};
-  for (int i = 0; i < 8; ++i) s.anchors.push_back({i, Vec3(xy[i][0], xy[i][1], z[i]), Quat::Identity()});
-  return s;
-}
+using test::circle;
+using test::cornerSurvey;
+using test::roll;
+using test::yaw;
 
 TEST(PoseTrack, InterpolatesPositionLinearlyAndAttitudeBySlerp) {
   // GIVEN two samples 10 ms apart, yaw 0 → 0.2 rad
