@@ -8,9 +8,10 @@
  *   - ledergerber k = θ0 exp(−(1 − xᵀx'/(‖x‖‖x'‖))/θ1 − (‖x‖ − ‖x'‖)²/θ2), x ∈ ℝ³  (paper k_L, eq. 9; P4)
  *  A kernel is Σ_terms Π_{parts in term} k_part (P5). Presets `z1`, `z2`, `tdoa` are the paper's eq. 7–9.
  *
- *  Each part type is its own class in its own file (gp/kernels/: Rbf, Matern52, Periodic, Ledergerber), with its
- *  value, analytic gradient and fast paths side by side; kernels/Product.h multiplies parts, this class sums the
- *  products and owns the parameters. The paper's compositions and the pair presets are named in kernels/Presets.h.
+ *  Each part type is its own class (kernels/Parts.h), defined in its own file (src/gp/kernels/: Rbf, Matern52,
+ *  Periodic, Ledergerber) with its value, analytic gradient and fast paths side by side; kernels/Product.h
+ *  multiplies parts, this class sums the products and owns the parameters. The paper's compositions and the pair
+ *  presets are named in kernels/Presets.h.
  *
  *  Design: a runtime composite over ONE flat vector of positive hyperparameters (values θ > 0, optimized in
  *  log-space: θ = exp(ξ), a smooth positive transform). Gram/cross matrices and their gradients are computed

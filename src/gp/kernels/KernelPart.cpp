@@ -8,10 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-#include "uwb/gp/kernels/Ledergerber.h"
-#include "uwb/gp/kernels/Matern52.h"
-#include "uwb/gp/kernels/Periodic.h"
-#include "uwb/gp/kernels/Rbf.h"
+#include "uwb/gp/kernels/Parts.h"
 
 namespace uwb::gp {
 

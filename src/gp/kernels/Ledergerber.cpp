@@ -1,7 +1,7 @@
 /** @file Ledergerber.cpp
  *  @brief The Ledergerber part: value (P4), gradient (P10), batch column (P32), one-point chunk.
  */
-#include "uwb/gp/kernels/Ledergerber.h"
+#include "uwb/gp/kernels/Parts.h"
 
 #include <nlohmann/json.hpp>
 #include <stdexcept>

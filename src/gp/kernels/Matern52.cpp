@@ -1,7 +1,7 @@
 /** @file Matern52.cpp
  *  @brief The Matérn-5/2 part: value (P2), gradient (P9), batch column (P32), one-point chunk.
  */
-#include "uwb/gp/kernels/Matern52.h"
+#include "uwb/gp/kernels/Parts.h"
 
 #include "ScaledExp.h"
 

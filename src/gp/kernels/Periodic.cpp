@@ -1,7 +1,7 @@
 /** @file Periodic.cpp
  *  @brief The periodic part: value (P1), gradient (P7), batch column (P32), one-point chunk.
  */
-#include "uwb/gp/kernels/Periodic.h"
+#include "uwb/gp/kernels/Parts.h"
 
 #include <nlohmann/json.hpp>
 

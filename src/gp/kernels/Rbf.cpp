@@ -1,7 +1,7 @@
 /** @file Rbf.cpp
  *  @brief The RBF part: value (P3), gradient (P8), batch column in one pass with e^x of P32, one-point chunk.
  */
-#include "uwb/gp/kernels/Rbf.h"
+#include "uwb/gp/kernels/Parts.h"
 
 #include "ScaledExp.h"
 
