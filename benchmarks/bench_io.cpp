@@ -12,6 +12,7 @@
 
 #include "uwb/io/PoseTrack.h"
 #include "uwb/io/UtilCsv.h"
+#include "uwb/sim/TdoaResiduals.h"
 
 namespace {
 

@@ -4,7 +4,7 @@
  *         plausibility checks, and a write/read round trip that must reproduce it).
  */
 #include "FuzzInput.h"
-#include "uwb/io/FlightSummary.h"
+#include "uwb/eval/FlightSummary.h"
 #include "uwb/io/InputChecks.h"
 #include "uwb/io/UtilCsv.h"
 

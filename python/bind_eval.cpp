@@ -6,6 +6,7 @@
  *    id_a, id_b (int32), yaw_a, yaw_b [rad], b_p_a, b_p_b (N, 3) [m, body frame], w_p_b (N, 3) [m, world],
  *    w_p_anchor_a, w_p_anchor_b (N, 3) [m, world]. A key that the model's feature map reads must be present.
  */
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <map>
@@ -18,6 +19,7 @@
 #include "uwb/eval/BiasModel.h"
 #include "uwb/eval/Evaluation.h"
 #include "uwb/eval/Localization.h"
+#include "uwb/eval/LocalizationJson.h"
 #include "uwb/eval/TrajectoryMetrics.h"
 #include "uwb/filter/EkfParamRegistry.h"
 #include "uwb/filter/EkfParams.h"
@@ -183,32 +185,32 @@ py::dict metricsDict(const TrajectoryMetrics& m) {
   return d;
 }
 
-py::dict summaryDict(const LocalizerSummary& s) {
-  py::dict d;
-  d["n_tdoa_total"] = s.n_tdoa_total, d["n_tdoa_used"] = s.n_tdoa_used, d["n_tdoa_rejected"] = s.n_tdoa_rejected;
-  d["n_tdoa_downweighted"] = s.n_tdoa_downweighted, d["n_tdoa_start"] = s.n_tdoa_start, d["n_tdoa_used_at_rest"] = s.n_tdoa_used_at_rest;
-  d["n_tdoa_degenerate"] = s.n_tdoa_degenerate, d["n_tdoa_unknown_anchor"] = s.n_tdoa_unknown_anchor;
-  d["n_predictions"] = s.n_predictions, d["n_covariance_propagations"] = s.n_covariance_propagations;
-  d["n_reacquisitions"] = s.n_reacquisitions, d["n_rejection_faults"] = s.n_rejection_faults;
-  d["n_reverted_motion"] = s.n_reverted_motion, d["start_replayed"] = s.start_replayed;
-  d["start_floor_refuted"] = s.start_floor_refuted;
-  d["n_heading_alignments"] = s.n_heading_alignments;
-  d["heading_alignment_t_s"] = s.heading_alignment_t_s;
-  d["heading_alignment_change_rad"] = s.heading_alignment_change_rad;
-  d["bias_level_m"] = s.bias_level_m, d["n_bias_level_windows"] = s.n_bias_level_windows;
-  d["raw_bias_level_m"] = s.raw_bias_level_m, d["bias_model_mean_scale"] = s.bias_model_mean_scale;
-  d["min_bias_model_mean_scale"] = s.min_bias_model_mean_scale, d["model_mean_level_m"] = s.model_mean_level_m;
-  d["bias_model_level_variance_m2"] = s.bias_model_level_variance_m2;
-  d["reacquisition_t_s"] = s.reacquisition_t_s;
-  d["reacquired_t_s"] = s.reacquired_t_s, d["takeoff_t_s"] = s.takeoff_t_s, d["landing_t_s"] = s.landing_t_s;
-  d["started_in_motion"] = s.started_in_motion, d["ready_t_s"] = s.ready_t_s;
-  d["ground_entered_t_s"] = s.ground_entered_t_s, d["ground_left_t_s"] = s.ground_left_t_s;
-  d["start_t_s"] = s.start_t_s, d["end_t_s"] = s.end_t_s, d["process_model"] = toString(s.process_model);
-  d["start_w_p_b"] = toNumpy(s.start_w_p_b, true), d["start_rms_residual_m"] = s.start_rms_residual_m;
-  d["n_tof_total"] = s.n_tof_total, d["n_tof_used"] = s.n_tof_used, d["n_tof_rejected"] = s.n_tof_rejected;
-  d["n_tof_invalid"] = s.n_tof_invalid, d["n_tof_tilted"] = s.n_tof_tilted;
-  d["n_tof_not_ready"] = s.n_tof_not_ready;
-  return d;
+/// JSON as Python objects, numbers kept as they are (NaN stays float('nan'); json.loads of the dump would give None).
+py::object jsonToPythonKeepingNan(const nlohmann::json& j) {
+  switch (j.type()) {
+    case nlohmann::json::value_t::null: return py::none();
+    case nlohmann::json::value_t::boolean: return py::bool_(j.get<bool>());
+    case nlohmann::json::value_t::number_integer: return py::int_(j.get<std::int64_t>());
+    case nlohmann::json::value_t::number_unsigned: return py::int_(j.get<std::uint64_t>());
+    case nlohmann::json::value_t::number_float: return py::float_(j.get<double>());
+    case nlohmann::json::value_t::string: return py::str(j.get<std::string>());
+    case nlohmann::json::value_t::array: {
+      py::list l;
+      for (const auto& v : j) l.append(jsonToPythonKeepingNan(v));
+      return l;
+    }
+    case nlohmann::json::value_t::object: {
+      py::dict d;
+      for (auto it = j.begin(); it != j.end(); ++it) d[py::str(it.key())] = jsonToPythonKeepingNan(it.value());
+      return d;
+    }
+    default: return py::none();
+  }
+}
+
+/// The run's summary: the keys of `uwbtdoa localize --json` (eval/LocalizationJson.h, one writer for both).
+py::object summaryDict(const LocalizerSummary& s, const EkfParams& params) {
+  return jsonToPythonKeepingNan(localizerSummaryJson(s, params));
 }
 
 py::dict trainReportDict(const BiasTrainReport& r) {
@@ -473,7 +475,7 @@ void bindEval(py::module_& m) {
         }
         py::dict d;
         d["trajectory"] = trajectoryToDict(run.trajectory);
-        d["summary"] = summaryDict(run.summary);
+        d["summary"] = summaryDict(run.summary, options.params);
         d["metrics"] = run.metrics ? py::object(metricsDict(*run.metrics)) : py::object(py::none());
         d["duration_s"] = run.duration_s, d["n_truth_glitches"] = run.n_truth_glitches;
         return d;

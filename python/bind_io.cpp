@@ -24,6 +24,7 @@
 #include "uwb/io/TrajectoryCsv.h"
 #include "uwb/io/UsdImport.h"
 #include "uwb/io/UtilCsv.h"
+#include "uwb/sim/TdoaResiduals.h"
 
 namespace uwb::python {
 namespace {

@@ -13,7 +13,7 @@
 #include "Command.h"
 #include "InputGuards.h"
 #include "uwb/io/FileAccess.h"
-#include "uwb/io/FlightSummary.h"
+#include "uwb/eval/FlightSummary.h"
 #include "uwb/io/InputChecks.h"
 #include "uwb/io/UsdImport.h"
 #include "uwb/io/UtilCsv.h"

@@ -1,7 +1,7 @@
 /** @file cmd_inspect.cpp
  *  @brief `uwbtdoa inspect FLIGHT.csv [--anchors SURVEY.txt] [--json]`: streams, TDoA pairs, reader notes, pose
  *  glitches and the TDoA residual against ground truth. The numbers come from uwb::summarizeFlight
- *  (io/FlightSummary.h); this file only formats them (docs/io.md, "inspect").
+ *  (eval/FlightSummary.h); this file only formats them (docs/io.md, "inspect").
  */
 #include <fmt/format.h>
 
@@ -10,7 +10,7 @@
 #include <string>
 
 #include "Command.h"
-#include "uwb/io/FlightSummary.h"
+#include "uwb/eval/FlightSummary.h"
 #include "uwb/io/InputChecks.h"
 #include "uwb/io/UtilCsv.h"
 #include "InputGuards.h"

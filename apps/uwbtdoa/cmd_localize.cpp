@@ -21,6 +21,7 @@
 #include "uwb/core/Error.h"
 #include "uwb/eval/BiasModel.h"
 #include "uwb/eval/Localization.h"
+#include "uwb/eval/LocalizationJson.h"
 #include "uwb/eval/RunDiagnostics.h"
 #include "uwb/filter/EkfParamRegistry.h"
 #include "uwb/io/FileAccess.h"
@@ -36,61 +37,6 @@
 namespace {
 
 using nlohmann::json;
-
-json vecJson(const uwb::Vec3& v) { return {v.x(), v.y(), v.z()}; }
-
-/// The checks of eval/RunDiagnostics.h as JSON (null for a check that did not run).
-json diagnosticsJson(const uwb::RunDiagnostics& d) {
-  json j;
-  const uwb::SurveyFitCheck& s = d.survey;
-  j["survey_fit"] = !s.done ? json(nullptr)
-                            : json{{"n", s.n},
-                                   {"residual_rms_m", s.truncated_rms_m},
-                                   {"gross_fraction", s.gross_fraction},
-                                   {"inlier_rms_m", s.inlier_rms_m},
-                                   {"start_rms_residual_m", s.start_rms_residual_m},
-                                   {"misfit", s.misfit},
-                                   {"mean_error_vs_truth_m", s.has_truth ? vecJson(s.mean_error_m) : json(nullptr)},
-                                   {"frame_offset", s.frame_offset}};
-  if (d.anchors.done) {
-    json per = json::array();
-    for (const uwb::AnchorOffset& o : d.anchors.anchors)
-      per.push_back({{"id", o.id},
-                     {"n", o.n},
-                     {"offset_m", vecJson(o.offset_m)},
-                     {"offset_norm_m", o.offset_m.norm()},
-                     {"rms_before_m", o.rms_before_m},
-                     {"rms_after_m", o.rms_after_m},
-                     {"gain_m", o.gain_m()}});
-    j["anchor_survey"] = {{"anchors", per},
-                          {"named_anchor", d.anchors.named_id >= 0 ? json(d.anchors.named_id) : json(nullptr)},
-                          {"named_offset_m", d.anchors.named_id >= 0 ? vecJson(d.anchors.named_offset_m) : json(nullptr)},
-                          {"top_gain_m", d.anchors.top_gain_m},
-                          {"gain_ratio", d.anchors.named_ratio}};
-  } else {
-    j["anchor_survey"] = nullptr;
-  }
-  j["clock_offset"] = !d.clock.done ? json(nullptr)
-                                    : json{{"lags_s", d.clock.lags_s},
-                                           {"residual_rms_m", d.clock.rms_m},
-                                           {"best_lag_s", d.clock.best_lag_s},
-                                           {"power_ratio", d.clock.power_ratio},
-                                           {"offset_detected", d.clock.offset}};
-  return j;
-}
-
-json statsJson(const uwb::PositionErrorStats& s) {
-  return {{"n", s.n},
-          {"rmse_m", s.rmse_m},
-          {"rmse_x_m", s.rmse_axis_m.x()},
-          {"rmse_y_m", s.rmse_axis_m.y()},
-          {"rmse_z_m", s.rmse_axis_m.z()},
-          {"mean_m", s.mean_m},
-          {"p50_m", s.p50_m},
-          {"p90_m", s.p90_m},
-          {"p99_m", s.p99_m},
-          {"max_m", s.max_m}};
-}
 
 struct LocalizeArgs {
   std::string flight, anchors, out, plot;
@@ -251,83 +197,22 @@ void runLocalize(const LocalizeArgs& a) {
   if (s.n_time_jumps > 0)
     warnings.add(std::to_string(s.n_time_jumps) + " sensor-time gap(s) or backward jump(s): the IMU was not integrated "
                  "across them");
-  json j;
+  json j = uwb::localizerSummaryJson(s, params);  // eval/LocalizationJson.h, shared with Python
   j["flight"] = a.flight;
   j["window_s"] = a.window.empty() ? json(nullptr) : json(a.window);
   j["duration_s"] = run.duration_s;
-  j["process_model"] = uwb::toString(s.process_model);
   j["bias_model"] = a.filter.bias_model.empty() ? json(nullptr) : json(a.filter.bias_model);
-  j["bias_guard_mean_weight"] = std::isnan(s.bias_guard_mean_weight) ? json(nullptr) : json(s.bias_guard_mean_weight);
-  j["bias_guard_final_weight"] = std::isnan(s.bias_guard_final_weight) ? json(nullptr) : json(s.bias_guard_final_weight);
-  j["n_tdoa"] = s.n_tdoa_total;
-  j["n_tdoa_used"] = s.n_tdoa_used;
-  j["n_tdoa_rejected"] = s.n_tdoa_rejected;
-  j["n_tdoa_downweighted"] = s.n_tdoa_downweighted;
-  j["n_tdoa_start"] = s.n_tdoa_start;
-  j["n_tdoa_used_at_rest"] = s.n_tdoa_used_at_rest;
-  j["n_tdoa_before_imu"] = s.n_tdoa_before_imu;
-  j["n_tdoa_out_of_order"] = s.n_tdoa_out_of_order;
-  j["n_zero_velocity_updates"] = s.n_zero_velocity_updates;
-  j["n_floor_updates"] = s.n_floor_updates;
-  j["n_descent_bound_updates"] = s.n_descent_bound_updates;
-  j["n_rest_periods"] = s.n_rest_periods;
-  j["n_landing_fixes"] = s.n_landing_fixes;
-  j["n_time_jumps"] = s.n_time_jumps;
-  j["reacquisition_t_s"] = s.reacquisition_t_s;
-  j["reacquired_t_s"] = s.reacquired_t_s;
-  j["ready_t_s"] = std::isnan(s.ready_t_s) ? json(nullptr) : json(s.ready_t_s);
-  j["n_tdoa_degenerate"] = s.n_tdoa_degenerate;
-  j["n_reacquisitions"] = s.n_reacquisitions;
-  j["floor_doubted_s"] = s.floor_doubted_s;
-  j["floor_doubted_max_height_m"] = s.floor_doubted_max_height_m;
-  j["n_mode_overrules"] = s.n_mode_overrules;
-  j["air_shake_rms_radps"] = s.air_shake_rms_radps;
-  j["n_inconsistent_periods"] = s.n_inconsistent_periods;
-  j["inconsistent_s"] = s.inconsistent_s;
-  j["n_consistency_widenings"] = s.n_consistency_widenings;
-  j["n_floor_checks"] = s.n_floor_checks;
-  j["n_floor_refutations"] = s.n_floor_refutations;
-  j["n_rejection_faults"] = s.n_rejection_faults;
-  j["n_reverted_motion"] = s.n_reverted_motion;
-  j["start_replayed"] = s.start_replayed;
-  j["start_floor_refuted"] = s.start_floor_refuted;
-  j["start_rms_residual_m"] = s.start_rms_residual_m;
-  j["n_heading_alignments"] = s.n_heading_alignments;
-  j["heading_alignment_t_s"] = s.heading_alignment_t_s;
-  j["heading_alignment_change_rad"] = s.heading_alignment_change_rad;
-  j["bias_level_m"] = std::isnan(s.bias_level_m) ? json(nullptr) : json(s.bias_level_m);
-  j["n_bias_level_windows"] = s.n_bias_level_windows;
-  j["raw_bias_level_m"] = std::isnan(s.raw_bias_level_m) ? json(nullptr) : json(s.raw_bias_level_m);
-  j["bias_model_training_level_m"] = params.bias_model_training_level_m;
-  j["model_mean_level_m"] = std::isnan(s.model_mean_level_m) ? json(nullptr) : json(s.model_mean_level_m);
-  j["bias_model_training_mean_level_m"] = params.bias_model_training_mean_level_m;
-  j["bias_model_mean_scale"] = s.bias_model_mean_scale;
-  j["min_bias_model_mean_scale"] = s.min_bias_model_mean_scale;
-  j["bias_model_level_variance_m2"] = s.bias_model_level_variance_m2;
-  j["fuse_tof"] = params.fuse_tof;
-  j["n_tof"] = s.n_tof_total;
-  j["n_tof_used"] = s.n_tof_used;
-  j["n_tof_rejected"] = s.n_tof_rejected;
-  j["n_tof_invalid"] = s.n_tof_invalid;
-  j["n_tof_tilted"] = s.n_tof_tilted;
-  j["n_tof_not_ready"] = s.n_tof_not_ready;
-  j["started_in_motion"] = s.started_in_motion;
-  j["ground_entered_t_s"] = s.ground_entered_t_s;
-  j["ground_left_t_s"] = s.ground_left_t_s;
-  j["takeoff_t_s"] = std::isnan(s.takeoff_t_s) ? json(nullptr) : json(s.takeoff_t_s);
-  j["landing_t_s"] = std::isnan(s.landing_t_s) ? json(nullptr) : json(s.landing_t_s);
-  j["start_position_m"] = {s.start_w_p_b.x(), s.start_w_p_b.y(), s.start_w_p_b.z()};
-  j["diagnostics"] = diag ? diagnosticsJson(*diag) : json(nullptr);
+  j["diagnostics"] = diag ? uwb::runDiagnosticsJson(*diag) : json(nullptr);
   if (diag && a.fix_survey && diag->anchors.named_id >= 0) {
     // the estimate with the named anchor moved by its fitted offset: the trajectory written and the RMSE below
+    const uwb::Vec3& offset = diag->anchors.named_offset_m;
     j["fixed_survey"] = {{"anchor", diag->anchors.named_id},
-                         {"offset_m", vecJson(diag->anchors.named_offset_m)},
+                         {"offset_m", {offset.x(), offset.y(), offset.z()}},
                          {"rmse_airborne_before_m",
                           std::isfinite(rmse_before_fix) ? json(rmse_before_fix) : json(nullptr)}};
     notes.push_back("--fix-survey: anchor " + std::to_string(diag->anchors.named_id) +
                     " moved by its fitted offset; the results are those of the corrected survey");
   }
-  j["merge_notes"] = s.merge.notes();
   j["read_notes"] = read_report.notes;
   j["warnings"] = warnings.list();
   j["notes"] = notes;
@@ -339,8 +224,8 @@ void runLocalize(const LocalizeArgs& a) {
     const uwb::TrajectoryMetrics& m = *run.metrics;
     j["rmse_m"] = m.whole.n ? json(m.whole.rmse_m) : json(nullptr);
     j["rmse_airborne_m"] = m.airborne.n ? json(m.airborne.rmse_m) : json(nullptr);
-    j["whole"] = statsJson(m.whole);
-    j["airborne"] = statsJson(m.airborne);
+    j["whole"] = uwb::positionErrorStatsJson(m.whole);
+    j["airborne"] = uwb::positionErrorStatsJson(m.airborne);
     j["n_truth_glitches"] = run.n_truth_glitches;
   } else {
     j["rmse_m"] = nullptr;

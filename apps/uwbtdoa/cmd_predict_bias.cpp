@@ -28,6 +28,7 @@
 #include "InputGuards.h"
 #include "uwb/io/PoseTrack.h"
 #include "uwb/io/UtilCsv.h"
+#include "uwb/sim/TdoaResiduals.h"
 
 namespace {
 

@@ -16,7 +16,7 @@
 #include "uwb/core/Error.h"
 #include "uwb/io/UtilCsv.h"
 #include "uwb/stream/LineProtocol.h"
-#include "uwb/stream/ReplayLog.h"
+#include "uwb/eval/Localization.h"
 #include "uwb/stream/ZmqWire.h"
 
 namespace {

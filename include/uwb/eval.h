@@ -11,6 +11,7 @@
 #include "uwb/eval/Evaluation.h"
 #include "uwb/eval/EvaluationTable.h"
 #include "uwb/eval/FaultInjection.h"
+#include "uwb/eval/FlightSummary.h"
 #include "uwb/eval/Localization.h"
 #include "uwb/eval/ProtocolScenarios.h"
 #include "uwb/eval/RunDiagnostics.h"

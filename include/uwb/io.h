@@ -8,7 +8,6 @@
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/FileAccess.h"
 #include "uwb/io/Flight.h"
-#include "uwb/io/FlightSummary.h"
 #include "uwb/io/FlightWindow.h"
 #include "uwb/io/InputChecks.h"
 #include "uwb/io/JsonFile.h"

@@ -12,4 +12,5 @@
 #include "uwb/sim/SimParams.h"
 #include "uwb/sim/SimulatedBias.h"
 #include "uwb/sim/Swarm.h"
+#include "uwb/sim/TdoaResiduals.h"
 #include "uwb/sim/Trajectory.h"

@@ -127,7 +127,7 @@ def test_a_gp_trained_in_python_drives_the_filter(flights, trained):
     # the ToF fields are accepted; a simulated flight has no ToF stream, so nothing is fused and nothing changes
     tof = u.localize_flight(test["flight"], test["survey"], bias_model=model,
                             params={"tdoa_sigma_m": 0.3, "fuse_tof": True, "tof_sigma_m": 0.05})
-    assert tof["summary"]["n_tof_total"] == 0 and tof["summary"]["n_tof_used"] == 0
+    assert tof["summary"]["n_tof"] == 0 and tof["summary"]["n_tof_used"] == 0
     np.testing.assert_array_equal(tof["trajectory"]["p"], run["trajectory"]["p"])
     # the correction's pose dependence (docs/math/gp.md P47): as variance the estimate moves a little, in the row more
     var = u.localize_flight(test["flight"], test["survey"], bias_model=model,

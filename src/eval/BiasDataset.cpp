@@ -10,7 +10,8 @@
 #include <stdexcept>
 
 #include "uwb/core/Error.h"
-#include "uwb/io/FlightSummary.h"
+#include "uwb/eval/FlightSummary.h"
+#include "uwb/sim/TdoaResiduals.h"
 
 namespace uwb {
 

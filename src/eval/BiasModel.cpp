@@ -21,6 +21,7 @@
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/FileAccess.h"
 #include "uwb/io/JsonFile.h"
+#include "uwb/gp/kernels/Presets.h"
 
 namespace uwb {
 
@@ -123,38 +124,12 @@ std::vector<std::string> featureColumnNames(FeatureMap map) {
 // ---------------------------------------------------------------------------------------------------------------
 
 gp::Kernel BiasPreset::kernel() const {
+  // the compositions and their starting parameters: gp/kernels/Presets.h
   if (name == "z1" || name == "z2" || name == "tdoa") return gp::Kernel::preset(name);
   if (name == "pair-tdoa" || name == "tdoa-pm") return gp::Kernel::preset("tdoa");
-  if (name == "anchor-tdoa" || name == "anchor-tdoa-pm") {
-    // docs/math/gp.md (P29): k = k_L(x_A) k_rbf(a_A) + k_L(x_B) k_rbf(a_B); the RBF outputscale is fixed to 1
-    // (the product's scale is k_L's θ0, paper eq. 9), its length scale [m] sets how much anchors share.
-    gp::PartSpec la{gp::PartType::kLedergerber, {0, 1, 2}, 0.05};
-    la.t1 = 0.5;
-    la.t2 = 4.0;
-    gp::PartSpec lb = la;
-    lb.active_dims = {3, 4, 5};
-    const gp::PartSpec ra{gp::PartType::kRbf, {6, 7, 8}, 1.0, {1.0}};
-    gp::PartSpec rb = ra;
-    rb.active_dims = {9, 10, 11};
-    gp::Kernel k({la, ra, lb, rb}, {{0, 1}, {2, 3}});
-    for (const auto& n : k.paramNames()) {
-      if (n.find("rbf.sigma2") != std::string::npos) k.setTrainable(n, false);
-    }
-    return k;
-  }
-  if (name == "pair-pos") {
-    gp::PartSpec s{gp::PartType::kRbf, {0, 1, 2}, 0.02, {0.5, 0.5, 0.5}};
-    return gp::Kernel::sum({s});
-  }
-  if (name == "pair-tdoa-pos") {
-    // docs/math/gp.md (P26b): paper eq. 9 on the body-frame anchor positions plus an RBF-ARD map over the arena
-    // (raw metres: the k_L inputs must not be standardized; 0.5 m start length scale, as pair-pos in its units)
-    const gp::Kernel eq9 = gp::Kernel::preset("tdoa");
-    std::vector<gp::PartSpec> parts;
-    for (int p = 0; p < eq9.numParts(); ++p) parts.push_back(eq9.partSpec(p));
-    parts.push_back(gp::PartSpec{gp::PartType::kRbf, {6, 7, 8}, 0.02, {0.5, 0.5, 0.5}});
-    return gp::Kernel::sum(parts);
-  }
+  if (name == "anchor-tdoa" || name == "anchor-tdoa-pm") return gp::anchorTdoaKernel();  // docs/math/gp.md (P29)
+  if (name == "pair-pos") return gp::positionMapKernel();
+  if (name == "pair-tdoa-pos") return gp::tdoaPositionKernel();  // docs/math/gp.md (P26b)
   throw std::invalid_argument("unknown bias-model preset '" + name + "'");
 }
 

@@ -26,6 +26,15 @@ SensorLog sensorLogFromFlight(const Flight& flight, MergeReport* report, bool wi
   return log;
 }
 
+SensorLog replayLogFromFlight(const Flight& flight, MergeReport* report) {
+  MergeReport pair_report;
+  SensorLog log = sensorLogFromFlight(flight, &pair_report, /*with_tof=*/true);
+  MergeReport clean_report = cleanSensorLog(log, EkfParams{}.max_gap_s);
+  clean_report.n_imu_unpaired = pair_report.n_imu_unpaired;
+  if (report) *report = clean_report;
+  return log;
+}
+
 AnchorTable anchorTableFromSurvey(const AnchorSurvey& survey, double anchor_sigma_m) {
   AnchorTable table;
   for (const Anchor& a : survey.anchors) table.set(a.id, a.w_p, anchor_sigma_m);

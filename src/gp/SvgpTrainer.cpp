@@ -531,7 +531,7 @@ SvgpTrainSummary trainSvgp(Svgp& gp, const MatX& X, const VecX& y, const SvgpTra
     rep.epoch = epoch;
     rep.epochs = params.epochs;
     rep.elbo = elbo_sum / static_cast<double>(nbatches);
-    if (last) summary.final_elbo = fullDataElboOn(team, gp, X, y).elbo;
+    if (last && params.final_full_data_elbo) summary.final_elbo = fullDataElboOn(team, gp, X, y).elbo;
     if (X_val && y_val && X_val->rows() > 0) {
       const SvgpPrediction p = gp.predictor().predict(*X_val, T);
       rep.val_rmse = std::sqrt((*y_val - p.mean).squaredNorm() / static_cast<double>(y_val->size()));

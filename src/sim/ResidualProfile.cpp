@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "uwb/io/PoseTrack.h"
+#include "uwb/sim/TdoaResiduals.h"
 
 namespace uwb::sim {
 

@@ -6,16 +6,41 @@
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "support/TestSupport.h"
+#include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/Flight.h"
 
 namespace uwb::test {
+
+inline Quat yaw(double rad) { return Quat(Eigen::AngleAxisd(rad, Vec3::UnitZ())); }
+inline Quat roll(double rad) { return Quat(Eigen::AngleAxisd(rad, Vec3::UnitX())); }
+
+/// A circle at 1.5 m height, radius 1.5 m, ω rad/s, sampled at `rate_hz`, yawing slowly.
+inline std::vector<PoseSample> circle(double rate_hz, double duration_s, double omega = 1.0) {
+  std::vector<PoseSample> out;
+  for (int i = 0; i * (1.0 / rate_hz) <= duration_s; ++i) {
+    const double t = i / rate_hz;
+    out.push_back({t, Vec3(1.5 * std::cos(omega * t), 1.5 * std::sin(omega * t), 1.5), yaw(0.1 * t)});
+  }
+  return out;
+}
+
+/// Eight anchors in the corners of an 8 m × 8 m room, low and high.
+inline AnchorSurvey cornerSurvey() {
+  AnchorSurvey s;
+  const double z[8] = {0.2, 2.9, 0.2, 3.2, 3.0, 0.2, 3.1, 0.2};
+  const double xy[8][2] = {{-3, -4}, {-3.2, 3.8}, {3.7, 3.7}, {4.1, -4.3}, {-3, -4.4}, {3.9, -3.8}, {4, 3.9}, {-3.2, 3.3}};
+  for (int i = 0; i < 8; ++i) s.anchors.push_back({i, Vec3(xy[i][0], xy[i][1], z[i]), Quat::Identity()});
+  return s;
+}
 
 /// A fresh directory under the system temp dir, removed at destruction.
 class TempDir {

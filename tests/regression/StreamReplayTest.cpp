@@ -24,7 +24,6 @@
 #include "uwb/io/FlightWindow.h"
 #include "uwb/io/UtilCsv.h"
 #include "uwb/stream/EstimateFormat.h"
-#include "uwb/stream/ReplayLog.h"
 
 namespace uwb {
 namespace {

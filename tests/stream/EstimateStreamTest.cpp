@@ -14,7 +14,6 @@
 #include "uwb/stream/EstimateFormat.h"
 #include "uwb/stream/EstimateStream.h"
 #include "uwb/stream/LineProtocol.h"
-#include "uwb/stream/ReplayLog.h"
 
 namespace uwb {
 namespace {

@@ -42,6 +42,10 @@ struct LocalizationRun {
 /// The flight's IMU (paired acc/gyro) and TDoA streams as the filter consumes them; with_tof also copies the
 /// downward ToF range (docs/math/filter.md F21), which the filter uses only with EkfParams::fuse_tof.
 SensorLog sensorLogFromFlight(const Flight& flight, MergeReport* report = nullptr, bool with_tof = false);
+/// A recorded flight as the events `uwbtdoa replay` sends: the IMU, TDoA and ToF streams paired as
+/// sensorLogFromFlight does, cleaned as the batch path cleans them (F17; sensorLogIsClean holds), to be walked in
+/// SensorEventCursor order; `report` gets what cleaning found.
+SensorLog replayLogFromFlight(const Flight& flight, MergeReport* report = nullptr);
 /// Anchor beliefs from a survey; every coordinate with std anchor_sigma_m.
 AnchorTable anchorTableFromSurvey(const AnchorSurvey& survey, double anchor_sigma_m = 0.0);
 /// Filter output → trajectory samples (position, attitude, velocity, position std; with imu_biases the IMU biases

@@ -8,6 +8,11 @@
  *   - ledergerber k = θ0 exp(−(1 − xᵀx'/(‖x‖‖x'‖))/θ1 − (‖x‖ − ‖x'‖)²/θ2), x ∈ ℝ³  (paper k_L, eq. 9; P4)
  *  A kernel is Σ_terms Π_{parts in term} k_part (P5). Presets `z1`, `z2`, `tdoa` are the paper's eq. 7–9.
  *
+ *  Each part type is its own class (kernels/Parts.h), defined in its own file (src/gp/kernels/: Rbf, Matern52,
+ *  Periodic, Ledergerber) with its value, analytic gradient and fast paths side by side; kernels/Product.h
+ *  multiplies parts, this class sums the products and owns the parameters. The paper's compositions and the pair
+ *  presets are named in kernels/Presets.h.
+ *
  *  Design: a runtime composite over ONE flat vector of positive hyperparameters (values θ > 0, optimized in
  *  log-space: θ = exp(ξ), a smooth positive transform). Gram/cross matrices and their gradients are computed
  *  a whole block at a time with vectorized Eigen column operations, so there is no per-element virtual call.
@@ -16,32 +21,17 @@
 #pragma once
 
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json_fwd.hpp>
 
 #include "uwb/core/Types.h"
+#include "uwb/gp/kernels/KernelPart.h"
+#include "uwb/gp/kernels/Product.h"
 
 namespace uwb::gp {
-
-enum class PartType { kRbf, kMatern52, kPeriodic, kLedergerber };
-
-std::string toString(PartType type);
-PartType partTypeFromString(const std::string& name);  ///< throws std::invalid_argument
-
-/// One kernel part. Parameters are given as positive values; sizes of `l` and `T` are 1 (shared) or the number
-/// of active dims (ARD). Unused fields are ignored for the type (e.g. `l` for ledergerber).
-struct PartSpec {
-  PartType type = PartType::kRbf;
-  std::vector<int> active_dims;   ///< columns of the input row this part reads, in order
-  double sigma2 = 1.0;            ///< outputscale σ² (θ0 for ledergerber)
-  std::vector<double> l{1.0};     ///< lengthscales (paper l; NOT GPyTorch's l² for periodic)
-  std::vector<double> T{2.0 * kPi};  ///< periods (periodic only)
-  double t1 = 1.0;                ///< ledergerber θ1 (angular scale, dimensionless)
-  double t2 = 1.0;                ///< ledergerber θ2 (range scale) [m²]
-  bool train_period = false;      ///< periodic: T trainable (paper: T = 2π fixed)
-};
 
 /// A named scalar hyperparameter (albatross-style): positive value, trainable or fixed.
 struct Parameter {
@@ -70,8 +60,8 @@ class Kernel {
   int numParams() const { return static_cast<int>(theta_.size()); }
   int numParts() const { return static_cast<int>(parts_.size()); }
   const std::vector<std::vector<int>>& terms() const { return terms_; }
-  PartType partType(int p) const { return parts_[p].type; }
-  const std::vector<int>& activeDims(int p) const { return parts_[p].active_dims; }
+  PartType partType(int p) const { return parts_[p]->type(); }
+  const std::vector<int>& activeDims(int p) const { return parts_[p]->activeDims(); }
   std::string name() const;  ///< e.g. "(periodic[0]+periodic[1])"
 
   /// Positive parameter values θ (flat) and their names ("p0.periodic.sigma2", "p0.periodic.l[0]", ...).
@@ -117,23 +107,11 @@ class Kernel {
   static Kernel fromJson(const nlohmann::json& j);  ///< throws std::invalid_argument with a clear message
 
  private:
-  struct Part {
-    PartType type;
-    std::vector<int> active_dims;
-    int offset = 0;  ///< index of σ² in theta_; then l (n_l), then T (n_T) or t1, t2
-    int n_l = 0;
-    int n_T = 0;
-    /// theta_ index of the lengthscale of active dimension d (one shared, or one per dimension).
-    Eigen::Index lengthscaleIndex(Eigen::Index d) const { return offset + 1 + (n_l == 1 ? 0 : d); }
-    /// theta_ index of the period of active dimension d (periodic parts).
-    Eigen::Index periodIndex(Eigen::Index d) const { return offset + 1 + n_l + (n_T == 1 ? 0 : d); }
-  };
   void build(const std::vector<PartSpec>& parts, const std::vector<std::vector<int>>& terms);
   MatX partCross(int p, const MatX& X1, const MatX& X2) const;
-  void partGradient(int p, const MatX& X1, const MatX& X2, const MatX& H, const MatX& Kp, VecX& grad_theta,
-                    MatX* grad_X1) const;
 
-  std::vector<Part> parts_;
+  PartList parts_;                     ///< immutable, shared between copies
+  std::vector<Product> products_;      ///< the terms
   std::vector<std::vector<int>> terms_;
   VecX theta_;
   std::vector<std::string> names_;

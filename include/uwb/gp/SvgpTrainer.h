@@ -37,6 +37,8 @@ struct SvgpTrainParams {
   /// After the last step, set q(v) to its optimum for the final hyperparameters on the FULL data (P41): the returned
   /// model does not depend on which minibatch came last, and its full-data ELBO is never below the last iterate's.
   bool final_full_data_q = true;
+  /// After the last step, compute SvgpTrainSummary::final_elbo on the FULL data (one more pass over all of it).
+  bool final_full_data_elbo = true;
   /// Throws std::invalid_argument naming the bad field.
   void validate() const;
 };

@@ -1,5 +1,5 @@
 /** @file PoseTrack.h
- *  @brief Ground-truth pose track of a flight (Vicon pose logged on board) and TDoA residuals against it.
+ *  @brief Ground-truth pose track of a flight (Vicon pose logged on board).
  *
  *  - interpolatePose / bracketPose: the one pose interpolation of the project (linear in position, slerp in
  *    attitude) between the two samples around a time, for any sorted sequence of samples with t_s, w_p_b and w_q_b
@@ -10,11 +10,9 @@
  *  - Glitches (util-pilot SOURCE.md, "Caveats"): Vicon occasionally reports a flipped attitude (roll ≈ ±170°) for
  *    one or a few samples, and single-sample position spikes up to 0.23 m. They are detected, counted, reported
  *    and excluded from interpolation (docs/io.md, "Ground truth").
- *  - tdoaResiduals: r = tdoa_meas − h(p_gt), with h the TDoA model of model/TdoaModel.h (paper eq. 1–2,
- *    docs/math/measurement.md M1–M2) and the tag lever arm b_t_tag. For position-only tracks (util-final-extract)
- *    the lever arm is added in the world frame (identity attitude), as that data's SOURCE.md prescribes.
  *
- *  Used by: `uwbtdoa inspect` (io/FlightSummary.h), GP training-data extraction and evaluation.
+ *  Used by: the TDoA residuals against ground truth (sim/TdoaResiduals.h), `uwbtdoa inspect`
+ *  (eval/FlightSummary.h), GP training-data extraction and evaluation.
  */
 #pragma once
 
@@ -145,37 +143,5 @@ class PoseTrack {
   std::vector<PoseGlitch> glitches_;
   std::size_t n_input_ = 0;
 };
-
-/// Settings of the residual computation.
-struct TdoaResidualParams {
-  Vec3 b_t_tag = kUtilTagOffset_b;  ///< tag (antenna) offset in the body frame [m]
-  double airborne_min_z_m = kAirborneMinZ_m;  ///< isAirborne threshold on the ground-truth body z [m]
-};
-
-/// One TDoA measurement compared with the ground truth.
-struct TdoaResidual {
-  std::size_t index = 0;  ///< index into Flight::tdoa
-  double t_s = 0.0;
-  int id_a = 0;
-  int id_b = 0;
-  double measured_m = 0.0;   ///< tdoa_meas
-  double predicted_m = 0.0;  ///< |p_tag − a_B| − |p_tag − a_A| at the ground truth
-  double residual_m = 0.0;   ///< measured_m − predicted_m (the measurement bias + noise the GP learns)
-  Vec3 w_p_b = Vec3::Zero();      ///< interpolated ground-truth body position [m]
-  Quat w_q_b = Quat::Identity();  ///< interpolated ground-truth attitude (identity for position-only tracks)
-  bool airborne = false;          ///< isAirborne(w_p_b.z(), airborne_min_z_m)
-};
-
-/// What tdoaResiduals could not compare (nothing is dropped silently).
-struct TdoaResidualReport {
-  std::size_t n_measurements = 0;     ///< flight.tdoa.size()
-  std::size_t n_residuals = 0;        ///< returned
-  std::size_t n_no_ground_truth = 0;  ///< outside the pose track or in a gap > max_gap_s
-  std::size_t n_unknown_anchor = 0;   ///< an anchor id missing from the survey
-};
-
-/// Residual of every TDoA measurement that has ground truth, in measurement order. See the file comment.
-std::vector<TdoaResidual> tdoaResiduals(const Flight& flight, const AnchorSurvey& survey, const PoseTrack& track,
-                                        const TdoaResidualParams& params = {}, TdoaResidualReport* report = nullptr);
 
 }  // namespace uwb

@@ -1,6 +1,6 @@
 /** @file ResidualStats.h
  *  @brief The statistics of a set of TDoA residuals (measured − model at the ground truth) used everywhere: by
- *         `uwbtdoa inspect` (io/FlightSummary.h, per phase and pair) and by the simulator's comparison with real
+ *         `uwbtdoa inspect` (eval/FlightSummary.h, per phase and pair) and by the simulator's comparison with real
  *         flights (sim/ResidualProfile.h).
  */
 #pragma once

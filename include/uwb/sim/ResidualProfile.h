@@ -26,7 +26,7 @@ struct ResidualProfile {
 
 enum class Phase { kAirborne, kGround, kAll };
 
-/// Residuals r = tdoa − (|p_tag − a_B| − |p_tag − a_A|) at the ground-truth pose, computed by io's tdoaResiduals
+/// Residuals r = tdoa − (|p_tag − a_B| − |p_tag − a_A|) at the ground-truth pose, computed by tdoaResiduals (sim/TdoaResiduals.h)
 /// on the flight's PoseTrack (pose glitches excluded; position interpolated linearly and attitude by slerp, as
 /// everywhere else); airborne = isAirborne(interpolated body z, airborne_min_z_m). Measurements without ground
 /// truth or with an anchor missing from the survey are skipped.

@@ -1,7 +1,7 @@
 /** @file FlightSummary.cpp
  *  @brief Flight overview for `uwbtdoa inspect` (docs/io.md, "inspect").
  */
-#include "uwb/io/FlightSummary.h"
+#include "uwb/eval/FlightSummary.h"
 
 #include <fmt/format.h>
 

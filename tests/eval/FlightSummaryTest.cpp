@@ -2,7 +2,7 @@
  *  @brief Flight summary behind `uwbtdoa inspect`: statistics, neighbour pairs, and agreement with
  *  util-pilot/MANIFEST.csv on every real flight (RealData* suites skip when the data is absent).
  */
-#include "uwb/io/FlightSummary.h"
+#include "uwb/eval/FlightSummary.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "IoTestHelpers.h"
+#include "io/IoTestHelpers.h"
 #include "uwb/io/UtilCsv.h"
 
 namespace uwb {

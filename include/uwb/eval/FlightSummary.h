@@ -13,6 +13,7 @@
 #include "uwb/io/PoseTrack.h"
 #include "uwb/io/ResidualStats.h"
 #include "uwb/io/UtilCsv.h"
+#include "uwb/sim/TdoaResiduals.h"
 
 namespace uwb {
 

@@ -1,0 +1,47 @@
+# The layering rule of docs/CONTRIBUTING.md as a test (ctest -R layering): every `#include "uwb/<module>/..."` in a
+# module's headers (include/uwb/<module>/, include/uwb/<module>.h) and sources (src/<module>/) names the module itself
+# or one it may depend on. Run: cmake -DUWB_SOURCE_DIR=<repo> -P cmake/CheckLayers.cmake
+cmake_minimum_required(VERSION 3.20)
+if(NOT UWB_SOURCE_DIR)
+  message(FATAL_ERROR "CheckLayers.cmake: pass -DUWB_SOURCE_DIR=<repository root>")
+endif()
+
+# module -> the modules it may include (besides itself); keep in step with docs/CONTRIBUTING.md "Tree".
+set(allowed_core "")
+set(allowed_model core)
+set(allowed_graph core model)
+set(allowed_filter core model graph)
+set(allowed_gp core)
+set(allowed_io core)
+set(allowed_sim core model io)
+set(allowed_eval core model graph filter gp io sim)
+set(allowed_stream core io filter eval)
+set(modules core model graph filter gp io sim eval stream)
+
+set(violations "")
+foreach(module ${modules})
+  file(GLOB_RECURSE files "${UWB_SOURCE_DIR}/include/uwb/${module}/*.h" "${UWB_SOURCE_DIR}/src/${module}/*.h"
+       "${UWB_SOURCE_DIR}/src/${module}/*.cpp")
+  if(EXISTS "${UWB_SOURCE_DIR}/include/uwb/${module}.h")
+    list(APPEND files "${UWB_SOURCE_DIR}/include/uwb/${module}.h")
+  endif()
+  foreach(f ${files})
+    file(STRINGS "${f}" lines REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"]uwb/[a-z]+[/.]")
+    foreach(line ${lines})
+      string(REGEX MATCH "uwb/([a-z]+)[/.]" _ "${line}")
+      set(dep "${CMAKE_MATCH_1}")
+      if(NOT dep STREQUAL module AND NOT dep IN_LIST allowed_${module})
+        file(RELATIVE_PATH rel "${UWB_SOURCE_DIR}" "${f}")
+        string(STRIP "${line}" line)
+        list(APPEND violations "${rel}: ${module} may not include ${dep} (${line})")
+      endif()
+    endforeach()
+  endforeach()
+endforeach()
+
+if(violations)
+  list(LENGTH violations n)
+  string(REPLACE ";" "\n  " text "${violations}")
+  message(FATAL_ERROR "${n} include(s) against the layering rule (docs/CONTRIBUTING.md):\n  ${text}")
+endif()
+message(STATUS "layering: every module includes only the modules below it")
