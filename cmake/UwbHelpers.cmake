@@ -17,7 +17,7 @@ if(UWB_DEV_WARNINGS)
   if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
     list(APPEND UWB_WARNINGS -Wno-restrict)
   endif()
-  # CI (scripts/test.sh): a warning in the project's own targets fails the build. Third-party code is compiled
+  # -DUWB_WERROR=ON (developers): a warning in the project's own targets fails the build. Third-party code is compiled
   # only through its headers, which are system includes (imported targets), so this covers our code alone.
   if(UWB_WERROR)
     list(APPEND UWB_WARNINGS -Werror)

@@ -13,6 +13,7 @@
 #include "uwb/eval/FaultInjection.h"
 #include "uwb/eval/FlightSummary.h"
 #include "uwb/eval/Localization.h"
+#include "uwb/eval/LocalizationJson.h"
 #include "uwb/eval/ProtocolScenarios.h"
 #include "uwb/eval/RunDiagnostics.h"
 #include "uwb/eval/SignatureMatrix.h"
