@@ -208,6 +208,17 @@ py::dict summaryDict(const LocalizerSummary& s) {
   d["n_tof_total"] = s.n_tof_total, d["n_tof_used"] = s.n_tof_used, d["n_tof_rejected"] = s.n_tof_rejected;
   d["n_tof_invalid"] = s.n_tof_invalid, d["n_tof_tilted"] = s.n_tof_tilted;
   d["n_tof_not_ready"] = s.n_tof_not_ready;
+  // (filter.md F31) samples skipped outside the sensors' physical ranges, per sensor, and the warnings naming them
+  py::dict range;
+  const auto count = [](const SensorRangeCount& c) {
+    py::dict r;
+    r["n"] = c.n, r["limit"] = c.limit, r["first_t_s"] = c.first_t_s, r["worst"] = c.worst;
+    return r;
+  };
+  range["gyro"] = count(s.sensor_range.gyro), range["acc"] = count(s.sensor_range.acc);
+  range["tdoa"] = count(s.sensor_range.tdoa);
+  d["sensor_range"] = range;
+  d["sensor_range_warnings"] = sensorRangeWarnings(s.sensor_range);
   return d;
 }
 

@@ -43,4 +43,13 @@ void checkPeriod(double value_s, const std::string& option, double max_s) {
   }
 }
 
+nlohmann::json sensorRangeJson(const SensorRangeReport& report) {
+  const auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  const auto one = [&](const SensorRangeCount& c) {
+    return nlohmann::json{{"n", c.n}, {"limit", num(c.limit)}, {"first_t_s", c.n ? num(c.first_t_s) : nullptr},
+                          {"worst", c.n ? num(c.worst) : nullptr}};
+  };
+  return {{"gyro", one(report.gyro)}, {"acc", one(report.acc)}, {"tdoa", one(report.tdoa)}};
+}
+
 }  // namespace uwb::app

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "uwb/core/Types.h"
+#include "uwb/filter/SensorRange.h"
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/InputChecks.h"
 
@@ -26,6 +27,10 @@ class Warnings {
  private:
   std::vector<std::string> list_;
 };
+
+/// The samples skipped outside the sensors' physical ranges (filter.md F31), per sensor: {"gyro": {"n", "limit",
+/// "first_t_s", "worst"}, "acc": …, "tdoa": …}; first_t_s and worst are null when nothing was skipped or not finite.
+nlohmann::json sensorRangeJson(const SensorRangeReport& report);
 
 /// JSON text for stdout; invalid UTF-8 (e.g. in a file name) is replaced instead of throwing.
 std::string dumpJson(const nlohmann::json& j, int indent = -1);

@@ -250,6 +250,7 @@ void runLocalize(const LocalizeArgs& a) {
   if (s.n_time_jumps > 0)
     warnings.add(std::to_string(s.n_time_jumps) + " sensor-time gap(s) or backward jump(s): the IMU was not integrated "
                  "across them");
+  for (const std::string& w : uwb::sensorRangeWarnings(s.sensor_range)) warnings.add(w);  // (F31)
   json j;
   j["flight"] = a.flight;
   j["window_s"] = a.window.empty() ? json(nullptr) : json(a.window);
@@ -310,6 +311,7 @@ void runLocalize(const LocalizeArgs& a) {
   j["n_tof_invalid"] = s.n_tof_invalid;
   j["n_tof_tilted"] = s.n_tof_tilted;
   j["n_tof_not_ready"] = s.n_tof_not_ready;
+  j["sensor_range"] = uwb::app::sensorRangeJson(s.sensor_range);
   j["started_in_motion"] = s.started_in_motion;
   j["ground_entered_t_s"] = s.ground_entered_t_s;
   j["ground_left_t_s"] = s.ground_left_t_s;
