@@ -183,6 +183,8 @@ py::dict metricsDict(const TrajectoryMetrics& m) {
   return d;
 }
 
+}  // namespace
+
 py::dict summaryDict(const LocalizerSummary& s) {
   py::dict d;
   d["n_tdoa_total"] = s.n_tdoa_total, d["n_tdoa_used"] = s.n_tdoa_used, d["n_tdoa_rejected"] = s.n_tdoa_rejected;
@@ -221,6 +223,8 @@ py::dict summaryDict(const LocalizerSummary& s) {
   d["sensor_range_warnings"] = sensorRangeWarnings(s.sensor_range);
   return d;
 }
+
+namespace {
 
 py::dict trainReportDict(const BiasTrainReport& r) {
   py::dict d;

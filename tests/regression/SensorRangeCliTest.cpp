@@ -224,5 +224,22 @@ TEST_F(SensorRangeCli, StreamSkipsFiveAccelerometerSamplesOfHugeForce) {
   EXPECT_THAT(c.err, Not(HasSubstr("physical range")));
 }
 
+TEST_F(SensorRangeCli, TheGrossTdoaOutliersOfARealFlightAreSkippedAndNamed) {
+  // GIVEN 0426-traj11, whose log carries 16 TDoA 17–25 m beyond their anchor pair's baseline
+  const std::optional<fs::path> f = test::pilotFlight("0426-traj11");
+  UWB_REQUIRE_REAL_DATA(f);
+  // WHEN it is localized
+  const test::CliResult r = test::runCli("localize " + f->string() + " --anchors " +
+                                         test::pilotSurvey("0426").string() + " --json --no-diagnostics");
+  // THEN they are skipped and named in one warning, and nothing else of the flight is (IMU within its range)
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["sensor_range"]["tdoa"]["n"], 16);
+  EXPECT_GT(j["sensor_range"]["tdoa"]["worst"].get<double>(), 10.0);
+  EXPECT_EQ(j["sensor_range"]["gyro"]["n"], 0);
+  EXPECT_EQ(j["sensor_range"]["acc"]["n"], 0);
+  EXPECT_THAT(r.err, HasSubstr("skipped 16 TDoA outside the sensor's physical range (|z| ≤ anchor-pair baseline + 1 m"));
+}
+
 }  // namespace
 }  // namespace uwb

@@ -238,7 +238,7 @@ struct EkfParams {
   double max_acc_mps2 = 490.0;
   /// A TDoA whose |z| exceeds its anchor pair's baseline ‖a_B − a_A‖ by more than this is no range difference [m]
   /// (triangle inequality; the margin covers noise, NLOS delay and survey error). Dev flights: 0.61 m at most, apart
-  /// from gross outliers 17–52 m beyond (F31).
+  /// from gross outliers 17–50 m beyond (F31).
   double max_tdoa_excess_m = 1.0;
 
   /// Throws std::invalid_argument naming the first field that is out of range.
