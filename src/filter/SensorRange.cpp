@@ -78,15 +78,15 @@ std::vector<std::string> sensorRangeWarnings(const SensorRangeReport& r) {
   const auto line = [&](const SensorRangeCount& c, const std::string& what, const std::string& bound,
                         const std::string& worst) {
     if (c.n == 0) return;
-    w.push_back(fmt::format("skipped {} {} outside the sensor's physical range ({}, filter.md F31): first at t = {:.3f} "
-                            "s, worst {}; a sensor or logging fault",
+    w.push_back(fmt::format("skipped {} {} outside the sensor's physical range ({}, filter.md F31): first at "
+                            "t = {:.3f} s, worst {}; a sensor or logging fault",
                             c.n, what, bound, c.first_t_s, worst));
   };
   line(r.gyro, r.gyro.n == 1 ? "gyro sample" : "gyro samples",
        fmt::format("‖ω‖ ≤ {:g} rad/s, max_gyro_radps", r.gyro.limit), worstText(r.gyro.worst, "rad/s"));
   line(r.acc, r.acc.n == 1 ? "accelerometer sample" : "accelerometer samples",
        fmt::format("‖f‖ ≤ {:g} m/s², max_acc_mps2", r.acc.limit), worstText(r.acc.worst, "m/s²"));
-  line(r.tdoa, r.tdoa.n == 1 ? "TDoA" : "TDoA",
+  line(r.tdoa, "TDoA",
        fmt::format("|z| ≤ anchor-pair baseline + {:g} m, max_tdoa_excess_m", r.tdoa.limit),
        std::isfinite(r.tdoa.worst) ? fmt::format("{:.3g} m beyond the baseline", r.tdoa.worst)
                                    : std::string("not finite"));

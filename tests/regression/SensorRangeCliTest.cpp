@@ -238,7 +238,8 @@ TEST_F(SensorRangeCli, TheGrossTdoaOutliersOfARealFlightAreSkippedAndNamed) {
   EXPECT_GT(j["sensor_range"]["tdoa"]["worst"].get<double>(), 10.0);
   EXPECT_EQ(j["sensor_range"]["gyro"]["n"], 0);
   EXPECT_EQ(j["sensor_range"]["acc"]["n"], 0);
-  EXPECT_THAT(r.err, HasSubstr("skipped 16 TDoA outside the sensor's physical range (|z| ≤ anchor-pair baseline + 1 m"));
+  EXPECT_THAT(r.err,
+              HasSubstr("skipped 16 TDoA outside the sensor's physical range (|z| ≤ anchor-pair baseline + 1 m"));
 }
 
 }  // namespace

@@ -65,8 +65,8 @@ bool checkImuRange(double t_s, const ImuReading& imu, SensorRangeReport& report)
 bool checkTdoaRange(const TdoaObservation& z, const AnchorTable& anchors, SensorRangeReport& report);
 
 /// One warning per sensor with samples skipped: the count, the bound, the first stamp and the worst value, e.g.
-/// "skipped 1 gyro sample outside the sensor's range (‖ω‖ ≤ 70 rad/s, filter.md F31): first at t = 20.000 s, worst
-/// 1.7e+08 rad/s". Empty when nothing was skipped.
+/// "skipped 1 gyro sample outside the sensor's physical range (‖ω‖ ≤ 70 rad/s, max_gyro_radps, filter.md F31): first
+/// at t = 20.000 s, worst 1.75e+08 rad/s; a sensor or logging fault". Empty when nothing was skipped.
 std::vector<std::string> sensorRangeWarnings(const SensorRangeReport& report);
 
 }  // namespace uwb
