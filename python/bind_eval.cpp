@@ -208,10 +208,17 @@ py::object jsonToPythonKeepingNan(const nlohmann::json& j) {
   }
 }
 
-/// The run's summary: the keys of `uwbtdoa localize --json` (eval/LocalizationJson.h, one writer for both).
-py::object summaryDict(const LocalizerSummary& s, const EkfParams& params) {
-  return jsonToPythonKeepingNan(localizerSummaryJson(s, params));
+}  // namespace
+
+/// The run's summary: the keys of `uwbtdoa localize --json` (eval/LocalizationJson.h, one writer for both), and the
+/// warnings of the samples skipped outside the sensors' ranges (filter.md F31), which the CLI prints.
+py::dict summaryDict(const LocalizerSummary& s, const EkfParams& params) {
+  py::dict d = jsonToPythonKeepingNan(localizerSummaryJson(s, params));
+  d["sensor_range_warnings"] = sensorRangeWarnings(s.sensor_range);
+  return d;
 }
+
+namespace {
 
 py::dict trainReportDict(const BiasTrainReport& r) {
   py::dict d;

@@ -65,6 +65,10 @@ void bindStream(py::module_& m) {
           py::arg("range_m"), "One downward range [m] (used with params fuse_tof).")
       .def_property_readonly("ready", &Estimator::ready, "The position is known (estimates are meaningful).")
       .def_property_readonly("time", &Estimator::time, "Stamp of the latest event [s].")
+      .def_property_readonly(
+          "summary", [](const Estimator& e) { return summaryDict(e.summary(), e.params()); },
+          "The counts so far, as localize_flight's summary; sensor_range: the samples skipped outside the sensors'\n"
+          "physical ranges (filter.md F31), sensor_range_warnings: one sentence per sensor.")
       .def(
           "estimate", [](const Estimator& e) { return estimateDict(e.estimate()); },
           "{t, p (3,), q (4,) w x y z, v (3,), sigma_p (3,), cov_pose (6, 6) of (δp, δθ), phase}. t is the\n"

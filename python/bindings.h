@@ -19,6 +19,7 @@
 
 #include "uwb/core/Types.h"
 #include "uwb/filter/EkfParams.h"
+#include "uwb/filter/Estimator.h"
 #include "uwb/io/Flight.h"
 #include "uwb/io/TrajectoryCsv.h"
 #include "uwb/model/TdoaFeature.h"
@@ -134,6 +135,9 @@ inline py::object requireKey(const py::dict& d, const char* key, const char* wha
 
 /// Trajectory ↔ dict {t (N,), p (N, 3), q (N, 4) (x, y, z, w), sigma_p (N, 3), v (N, 3)} (bind_io.cpp).
 py::dict trajectoryToDict(const Trajectory& trajectory);
+/// The run summary as localize_flight returns it ("summary"): the keys of `localize --json`, with the sensor
+/// ranges' counts and warnings (filter.md F31) (bind_eval.cpp).
+py::dict summaryDict(const LocalizerSummary& s, const EkfParams& params);
 Trajectory trajectoryFromDict(const py::dict& d);
 /// Pose samples → {t, p, q} (bind_io.cpp).
 py::dict poseSamplesToDict(const std::vector<PoseSample>& samples);

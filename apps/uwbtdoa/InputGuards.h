@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "uwb/core/Types.h"
+#include "uwb/filter/SensorRange.h"
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/InputChecks.h"
 

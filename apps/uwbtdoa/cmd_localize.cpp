@@ -197,6 +197,7 @@ void runLocalize(const LocalizeArgs& a) {
   if (s.n_time_jumps > 0)
     warnings.add(std::to_string(s.n_time_jumps) + " sensor-time gap(s) or backward jump(s): the IMU was not integrated "
                  "across them");
+  for (const std::string& w : uwb::sensorRangeWarnings(s.sensor_range)) warnings.add(w);  // (F31)
   json j = uwb::localizerSummaryJson(s, params);  // eval/LocalizationJson.h, shared with Python
   j["flight"] = a.flight;
   j["window_s"] = a.window.empty() ? json(nullptr) : json(a.window);

@@ -88,6 +88,8 @@ void run(const Options& o) {
     dp.min_z_m = o.min_z;
     const uwb::BiasDataset data = uwb::buildBiasDataset({flight}, survey, dp);
     flight_level_m = data.flights.at(0).bias_level_m;
+    for (const std::string& w : uwb::sensorRangeWarnings(data.flights.at(0).sensor_range))  // (F31)
+      uwb::app::Warnings().add(w);
     const uwb::DatasetPredictives predictives = uwb::datasetPredictives(model, data);
     mean_level_m = predictives.flight_mean_level_m.at(0);
     for (std::size_t i = 0; i < data.samples.size(); ++i) {

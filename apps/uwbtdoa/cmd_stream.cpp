@@ -165,6 +165,7 @@ void runStream(const StreamArgs& a) {
     emit(uwb::formatEstimate(stream.last(), format));
     ++n_out;
   }
+  for (const std::string& w : uwb::sensorRangeWarnings(stream.sensorRange())) warnings.add(w);  // (F31)
   if (sub && sub->timedOut())
     warnings.add(fmt::format("no message for {} (--idle-timeout): the producer is gone? ending the stream",
                              seconds(a.idle_timeout)));
@@ -174,6 +175,8 @@ void runStream(const StreamArgs& a) {
   std::cerr << "stream: " << stream.eventsIn() << " events, " << n_out << " estimates";
   if (n_bad > 0) std::cerr << ", " << n_bad << " bad lines skipped";
   if (stream.stampOutliers() > 0) std::cerr << ", " << stream.stampOutliers() << " events off the clock skipped";
+  if (const std::size_t n_range = stream.sensorRange().total(); n_range > 0)
+    std::cerr << ", " << n_range << " sensor values out of range skipped";
   if (!stream.clockJumps().empty()) std::cerr << ", " << stream.clockJumps().size() << " clock jumps (restarts)";
   if (sub && sub->timedOut()) std::cerr << " (idle timeout)";
   if (pub) std::cerr << ", " << pub->sent() << " sent, " << pub->dropped() << " dropped (slow consumer)";

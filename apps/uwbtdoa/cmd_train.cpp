@@ -99,6 +99,8 @@ void run(const TrainOptions& o) {
   dp.inputs = uwb::biasInputSourceFromString(o.inputs);
   uwb::BiasDataset data = uwb::buildBiasDataset(flights, survey, dp);
   if (!o.quiet) std::cerr << data.reportText();
+  for (const uwb::BiasFlightReport& f : data.flights)  // (F31) the estimated inputs' filter skipped sensor values
+    for (const std::string& w : uwb::sensorRangeWarnings(f.sensor_range)) uwb::app::Warnings().add(f.source + ": " + w);
 
   uwb::BiasTrainParams tp;
   tp.preset = o.kernel;

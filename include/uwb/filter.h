@@ -24,6 +24,7 @@
 #include "uwb/filter/QuadImuProcess.h"
 #include "uwb/filter/RestDetector.h"
 #include "uwb/filter/SensorEvents.h"
+#include "uwb/filter/SensorRange.h"
 #include "uwb/filter/StartReplay.h"
 #include "uwb/filter/StartUp.h"
 #include "uwb/filter/StateIndex.h"

@@ -65,3 +65,21 @@ def test_estimator_refuses_too_few_anchors_and_bad_params():
         uwbtdoa.Estimator({}, {0: (0.0, 0.0, 0.0), 1: (1.0, 0.0, 0.0)})
     with pytest.raises(ValueError):
         uwbtdoa.Estimator({"no_such_param": 1.0}, {i: (float(i), 0.0, 0.0) for i in range(4)})
+
+
+def test_estimator_skips_and_counts_sensor_values_outside_their_range():
+    # GIVEN an estimator on four anchors (filter.md F31: the gyro's range ‖ω‖ ≤ 70 rad/s, the TDoA's the baseline)
+    anchors = {0: (-3.0, -3.0, 0.2), 1: (3.0, -3.0, 2.8), 2: (3.0, 3.0, 0.2), 3: (-3.0, 3.0, 2.8)}
+    est = uwbtdoa.Estimator({}, anchors)
+    # WHEN a level IMU sample, one with a gyro of 1e10 deg/s, one with a NaN accelerometer and a TDoA of 1e30 m arrive
+    est.add_imu(0.0, (0.0, 0.0, 9.81), (0.0, 0.0, 0.0))
+    est.add_imu(0.001, (0.0, 0.0, 9.81), (0.0, 0.0, np.radians(1e10)))
+    est.add_imu(0.002, (np.nan, 0.0, 9.81), (0.0, 0.0, 0.0))
+    est.add_tdoa(0.003, 0, 1, 1e30)
+    # THEN the three bad ones are skipped and counted per sensor, with the warnings naming them
+    r = est.summary["sensor_range"]
+    assert (r["gyro"]["n"], r["acc"]["n"], r["tdoa"]["n"]) == (1, 1, 1)
+    assert r["gyro"]["first_t_s"] == pytest.approx(0.001)
+    assert r["gyro"]["limit"] == 70.0
+    warnings = est.summary["sensor_range_warnings"]
+    assert len(warnings) == 3 and "skipped 1 gyro sample" in warnings[0]

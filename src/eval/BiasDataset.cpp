@@ -71,17 +71,20 @@ BiasDataset buildBiasDataset(const std::vector<Flight>& flights, const AnchorSur
     const std::vector<TdoaResidual> residuals = tdoaResiduals(flight, survey, track, rp, &rr);
     Trajectory estimate;
     double bias_level_m = std::numeric_limits<double>::quiet_NaN();
+    SensorRangeReport sensor_range;
     if (params.inputs == BiasInputSource::kFilterEstimate) {
       LocalizationRun run = localizeFlight(flight, survey, params.localization, params.estimate_bias);
       estimate = std::move(run.trajectory);
       // (F24b) the level before the correction: with estimate_bias the raw one, else the corrected one is it
       bias_level_m = params.estimate_bias ? run.summary.raw_bias_level_m : run.summary.bias_level_m;
+      sensor_range = run.summary.sensor_range;
     }
 
     BiasFlightReport rep;
     rep.source = name;
     rep.orientation_from_truth = flight.pose_has_orientation;
     rep.bias_level_m = bias_level_m;
+    rep.sensor_range = sensor_range;
     rep.n_measurements = rr.n_measurements;
     rep.n_unknown_anchor = rr.n_unknown_anchor;
     rep.n_no_ground_truth = rr.n_no_ground_truth;

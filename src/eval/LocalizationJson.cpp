@@ -15,6 +15,15 @@ json vecJson(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
 }  // namespace
 
+json sensorRangeJson(const SensorRangeReport& report) {
+  const auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  const auto one = [&](const SensorRangeCount& c) {
+    return json{{"n", c.n}, {"limit", num(c.limit)}, {"first_t_s", c.n ? num(c.first_t_s) : json(nullptr)},
+                {"worst", c.n ? num(c.worst) : json(nullptr)}};
+  };
+  return {{"gyro", one(report.gyro)}, {"acc", one(report.acc)}, {"tdoa", one(report.tdoa)}};
+}
+
 json localizerSummaryJson(const LocalizerSummary& s, const EkfParams& params) {
   json j;
   j["process_model"] = toString(s.process_model);
@@ -72,6 +81,7 @@ json localizerSummaryJson(const LocalizerSummary& s, const EkfParams& params) {
   j["n_tof_invalid"] = s.n_tof_invalid;
   j["n_tof_tilted"] = s.n_tof_tilted;
   j["n_tof_not_ready"] = s.n_tof_not_ready;
+  j["sensor_range"] = sensorRangeJson(s.sensor_range);
   j["started_in_motion"] = s.started_in_motion;
   j["ground_entered_t_s"] = s.ground_entered_t_s;
   j["ground_left_t_s"] = s.ground_left_t_s;

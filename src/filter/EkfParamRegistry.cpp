@@ -249,6 +249,15 @@ std::vector<EkfParamInfo> makeRegistry() {
            "ToF readings above this, <= 0 or non-finite are ignored"),
       real("tof_gate_sigma", &P::tof_gate_sigma, "", kFinite,
            "Mahalanobis gate on the ToF innovation (sigmas); <= 0 disables"),
+      // --- the sensors' physical ranges (F31) ---
+      real("max_gyro_radps", &P::max_gyro_radps, "rad/s", kPositive,
+           "Gyro samples with |w| above this are skipped and counted: 2x the +-2000 deg/s full scale (BMI088) (F31)"),
+      real("max_acc_mps2", &P::max_acc_mps2, "m/s^2", kPositive,
+           "Accelerometer samples with |f| above this are skipped and counted: 50 g, 2x the +-24 g full scale "
+           "(BMI088) (F31)"),
+      real("max_tdoa_excess_m", &P::max_tdoa_excess_m, "m", kNonNegative,
+           "TDoA with |z| beyond the anchor-pair baseline by more than this are skipped and counted (triangle "
+           "inequality) (F31)"),
   };
 }
 

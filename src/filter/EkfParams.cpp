@@ -96,6 +96,9 @@ void EkfParams::validate() const {
   if (!std::isfinite(floor_z_m)) throw std::invalid_argument("EkfParams.floor_z_m must be finite");
   requirePositive(tof_max_range_m, "tof_max_range_m");
   if (!std::isfinite(tof_gate_sigma)) throw std::invalid_argument("EkfParams.tof_gate_sigma must be finite");
+  requirePositive(max_gyro_radps, "max_gyro_radps");
+  requirePositive(max_acc_mps2, "max_acc_mps2");
+  requireNonNegative(max_tdoa_excess_m, "max_tdoa_excess_m");
 }
 
 EkfParams EkfParams::crazyflieLike() {

@@ -158,6 +158,7 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
   floor_anchors_ = FloorLevelAnchors(anchors_, params_.ground_z_m, params_.floor_anchor_height_m);
   if (floor_anchors_.any()) start_.setFloorLevelAnchors(floor_anchors_.mask());
   summary_.process_model = params_.process_model;
+  summary_.sensor_range = SensorRangeReport(params_);  // (F31) the limits, nothing counted
   for (std::vector<double>* list : {&summary_.reacquisition_t_s, &summary_.reacquired_t_s,
                                     &summary_.ground_entered_t_s, &summary_.ground_left_t_s,
                                     &summary_.heading_alignment_t_s, &summary_.heading_alignment_change_rad})
@@ -533,6 +534,8 @@ bool Estimator::diverged() const {
 void Estimator::addImu(double t_s, const ImuReading& imu) {
   ++summary_.n_imu_total;
   if (!imu_mode_) return;
+  // (F31) a reading outside the sensors' range is skipped whole: the next sample integrates over the gap
+  if (!checkImuRange(t_s, imu, summary_.sensor_range)) return;
   if (std::isnan(t_last_event_)) summary_.start_t_s = t_s;
   t_last_event_ = std::isnan(t_last_event_) ? t_s : std::max(t_last_event_, t_s);
   summary_.end_t_s = t_last_event_;
@@ -776,6 +779,8 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   ++summary_.n_tdoa_total;
   last_tdoa_ = TdoaUpdateResult{};
   last_tdoa_in_flight_ = false;
+  // (F31) a TDoA longer than its anchor pair's baseline (or not finite) is no range difference: skipped
+  if (!checkTdoaRange(z, anchors_, summary_.sensor_range)) return;
   const double t = z.t_s;
   if (!initialized_) {
     if (imu_mode_) {

@@ -26,6 +26,9 @@ EstimateStream::EstimateStream(const EkfParams& params, AnchorTable anchors, dou
 }
 
 void EstimateStream::restart() {
+  // (F31) the range check's counts outlive the estimator
+  if (guarded_ || plain_) range_before_.merge(estimator().summary().sensor_range);
+  else range_before_ = SensorRangeReport(params_);
   // as TdoaLocalizer::run: with a bias model and bias_guard the corrected and the uncorrected filter run side by side
   guarded_.reset();
   plain_.reset();
@@ -84,6 +87,12 @@ bool EstimateStream::accept(const StreamEvent& ev) {
   t_max_ = std::max(t_max_, ev.t_s);
   if (ready() && ev.t_s - t_last_out_ >= output_period_s_) return emit(ev.t_s);
   return false;
+}
+
+SensorRangeReport EstimateStream::sensorRange() const {
+  SensorRangeReport r = range_before_;
+  r.merge(estimator().summary().sensor_range);
+  return r;
 }
 
 bool EstimateStream::finish() {

@@ -79,6 +79,8 @@ struct BiasFlightReport {
   /// The TDoA bias level the filter measured in flight before any correction (filter.md F23c, F24b); NaN without a
   /// filter run (ground-truth inputs) or when it counted no window
   double bias_level_m = std::numeric_limits<double>::quiet_NaN();
+  /// Samples the filter skipped outside the sensors' physical ranges (filter.md F31); none counted without a filter run
+  SensorRangeReport sensor_range;
 };
 
 struct BiasDataset {

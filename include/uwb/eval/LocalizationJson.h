@@ -13,6 +13,7 @@
 #include "uwb/eval/TrajectoryMetrics.h"
 #include "uwb/filter/EkfParams.h"
 #include "uwb/filter/Estimator.h"
+#include "uwb/filter/SensorRange.h"
 
 namespace uwb {
 
@@ -21,6 +22,9 @@ namespace uwb {
 nlohmann::json localizerSummaryJson(const LocalizerSummary& s, const EkfParams& params);
 /// Position-error statistics {n, rmse_m, rmse_x_m, rmse_y_m, rmse_z_m, mean_m, p50_m, p90_m, p99_m, max_m}.
 nlohmann::json positionErrorStatsJson(const PositionErrorStats& s);
+/// The samples skipped outside the sensors' physical ranges (filter.md F31), per sensor: {"gyro": {"n", "limit",
+/// "first_t_s", "worst"}, "acc": …, "tdoa": …}; first_t_s and worst are null when nothing was skipped or not finite.
+nlohmann::json sensorRangeJson(const SensorRangeReport& report);
 /// The checks after a run (eval/RunDiagnostics.h); null for a check that did not run.
 nlohmann::json runDiagnosticsJson(const RunDiagnostics& d);
 

@@ -229,6 +229,18 @@ struct EkfParams {
   double tof_max_range_m = 3.5;          ///< readings above this (VL53L1x limit), ≤ 0 or non-finite are ignored [m]
   double tof_gate_sigma = 4.0;           ///< Mahalanobis gate on the ToF innovation (F11); ≤ 0 disables
 
+  // --- the sensors' physical ranges, docs/math/filter.md F31: a sample outside is skipped, counted and reported ---
+  /// ‖ω‖ above this is no reading [rad/s]: 2× the full scale of a ±2000 deg/s gyro (Crazyflie 2.x BMI088, 34.9 rad/s
+  /// per axis; saturated on all three axes ‖ω‖ = 60.5 rad/s). Dev flights: at most 8.6 rad/s (F31).
+  double max_gyro_radps = 70.0;
+  /// ‖f‖ above this is no reading [m/s²]: 50 g, about 2× the full scale of a ±24 g accelerometer (BMI088; saturated
+  /// on all three axes 41.6 g). Dev flights: at most 4.9 g (F31).
+  double max_acc_mps2 = 490.0;
+  /// A TDoA whose |z| exceeds its anchor pair's baseline ‖a_B − a_A‖ by more than this is no range difference [m]
+  /// (triangle inequality; the margin covers noise, NLOS delay and survey error). Dev flights: 0.61 m at most, apart
+  /// from gross outliers 17–50 m beyond (F31).
+  double max_tdoa_excess_m = 1.0;
+
   /// Throws std::invalid_argument naming the first field that is out of range.
   void validate() const;
 

@@ -37,6 +37,7 @@
 #include "uwb/filter/EkfParams.h"
 #include "uwb/filter/InMotionAlignment.h"
 #include "uwb/filter/RestDetector.h"
+#include "uwb/filter/SensorRange.h"
 #include "uwb/filter/SensorEvents.h"
 #include "uwb/filter/StartReplay.h"
 #include "uwb/filter/StartUp.h"
@@ -86,6 +87,8 @@ struct LocalizerSummary {
   std::size_t n_tof_invalid = 0;       ///< non-finite, ≤ 0 or above tof_max_range_m (ignored)
   std::size_t n_tof_tilted = 0;        ///< cos(tilt) ≤ kTofMinCosTilt (ignored)
   std::size_t n_tof_not_ready = 0;     ///< before the position was known
+  /// Samples outside the sensors' physical ranges, skipped (F31): per sensor the count, first stamp, worst value
+  SensorRangeReport sensor_range;
   // ranges to neighbouring agents (message-passing.md G20–G22; only through addNeighbourRange)
   std::size_t n_coop_total = 0;
   std::size_t n_coop_used = 0;

@@ -73,6 +73,9 @@ class EstimateStream {
   /// Every clock jump accepted, in order (each restarted the estimator).
   const std::vector<StreamClockJump>& clockJumps() const { return jumps_; }
   bool ready() const { return guarded_ ? guarded_->ready() : plain_->ready(); }
+  /// Samples skipped outside the sensors' physical ranges (filter.md F31) over the whole stream: the estimators
+  /// before each clock jump's restart and the current one.
+  SensorRangeReport sensorRange() const;
 
  private:
   bool emit(double t_s);
@@ -109,6 +112,7 @@ class EstimateStream {
   std::size_t n_outliers_ = 0;
   double t_last_outlier_s_ = 0.0, t_last_outlier_clock_s_ = 0.0;
   std::vector<StreamClockJump> jumps_;
+  SensorRangeReport range_before_;  ///< (F31) of the estimators replaced by restarts
 };
 
 }  // namespace uwb
