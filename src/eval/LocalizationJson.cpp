@@ -115,6 +115,7 @@ json runDiagnosticsJson(const RunDiagnostics& d) {
                                    {"inlier_rms_m", s.inlier_rms_m},
                                    {"start_rms_residual_m", s.start_rms_residual_m},
                                    {"misfit", s.misfit},
+                                   {"outliers", s.outliers},
                                    {"mean_error_vs_truth_m", s.has_truth ? vecJson(s.mean_error_m) : json(nullptr)},
                                    {"frame_offset", s.frame_offset}};
   if (d.anchors.done) {

@@ -94,7 +94,9 @@ SurveyFitCheck checkSurveyFit(const Flight& flight, const AnchorSurvey& survey, 
     c.inlier_rms_m = n_in > 0 ? std::sqrt(sum / static_cast<double>(n_in)) : 0.0;
   }
   c.start_rms_residual_m = run.summary.start_rms_residual_m;
-  c.misfit = c.n > 0 && c.truncated_rms_m > p.survey_fit_max_rms_m;
+  // a wrong survey spreads every residual; outliers (multipath, a faulty anchor) leave the others small
+  c.misfit = c.n > 0 && c.truncated_rms_m > p.survey_fit_max_rms_m && c.inlier_rms_m > p.survey_fit_max_inlier_rms_m;
+  c.outliers = c.n > 0 && !c.misfit && c.gross_fraction > p.outlier_warn_fraction;
   if (run.metrics) {
     std::size_t n = 0;
     for (const PositionErrorSample& e : run.metrics->samples)
@@ -313,6 +315,11 @@ std::vector<std::string> RunDiagnostics::warnings() const {
                 fmt("%.2f", survey.truncated_rms_m) + " m over the flight (clean flights ≤ 0.3 m), " +
                 fmt("%.0f", 100.0 * survey.gross_fraction) +
                 " % of the residuals above 1 m; is it the survey of this arena, with these anchor ids?");
+  if (survey.outliers)
+    w.push_back(fmt("%.0f", 100.0 * survey.gross_fraction) + " % of the TDoA are off the estimate by more than 1 m " +
+                "while the others fit the survey " + survey_source + " (their RMS " +
+                fmt("%.2f", survey.inlier_rms_m) + " m): outliers in the measurements (multipath, an obstructed or " +
+                "faulty anchor), not a wrong survey; the filter's gate rejected what it could");
   if (survey.frame_offset)
     w.push_back("the estimate is offset from the flight's ground truth by " + fmtVec(survey.mean_error_m) +
                 " m on average: the survey " + survey_source +
@@ -336,6 +343,7 @@ std::string RunDiagnostics::verdict() const {
   if (doubts.floor_doubted_s > 1.0) add("floor doubted " + fmt("%.1f", doubts.floor_doubted_s) + " s");
   if (doubts.inconsistent_s > 1.0) add("inconsistent " + fmt("%.1f", doubts.inconsistent_s) + " s");
   if (survey.misfit) add("survey misfit (rms " + fmt("%.2f", survey.truncated_rms_m) + " m)");
+  if (survey.outliers) add("TDoA outliers " + fmt("%.0f", 100.0 * survey.gross_fraction) + " %");
   if (survey.frame_offset) add("frame offset " + fmtVec(survey.mean_error_m) + " m vs truth");
   if (anchors.named_id >= 0)
     add("anchor " + std::to_string(anchors.named_id) + " named " + fmtVec(anchors.named_offset_m) + " m");

@@ -182,6 +182,33 @@ TEST(RunDiagnosticsReal, SurveyOfAnotherArenaOrShiftedIsReported) {
   }
 }
 
+// One TDoA in five off by ±5 m over the whole flight: the estimate holds (the gate rejects them), the other residuals
+// fit the survey, so the warning names outliers in the measurements and does not blame the survey.
+TEST(RunDiagnosticsReal, TdoaOutliersAreNamedAsSuchNotAsASurveyMisfit) {
+  auto real = loadReal();
+  UWB_REQUIRE_REAL_DATA(real);
+  Flight f = real->flight;
+  for (std::size_t k = 0; k < f.tdoa.size(); k += 5) f.tdoa[k].tdoa_m += (k % 10 == 0) ? 5.0 : -5.0;
+  const RunDiagnostics d = diagnose(f, real->survey, only(true, false, false));
+  EXPECT_GT(d.survey.gross_fraction, 0.15);
+  EXPECT_GT(d.survey.truncated_rms_m, 0.45);  // the truncated RMS alone called this a misfit
+  EXPECT_LT(d.survey.inlier_rms_m, 0.3);
+  EXPECT_FALSE(d.survey.misfit) << d.verdict();
+  EXPECT_TRUE(d.survey.outliers) << d.verdict();
+  const std::vector<std::string> w = d.warnings();
+  ASSERT_EQ(w.size(), 1u) << d.verdict();
+  EXPECT_NE(w[0].find("outliers in the measurements"), std::string::npos) << w[0];
+  EXPECT_EQ(w[0].find("does not fit"), std::string::npos) << w[0];
+  // and the survey of another arena still spreads the residuals below 1 m too
+  Flight g = real->flight;
+  AnchorSurvey s = real->survey;
+  injectFault(fault(FaultKind::kSurveyOtherArena, 0), g, s);
+  const RunDiagnostics other = diagnose(g, s, only(true, false, false));
+  EXPECT_GT(other.survey.inlier_rms_m, 0.35) << other.verdict();
+  EXPECT_TRUE(other.survey.misfit);
+  EXPECT_FALSE(other.survey.outliers);
+}
+
 /// A simulated circle over the paper's anchors: every check silent, then each fault named.
 TEST(RunDiagnosticsSim, EachCheckOnASimulatedFlight) {
   const sim::SimResult simres = sim::simulateFlight(

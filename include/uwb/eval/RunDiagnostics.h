@@ -46,6 +46,11 @@ struct RunDiagnosticParams {
   /// Survey fit: truncated RMS of the airborne residuals above this → the survey does not fit the TDoA [m]. Clean
   /// dev flights 0.23–0.39 m; docs/robustness.md gives the data.
   double survey_fit_max_rms_m = 0.45;
+  /// … and the RMS of the residuals below gross_residual_m above this: a survey that does not fit spreads every
+  /// residual; TDoA outliers leave the others as on a clean flight (0.1–0.3 m) [m] (docs/robustness.md).
+  double survey_fit_max_inlier_rms_m = 0.35;
+  /// Share of gross residuals above this while the others fit: a warning of TDoA outliers, not of the survey.
+  double outlier_warn_fraction = 0.1;
   /// With ground truth: the mean airborne error vector longer than this → the survey and the truth are in
   /// different frames [m].
   double max_mean_error_m = 1.0;
@@ -95,7 +100,8 @@ struct SurveyFitCheck {
   double start_rms_residual_m = 0.0;  ///< the start-up multilateration's residual RMS (LocalizerSummary)
   bool has_truth = false;
   Vec3 mean_error_m = Vec3::Zero();   ///< mean airborne estimate − truth (with ground truth)
-  bool misfit = false;            ///< truncated_rms_m > survey_fit_max_rms_m
+  bool misfit = false;            ///< truncated_rms_m > survey_fit_max_rms_m and inlier_rms_m > survey_fit_max_inlier_rms_m
+  bool outliers = false;          ///< not misfit, gross_fraction > outlier_warn_fraction: outliers in the TDoA
   bool frame_offset = false;      ///< |mean_error_m| > max_mean_error_m
 };
 
