@@ -18,7 +18,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       params.validate();
     });
     if (j.is_object())
-      for (const auto& [key, value] : j.items()) {
+      for (const auto& item : j.items()) {
+        const std::string& key = item.key();  // not a structured binding: clang 14 cannot capture one
+        const auto& value = item.value();
         fuzz::expectCleanRejection([&] { (void)jsonDouble(value, key); });
         fuzz::expectCleanRejection([&] { (void)jsonString(value, key); });
       }
