@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 
 PACKAGES=(build-essential cmake ninja-build libeigen3-dev libcli11-dev nlohmann-json3-dev libfmt-dev
           libgtest-dev libgmock-dev libbenchmark-dev pybind11-dev python3-dev python3-numpy
-          python3-matplotlib python3-pytest libzmq3-dev cppzmq-dev python3-zmq libboost-dev)
+          python3-matplotlib python3-pytest python3-yaml libzmq3-dev cppzmq-dev python3-zmq libboost-dev)
 # Only for scripts/fuzz.sh (libFuzzer harnesses need clang): installed when UWB_WITH_CLANG=1.
 CLANG_PACKAGES=(clang-14 libclang-rt-14-dev)
 [ "${UWB_WITH_CLANG:-0}" = "1" ] && PACKAGES+=("${CLANG_PACKAGES[@]}")
