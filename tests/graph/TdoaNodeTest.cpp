@@ -46,7 +46,11 @@ Moments bruteForcePosterior(const NodeScene& s, int which) {
   V.block<3, 3>(6, 6) = s.x_j.V;
   V(9, 9) = s.var_m2;
   Eigen::RowVectorXd L(10);
-  L << s.lin.B12(), -s.lin.B1, s.lin.B2, 1.0;
+  // by segments: GCC 12 reads a comma-initialized 3-vector with a 4-wide AVX load (a -Warray-bounds false positive)
+  L.segment<3>(0) = s.lin.B12();
+  L.segment<3>(3) = -s.lin.B1;
+  L.segment<3>(6) = s.lin.B2;
+  L(9) = 1.0;
   MatX T = MatX::Zero(4, 10);  // [x_which; z]
   T.block<3, 3>(0, 3 * which) = Mat3::Identity();
   T.row(3) = L;
