@@ -42,11 +42,14 @@ double rangeNorm(const Vec3& v) {
 
 bool checkImuRange(double t_s, const ImuReading& imu, SensorRangeReport& report) {
   // docs/math/filter.md (F31): ‖ω‖ ≤ ω_max, ‖f‖ ≤ f_max, all finite (a NaN fails every comparison)
-  const double w = rangeNorm(imu.b_gyro_radps), f = rangeNorm(imu.b_acc_mps2);
-  const bool gyro_ok = w <= report.gyro.limit, acc_ok = f <= report.acc.limit;
+  // compared squared on the per-sample path (a NaN or an overflow to inf fails the comparison); the overflow-safe
+  // norm only for a sample that is reported
+  const double w_lim = report.gyro.limit, f_lim = report.acc.limit;
+  const bool gyro_ok = imu.b_gyro_radps.squaredNorm() <= w_lim * w_lim;
+  const bool acc_ok = imu.b_acc_mps2.squaredNorm() <= f_lim * f_lim;
   if (gyro_ok && acc_ok && std::isfinite(t_s)) return true;
-  if (!gyro_ok) report.gyro.add(t_s, w);
-  if (!acc_ok) report.acc.add(t_s, f);
+  if (!gyro_ok) report.gyro.add(t_s, rangeNorm(imu.b_gyro_radps));
+  if (!acc_ok) report.acc.add(t_s, rangeNorm(imu.b_acc_mps2));
   return false;
 }
 
