@@ -34,10 +34,6 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-std::string readAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 void writeAll(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
 
@@ -70,8 +66,8 @@ test::CliResult runArgs(const fs::path& cwd, const std::vector<std::string>& arg
   ::waitpid(pid, &status, 0);
   test::CliResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = readAll(out);
-  r.err = readAll(err);
+  r.out = test::readFileBytes(out);
+  r.err = test::readFileBytes(err);
   fs::remove(out);
   fs::remove(err);
   return r;
@@ -122,7 +118,7 @@ class HostileCli : public ::testing::Test {
   /// The flight's CSV with `edit(header, rows)` applied to its lines.
   static std::string editedFlight(const std::function<void(std::vector<std::string>&)>& edit) {
     std::vector<std::string> lines;
-    std::istringstream in(readAll(flight_));
+    std::istringstream in(test::readFileBytes(flight_));
     for (std::string line; std::getline(in, line);) lines.push_back(line);
     edit(lines);
     std::string text;
@@ -186,7 +182,7 @@ TEST_F(HostileCli, AFifoOrASymlinkAsOutputIsRefusedAndKept) {
   EXPECT_EQ(s.exit_code, 3) << s.err;
   EXPECT_THAT(s.err, HasSubstr("symbolic link"));
   EXPECT_TRUE(fs::is_symlink(link));
-  EXPECT_EQ(readAll(target), "keep me\n");
+  EXPECT_EQ(test::readFileBytes(target), "keep me\n");
   if (fs::exists("/dev/null")) {
     const test::CliResult d = runArgs(case_, {"localize", flight_, "--anchors", survey_, "--out", "/dev/null"});
     EXPECT_EQ(d.exit_code, 3) << d.err;
@@ -200,7 +196,7 @@ TEST_F(HostileCli, AnOutputThatIsAnInputIsRefusedAndTheInputKept) {
   fs::copy_file(flight_, flight);
   fs::copy_file(survey_, survey);
   fs::create_hard_link(flight, hard);
-  const std::string before = readAll(flight), survey_before = readAll(survey);
+  const std::string before = test::readFileBytes(flight), survey_before = test::readFileBytes(survey);
   for (const fs::path& out : {flight, hard}) {
     const test::CliResult r = runArgs(case_, {"localize", "f.csv", "--anchors", "s.txt", "--out", out.string()});
     EXPECT_EQ(r.exit_code, 3) << r.err;
@@ -210,8 +206,8 @@ TEST_F(HostileCli, AnOutputThatIsAnInputIsRefusedAndTheInputKept) {
                                             "5", "--epochs", "1", "--quiet", "--out", "s.txt"});
   EXPECT_EQ(t.exit_code, 3) << t.err;
   EXPECT_THAT(t.err, HasSubstr("input file"));
-  EXPECT_EQ(readAll(flight), before);
-  EXPECT_EQ(readAll(survey), survey_before);
+  EXPECT_EQ(test::readFileBytes(flight), before);
+  EXPECT_EQ(test::readFileBytes(survey), survey_before);
 }
 
 TEST_F(HostileCli, AReplacedOutputKeepsItsPermissions) {
@@ -224,7 +220,7 @@ TEST_F(HostileCli, AReplacedOutputKeepsItsPermissions) {
   struct stat st {};
   ASSERT_EQ(::stat(out.c_str(), &st), 0);
   EXPECT_EQ(st.st_mode & 0777, 0600u);
-  EXPECT_NE(readAll(out), "old\n");
+  EXPECT_NE(test::readFileBytes(out), "old\n");
 }
 
 // ------------------------------------------------------------------------------------------------ 3. deep JSON
@@ -278,7 +274,7 @@ TEST_F(HostileCli, AFileOfExactlyTwoGibibytesIsRefusedBeforeReading) {
 // --------------------------------------------------------------------------------- 6. absurd models, NaN output
 
 TEST_F(HostileCli, ABiasModelWithAnAbsurdVariationalMeanIsRefusedOnLoad) {
-  nlohmann::json j = nlohmann::json::parse(readAll(model()));
+  nlohmann::json j = nlohmann::json::parse(test::readFileBytes(model()));
   j["models"][0]["svgp"]["variational"]["m"][0] = 1e300;
   writeAll(case_ / "absurd.json", j.dump());
   const test::CliResult r = runArgs(case_, {"localize", flight_, "--anchors", survey_, "--bias-model", "absurd.json",
@@ -317,7 +313,7 @@ TEST_F(HostileCli, NoCommandWritesANonFiniteEstimate) {
     const test::CliResult r = runArgs(case_, args);
     // THEN either every number written is finite, or the command fails saying so and writes nothing
     if (r.exit_code == 0) {
-      const std::string out = readAll(case_ / "out.csv");
+      const std::string out = test::readFileBytes(case_ / "out.csv");
       EXPECT_THAT(out, Not(HasSubstr("nan")));
       EXPECT_THAT(out, Not(HasSubstr("inf")));
     } else {
@@ -349,7 +345,7 @@ TEST_F(HostileCli, ARunThatNeverFindsAPositionFailsAndSaysWhy) {
   // GIVEN the survey scaled by 1e9 (a unit error)
   std::string scaled;
   {
-    std::istringstream in(readAll(survey_));
+    std::istringstream in(test::readFileBytes(survey_));
     for (std::string line; std::getline(in, line);) {
       std::vector<std::string> c = cells(line);
       if (!c.empty() && c[0].rfind("an", 0) == 0 && c[0].size() > 2 && c[0].back() == 'p') {
@@ -413,7 +409,7 @@ TEST_F(HostileCli, AnImuThatEndsMidFlightIsAWarningWithBothEndTimes) {
 TEST_F(HostileCli, TwoAnchorsAtOnePlaceAreAWarningNamingBoth) {
   // GIVEN the survey with anchor 1's coordinates copied onto anchor 2
   std::string text, p1;
-  std::istringstream in(readAll(survey_));
+  std::istringstream in(test::readFileBytes(survey_));
   std::vector<std::string> lines;
   for (std::string line; std::getline(in, line);) lines.push_back(line);
   for (const auto& l : lines)

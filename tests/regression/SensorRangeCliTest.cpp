@@ -29,10 +29,6 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-std::string readAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 std::vector<std::string> split(const std::string& line, char sep = ',') {
   std::vector<std::string> c;
@@ -86,7 +82,7 @@ class SensorRangeCli : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("uwb_sensor_range_" + std::to_string(::getpid()) + "_" +
                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
-    text_ = readAll(*flight_);
+    text_ = test::readFileBytes(*flight_);
   }
   void TearDown() override {
     if (!dir_.empty()) fs::remove_all(dir_);
@@ -107,7 +103,7 @@ class SensorRangeCli : public ::testing::Test {
     fs::remove(out);
     const test::CliResult r =
         test::runCli("localize " + flight + " --anchors " + survey_ + " --json --no-diagnostics --out " + out);
-    Run run{r.exit_code, nullptr, fs::exists(out) ? readAll(out) : std::string(), r.err};
+    Run run{r.exit_code, nullptr, fs::exists(out) ? test::readFileBytes(out) : std::string(), r.err};
     if (r.exit_code == 0) run.j = nlohmann::json::parse(r.out);
     return run;
   }
@@ -161,7 +157,7 @@ TEST_F(SensorRangeCli, PredictBiasOnEstimatedInputsWritesNoNanRowForOneBadGyroSa
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json jc = nlohmann::json::parse(c.out), j = nlohmann::json::parse(r.out);
   EXPECT_NEAR(j["n_rows"].get<double>(), jc["n_rows"].get<double>(), 0.02 * jc["n_rows"].get<double>());
-  const std::string rows = readAll(out);
+  const std::string rows = test::readFileBytes(out);
   EXPECT_THAT(rows, Not(HasSubstr("nan")));
   EXPECT_THAT(rows, Not(HasSubstr("inf")));
   EXPECT_LE(j["bias_rmse_before_m"].get<double>(), 1.05 * jc["bias_rmse_before_m"].get<double>());

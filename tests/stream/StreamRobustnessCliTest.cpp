@@ -40,8 +40,7 @@ class StreamFaults : public ::testing::Test {
     fs::create_directories(dir_);
     flight_ = (dir_ / "flight.csv").string();
     survey_ = (dir_ / "survey.txt").string();
-    const test::CliResult sim = test::runCli("simulate --trajectory circle --duration 30 --seed 3 --json --out " +
-                                             flight_ + " --survey-out " + survey_);
+    const test::CliResult sim = test::simulateCircleFiles(flight_, survey_);
     ASSERT_EQ(sim.exit_code, 0) << sim.err;
     const test::CliResult replay = test::runCli("replay " + flight_);
     ASSERT_EQ(replay.exit_code, 0) << replay.err;

@@ -48,6 +48,16 @@ CliResult runCli(const std::string& args) {
   return r;
 }
 
+CliResult simulateCircleFiles(const std::string& flight_csv, const std::string& survey_txt) {
+  return runCli("simulate --trajectory circle --duration 30 --seed 3 --json --out " + flight_csv + " --survey-out " +
+                survey_txt);
+}
+
+std::string readFileBytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 double relativeError(const MatX& a, const MatX& b) {
   const double denom = b.cwiseAbs().maxCoeff();
   const double num = (a - b).cwiseAbs().maxCoeff();

@@ -31,6 +31,11 @@ struct CliResult {
 };
 /// Runs `uwbtdoa <args>` through the shell (args are not quoted).
 CliResult runCli(const std::string& args);
+/// `uwbtdoa simulate` of the 30 s circle (seed 3) into `flight_csv` and `survey_txt`: the shared input of the CLI
+/// robustness tests.
+CliResult simulateCircleFiles(const std::string& flight_csv, const std::string& survey_txt);
+/// The whole file as bytes (empty when it cannot be read).
+std::string readFileBytes(const std::filesystem::path& path);
 
 /// Skips the current test with a clear message when the real data is absent.
 #define UWB_REQUIRE_REAL_DATA(path_opt)                                                           \
