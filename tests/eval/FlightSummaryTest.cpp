@@ -177,7 +177,7 @@ TEST(RealDataManifest, FinalExtractResidualsMatchSourceMd) {
 TEST(RealDataInspectCli, JsonIsExactlyOneObject) {
   const auto flight = test::pilotFlight("0425-traj4");
   UWB_REQUIRE_REAL_DATA(flight);
-  if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built at " << test::cliPath();
+  UWB_REQUIRE_CLI();
   test::TempDir dir;
   const std::string out = dir.file("out.json");
   const std::string cmd = test::cliPath() + " inspect " + flight->string() + " --anchors " +
@@ -191,7 +191,7 @@ TEST(RealDataInspectCli, JsonIsExactlyOneObject) {
 }
 
 TEST(InspectCli, BadInputExitsNonZeroWithLocationOnStderr) {
-  if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built at " << test::cliPath();
+  UWB_REQUIRE_CLI();
   test::TempDir dir;
   const std::string bad = dir.write("bad.csv", "t_tdoa,idA,idB,tdoa_meas\n0.1,1,2,oops\n");
   const std::string cmd = test::cliPath() + " inspect " + bad + " --json > " + dir.file("o") + " 2> " + dir.file("e");

@@ -19,7 +19,7 @@ namespace {
 class ProtocolCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
+    UWB_REQUIRE_CLI();
     UWB_REQUIRE_REAL_DATA(test::pilotFlight("0425-traj2"));
   }
   /// `uwbtdoa protocol --json --no-sim` on the flight with `options`; its JSON output.
@@ -90,7 +90,7 @@ TEST_F(ProtocolCli, AWrittenCutGivesTheSameResultWithLocalize) {
 }
 
 TEST(ProtocolCliSims, AWrittenSimulatedRunGivesTheSameResultWithLocalize) {
-  if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
+  UWB_REQUIRE_CLI();
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("uwb_protocol_sims_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);

@@ -25,12 +25,23 @@ std::string readAll(const std::filesystem::path& p) {
   return ss.str();
 }
 
+/// `localize` (a command line ending in --json) without and with the bias model `model`: the corrected airborne RMSE
+/// is below `factor` times the uncorrected one.
+void expectModelCorrects(const std::string& localize, const std::string& model, double factor) {
+  const test::CliResult plain = test::runCli(localize), corrected = test::runCli(localize + " --bias-model " + model);
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  ASSERT_EQ(corrected.exit_code, 0) << corrected.err;
+  const double before = nlohmann::json::parse(plain.out).at("rmse_airborne_m").get<double>();
+  const double after = nlohmann::json::parse(corrected.out).at("rmse_airborne_m").get<double>();
+  EXPECT_LT(after, factor * before) << "uncorrected " << before << " m, corrected " << after << " m";
+}
+
 TEST(TrainCli, DumpsNamedTrainingArraysAndIsRepeatableForASeedAndThreadCount) {
-  if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
+  UWB_REQUIRE_CLI();
   const auto flight = test::pilotFlight("0425-traj3");
   UWB_REQUIRE_REAL_DATA(flight);
-  const auto dir = std::filesystem::temp_directory_path() / ("uwb_train_cli_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  const test::TempDir tmp("train_cli");
+  const std::filesystem::path& dir = tmp.path();
   const std::string base = "train " + flight->string() + " --anchors " + test::pilotSurvey("0425").string() +
                            " --kernel tdoa --inducing 10 --epochs 2 --threads 2 --quiet --json";
   // WHEN the same training runs twice, the first one also dumping its arrays
@@ -71,13 +82,12 @@ TEST(TrainCli, DumpsNamedTrainingArraysAndIsRepeatableForASeedAndThreadCount) {
   EXPECT_GT(mean_level, 0.02);
   EXPECT_LT(mean_level, 0.5);
   EXPECT_EQ(summary.at("training_mean_level_m").get<double>(), mean_level);
-  std::filesystem::remove_all(dir);
 }
 
 /// The default of `train` (gp.md P26c) on split A of docs/results.md: a model of the four sine flights 0425-traj6…9
 /// corrects the circle flight 0425-traj2 (there 0.176 → 0.137 m with the tdoa kernel's 0.149 m beside it).
 TEST(TrainCli, TheDefaultModelIsPerPairWithAnArenaMapAndCorrectsAnotherFlight) {
-  if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
+  UWB_REQUIRE_CLI();
   std::string flights;
   for (const char* name : {"0425-traj6", "0425-traj7", "0425-traj8", "0425-traj9"}) {
     const auto flight = test::pilotFlight(name);
@@ -87,8 +97,8 @@ TEST(TrainCli, TheDefaultModelIsPerPairWithAnArenaMapAndCorrectsAnotherFlight) {
   const auto test_flight = test::pilotFlight("0425-traj2");
   UWB_REQUIRE_REAL_DATA(test_flight);
   const std::string survey = " --anchors " + test::pilotSurvey("0425").string();
-  const auto dir = std::filesystem::temp_directory_path() / ("uwb_train_default_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  const test::TempDir tmp("train_default");
+  const std::filesystem::path& dir = tmp.path();
   const std::string model = (dir / "m.json").string();
   // WHEN a model is trained with no kernel or M given
   const test::CliResult trained = test::runCli("train " + flights + survey + " --quiet --json --out " + model);
@@ -100,18 +110,12 @@ TEST(TrainCli, TheDefaultModelIsPerPairWithAnArenaMapAndCorrectsAnotherFlight) {
   EXPECT_GT(summary.at("num_models").get<int>(), 1);
   // AND it takes the other flight's airborne RMSE well below the uncorrected filter's
   const std::string localize = "localize " + test_flight->string() + survey + " --no-diagnostics --json";
-  const test::CliResult plain = test::runCli(localize), corrected = test::runCli(localize + " --bias-model " + model);
-  ASSERT_EQ(plain.exit_code, 0) << plain.err;
-  ASSERT_EQ(corrected.exit_code, 0) << corrected.err;
-  const double before = nlohmann::json::parse(plain.out).at("rmse_airborne_m").get<double>();
-  const double after = nlohmann::json::parse(corrected.out).at("rmse_airborne_m").get<double>();
-  EXPECT_LT(after, 0.9 * before) << "uncorrected " << before << " m, corrected " << after << " m";
-  std::filesystem::remove_all(dir);
+  ASSERT_NO_FATAL_FAILURE(expectModelCorrects(localize, model, 0.9));
 }
 
 TEST(TrainCli, APositionOnlyFlightWithoutImuTrainsAModelThatCorrectsAnotherDayInItsRoom) {
   // GIVEN the TDoA-only flights of util-final-extract: position-only pose, no IMU (their SOURCE.md)
-  if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
+  UWB_REQUIRE_CLI();
   const auto dir_in = test::dataDir() / "real" / "util-final-extract";
   const std::string survey = " --anchors " + (dir_in / "survey" / "anchor_const4_survey.txt").string();
   std::string flights;
@@ -122,27 +126,21 @@ TEST(TrainCli, APositionOnlyFlightWithoutImuTrainsAModelThatCorrectsAnotherDayIn
   }
   const auto test_flight = dir_in / "const4-trial2-tdoa2-traj2.csv";
   if (!std::filesystem::exists(test_flight)) GTEST_SKIP() << "util-final-extract not found under " << test::dataDir();
-  const auto dir = std::filesystem::temp_directory_path() / ("uwb_train_extract_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  const test::TempDir tmp("train_extract");
+  const std::filesystem::path& dir = tmp.path();
   const std::string model = (dir / "m.json").string();
   // WHEN the default model is trained on one trial's three flights
   const test::CliResult trained = test::runCli("train " + flights + survey + " --quiet --json --out " + model);
   ASSERT_EQ(trained.exit_code, 0) << trained.err;
   // THEN it takes a flight of the other trial well below the uncorrected filter (measured: 0.171 -> 0.101 m)
   const std::string localize = "localize " + test_flight.string() + survey + " --no-diagnostics --json";
-  const test::CliResult plain = test::runCli(localize), corrected = test::runCli(localize + " --bias-model " + model);
-  ASSERT_EQ(plain.exit_code, 0) << plain.err;
-  ASSERT_EQ(corrected.exit_code, 0) << corrected.err;
-  const double before = nlohmann::json::parse(plain.out).at("rmse_airborne_m").get<double>();
-  const double after = nlohmann::json::parse(corrected.out).at("rmse_airborne_m").get<double>();
-  EXPECT_LT(after, 0.8 * before) << "uncorrected " << before << " m, corrected " << after << " m";
+  ASSERT_NO_FATAL_FAILURE(expectModelCorrects(localize, model, 0.8));
   // AND predict-bias scores the model there, its features formed in the same frame
   const test::CliResult scored = test::runCli("predict-bias " + test_flight.string() + survey + " --model " + model +
                                               " --json --out " + (dir / "bias.csv").string());
   ASSERT_EQ(scored.exit_code, 0) << scored.err;
   const nlohmann::json cal = nlohmann::json::parse(scored.out).at("calibration");
   EXPECT_GT(cal.at("coverage_2sigma").get<double>(), 0.9);
-  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
 /** @file IoTestHelpers.h
- *  @brief Helpers of the io tests: temporary files, bitwise flight comparison, real-data locations.
+ *  @brief Helpers of the io tests: bitwise flight comparison, real-data locations.
  */
 #pragma once
 
@@ -41,33 +41,6 @@ inline AnchorSurvey cornerSurvey() {
   for (int i = 0; i < 8; ++i) s.anchors.push_back({i, Vec3(xy[i][0], xy[i][1], z[i]), Quat::Identity()});
   return s;
 }
-
-/// A fresh directory under the system temp dir, removed at destruction.
-class TempDir {
- public:
-  TempDir() {
-    std::random_device rd;
-    path_ = std::filesystem::temp_directory_path() / ("uwb_io_test_" + std::to_string(rd()) + std::to_string(rd()));
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  /// Writes `text` to a file named `name` in the directory and returns its path.
-  std::string write(const std::string& name, const std::string& text) const {
-    const auto p = path_ / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  std::filesystem::path path_;
-};
 
 inline bool sameBits(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
 inline bool sameBits(const Vec3& a, const Vec3& b) {

@@ -497,7 +497,7 @@ TEST(UsdDeckConfig, TheShippedConfigNamesOnlyWhatImportReadsAndItsLogImports) {
 class ImportCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
+    UWB_REQUIRE_CLI();
   }
   test::TempDir dir_;
 };

@@ -70,7 +70,7 @@ class SalvageCli : public ::testing::Test {
     delete dir_;
   }
   void SetUp() override {
-    if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
+    UWB_REQUIRE_CLI();
   }
   /// Header bytes (the events start after them): a log with the types and no event, less its CRC.
   static std::size_t headerBytes() {

@@ -14,7 +14,7 @@
 
 #include <unistd.h>
 
-#include "support/TestSupport.h"
+#include "support/CliFixture.h"
 #include "support/UsdDeckConfig.h"
 #include "uwb/io/SurveyCheck.h"
 #include "uwb/io/TrajectoryCsv.h"
@@ -25,19 +25,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class SlowCrazyflieGuide : public ::testing::Test {
+class SlowCrazyflieGuide : public test::PilotFlightCliTest {
  protected:
-  void SetUp() override {
-    if (!fs::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
-    flight_ = test::pilotFlight("0425-traj2");
-    UWB_REQUIRE_REAL_DATA(flight_);
-    dir_ = fs::temp_directory_path() / ("uwb_guide_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    if (!dir_.empty()) fs::remove_all(dir_);
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  SlowCrazyflieGuide() : PilotFlightCliTest("guide", "0425-traj2") {}
   /// `uwbtdoa <command> <args>` as the guide writes it, its file names taken in the test's directory.
   test::CliResult run(const std::string& command_line) const {
     std::istringstream in(command_line);
@@ -46,8 +36,6 @@ class SlowCrazyflieGuide : public ::testing::Test {
     while (in >> word) out += " " + (word.find('.') != std::string::npos || word == "log00" ? path(word) : word);
     return test::runCli(out);
   }
-  std::optional<fs::path> flight_;
-  fs::path dir_;
 };
 
 TEST_F(SlowCrazyflieGuide, TheGuidesCommandsFromTheUsdLogToTheFigure) {

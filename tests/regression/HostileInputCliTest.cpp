@@ -25,7 +25,7 @@
 #include <sstream>
 #include <thread>
 
-#include "support/TestSupport.h"
+#include "support/CliFixture.h"
 
 namespace uwb {
 namespace {
@@ -84,23 +84,14 @@ std::vector<std::string> temporaryFiles(const fs::path& dir) {
 }
 
 /// A 30 s simulated flight with ground truth, its survey and a tiny bias model, shared by the tests of this file.
-class HostileCli : public ::testing::Test {
+class HostileCli : public test::SimulatedCircleSuite<HostileCli> {
+ public:
+  static constexpr const char* kTag = "hostile_cli";
+
  protected:
-  static void SetUpTestSuite() {
-    if (!fs::exists(test::cliPath())) return;
-    dir_ = fs::temp_directory_path() / ("uwb_hostile_cli_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-    flight_ = (dir_ / "flight.csv").string();
-    survey_ = (dir_ / "survey.txt").string();
-    const test::CliResult sim = runArgs(dir_, {"simulate", "--trajectory", "circle", "--duration", "30", "--seed", "3",
-                                               "--out", flight_, "--survey-out", survey_});
-    ASSERT_EQ(sim.exit_code, 0) << sim.err;
-  }
-  static void TearDownTestSuite() {
-    if (!dir_.empty()) fs::remove_all(dir_);
-  }
   void SetUp() override {
-    if (!fs::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
+    SimulatedCircleSuite::SetUp();
+    if (IsSkipped()) return;
     case_ = dir_ / ::testing::UnitTest::GetInstance()->current_test_info()->name();
     fs::create_directories(case_);
   }
@@ -145,8 +136,6 @@ class HostileCli : public ::testing::Test {
     return s;
   }
 
-  static inline fs::path dir_;
-  static inline std::string flight_, survey_;
   fs::path case_;
 };
 

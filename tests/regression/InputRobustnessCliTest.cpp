@@ -17,7 +17,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "support/TestSupport.h"
+#include "support/CliFixture.h"
 #include "uwb/eval/BiasCalibration.h"
 #include "uwb/io/UtilCsv.h"
 
@@ -29,29 +29,11 @@ using ::testing::HasSubstr;
 using ::testing::Not;
 
 /// A 30 s simulated flight, its survey and a tiny trained bias model, shared by the tests of this file.
-class RobustCli : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    if (!fs::exists(test::cliPath())) return;
-    dir_ = fs::temp_directory_path() / ("uwb_robust_cli_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-    flight_ = (dir_ / "flight.csv").string();
-    survey_ = (dir_ / "survey.txt").string();
-    const test::CliResult sim = test::simulateCircleFiles(flight_, survey_);
-    ASSERT_EQ(sim.exit_code, 0) << sim.err;
-  }
-  static void TearDownTestSuite() {
-    if (!dir_.empty()) fs::remove_all(dir_);
-  }
-  void SetUp() override {
-    if (!fs::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
-  }
+class RobustCli : public test::SimulatedCircleSuite<RobustCli> {
+ public:
+  static constexpr const char* kTag = "robust_cli";
 
-  static std::string write(const std::string& name, const std::string& text) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
+ protected:
   static std::string read(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -79,8 +61,6 @@ class RobustCli : public ::testing::Test {
     EXPECT_THAT(r.err, Not(HasSubstr("json.exception")));
   }
 
-  static inline fs::path dir_;
-  static inline std::string flight_, survey_;
 };
 
 // ----------------------------------------------------------------------------------------------- crashes, blow-ups

@@ -14,37 +14,22 @@
 
 #include <unistd.h>
 
-#include "support/TestSupport.h"
+#include "support/CliFixture.h"
 #include "uwb/io/TrajectoryCsv.h"
 
 namespace uwb {
 namespace {
 
-class LocalizeCli : public ::testing::Test {
+class LocalizeCli : public test::PilotFlightCliTest {
  protected:
-  void SetUp() override {
-    if (!std::filesystem::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
-    flight_ = test::pilotFlight("0425-traj3");
-    UWB_REQUIRE_REAL_DATA(flight_);
-    dir_ = std::filesystem::temp_directory_path() / ("uwb_localize_cli_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override {
-    if (!dir_.empty()) std::filesystem::remove_all(dir_);
-  }
+  LocalizeCli() : PilotFlightCliTest("localize_cli", "0425-traj3") {}
   nlohmann::json localize(const std::string& extra) {
     const test::CliResult r = test::runCli("localize " + flight_->string() + " --anchors " +
                                            test::pilotSurvey("0425").string() + " --json " + extra);
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return nlohmann::json::parse(r.out);
   }
-  std::string writeConfig(const std::string& name, const std::string& text) {
-    const auto p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
-  std::optional<std::filesystem::path> flight_;
-  std::filesystem::path dir_;
+  std::string writeConfig(const std::string& name, const std::string& text) { return write(name, text); }
 };
 
 TEST_F(LocalizeCli, TofFusionByFlagOrConfigUsesTheHeightSensorAndReportsItsCounters) {
@@ -84,7 +69,7 @@ TEST_F(LocalizeCli, AWindowLocalizesThePartOfTheLogAsALogStartedInTheAir) {
   // GIVEN 0425-traj3 (take-off at about 3 s, landing at about 29.6 s)
   const nlohmann::json whole = localize("--no-diagnostics");
   // WHEN only 10 … 28.57 s of it is localized (the protocol's cut at 10 s, docs/results.md)
-  const std::string traj = (dir_ / "window.csv").string();
+  const std::string traj = path("window.csv");
   const nlohmann::json cut = localize("--no-diagnostics --window 10,28.57 --out " + traj);
   // THEN the filter starts in motion from the window's first samples and holds the protocol's bound for cuts
   EXPECT_EQ(cut["window_s"], nlohmann::json({10.0, 28.57}));
@@ -125,7 +110,7 @@ TEST_F(LocalizeCli, AWindowThatIsReversedOrHoldsNoTdoaIsAClearError) {
 
 TEST_F(LocalizeCli, TumOutputHoldsTheSamePosesAsTheCsv) {
   // GIVEN the trajectory of a real flight written as CSV and, by a second run, as TUM (`--format tum`, for evo)
-  const std::string csv = (dir_ / "traj.csv").string(), tum = (dir_ / "traj.tum").string();
+  const std::string csv = path("traj.csv"), tum = path("traj.tum");
   localize("--no-diagnostics --out " + csv);
   localize("--no-diagnostics --format tum --out " + tum);
   // WHEN both are read back

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "support/TestSupport.h"
+#include "support/CliFixture.h"
 #include "uwb/io/Airborne.h"
 #include "uwb/io/PoseTrack.h"
 #include "uwb/io/UtilCsv.h"
@@ -72,25 +72,13 @@ std::string spiked(const std::string& text, const std::string& time_column, cons
   return out;
 }
 
-class SensorRangeCli : public ::testing::Test {
+class SensorRangeCli : public test::PilotFlightCliTest {
  protected:
+  SensorRangeCli() : PilotFlightCliTest("sensor_range", "0425-traj2") {}
   void SetUp() override {
-    if (!fs::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
-    flight_ = test::pilotFlight("0425-traj2");
-    UWB_REQUIRE_REAL_DATA(flight_);
-    survey_ = test::pilotSurvey("0425").string();
-    dir_ = fs::temp_directory_path() / ("uwb_sensor_range_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
+    PilotFlightCliTest::SetUp();
+    if (IsSkipped()) return;
     text_ = test::readFileBytes(*flight_);
-  }
-  void TearDown() override {
-    if (!dir_.empty()) fs::remove_all(dir_);
-  }
-  std::string write(const std::string& name, const std::string& text) const {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
   }
   /// `localize --json --no-diagnostics` on a flight file: exit code, summary, trajectory text, stderr.
   struct Run {
@@ -99,7 +87,7 @@ class SensorRangeCli : public ::testing::Test {
     std::string trajectory, err;
   };
   Run localize(const std::string& flight) const {
-    const std::string out = (dir_ / "trajectory.csv").string();
+    const std::string out = path("trajectory.csv");
     fs::remove(out);
     const test::CliResult r =
         test::runCli("localize " + flight + " --anchors " + survey_ + " --json --no-diagnostics --out " + out);
@@ -108,9 +96,7 @@ class SensorRangeCli : public ::testing::Test {
     return run;
   }
 
-  std::optional<fs::path> flight_;
-  std::string survey_, text_;
-  fs::path dir_;
+  std::string text_;
 };
 
 TEST_F(SensorRangeCli, OneGyroSampleOfHugeRateIsSkippedCountedAndWarned) {
@@ -139,7 +125,7 @@ TEST_F(SensorRangeCli, OneGyroSampleOfHugeRateIsSkippedCountedAndWarned) {
 
 TEST_F(SensorRangeCli, PredictBiasOnEstimatedInputsWritesNoNanRowForOneBadGyroSample) {
   // GIVEN a small bias model trained on 0425-traj2 and the flight with one gyro_z of 1e308 deg/s at t = 20 s
-  const std::string model = (dir_ / "model.json").string();
+  const std::string model = path("model.json");
   const test::CliResult t = test::runCli("train " + flight_->string() + " --anchors " + survey_ +
                                          " --kernel tdoa --inducing 5 --epochs 2 --quiet --out " + model);
   ASSERT_EQ(t.exit_code, 0) << t.err;
@@ -148,7 +134,7 @@ TEST_F(SensorRangeCli, PredictBiasOnEstimatedInputsWritesNoNanRowForOneBadGyroSa
     return test::runCli("predict-bias " + flight + " --anchors " + survey_ + " --model " + model +
                         " --inputs estimate --json --out " + out);
   };
-  const std::string out_clean = (dir_ / "clean.csv").string(), out = (dir_ / "bias.csv").string();
+  const std::string out_clean = path("clean.csv"), out = path("bias.csv");
   const test::CliResult c = predict(flight_->string(), out_clean);
   ASSERT_EQ(c.exit_code, 0) << c.err;
   // WHEN the bias is predicted on the filter's estimate

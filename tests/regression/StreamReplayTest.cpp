@@ -18,7 +18,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "support/TestSupport.h"
+#include "support/CliFixture.h"
 #include "uwb/eval/Localization.h"
 #include "uwb/filter/TdoaLocalizer.h"
 #include "uwb/io/FlightWindow.h"
@@ -30,25 +30,17 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class StreamCli : public ::testing::Test {
+class StreamCli : public test::PilotFlightCliTest {
  protected:
+  StreamCli() : PilotFlightCliTest("stream_cli", "0425-traj1") {}
   void SetUp() override {
-    if (!fs::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
-    flight_path_ = test::pilotFlight("0425-traj1");
-    UWB_REQUIRE_REAL_DATA(flight_path_);
-    survey_ = test::pilotSurvey("0425").string();
-    dir_ = fs::temp_directory_path() / ("uwb_stream_cli_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
+    PilotFlightCliTest::SetUp();
+    if (IsSkipped()) return;
     // 5 s in the air, as a log started in flight would hold them
-    short_ = (dir_ / "short.csv").string();
-    writeFlightCsv(sliceFlight(readFlightCsv(flight_path_->string()), 12.0, 17.0), short_);
+    short_ = path("short.csv");
+    writeFlightCsv(sliceFlight(readFlightCsv(flight_->string()), 12.0, 17.0), short_);
   }
-  void TearDown() override {
-    if (!dir_.empty()) fs::remove_all(dir_);
-  }
-  std::optional<fs::path> flight_path_;
-  std::string survey_, short_;
-  fs::path dir_;
+  std::string short_;
 };
 
 std::vector<LocalizerEstimate> parseLines(const std::string& text, EstimateFormat f, bool header) {
@@ -95,7 +87,7 @@ TEST_F(StreamCli, ReplayIntoStreamGivesTheBatchEstimates) {
 }
 
 TEST_F(StreamCli, AMalformedLineIsAnErrorNamingItsLineAndFieldUnderStrict) {
-  const std::string events = (dir_ / "bad.txt").string();
+  const std::string events = path("bad.txt");
   {
     std::ofstream out(events);
     out << "# uwbtdoa-events v1\nimu,0,0,0,9.81,0,0,0\ntdoa,0.001,0,1,zz\n";
@@ -108,7 +100,7 @@ TEST_F(StreamCli, AMalformedLineIsAnErrorNamingItsLineAndFieldUnderStrict) {
 
 TEST_F(StreamCli, ReplayAtSpeedOneTakesTheFlightsDuration) {
   // GIVEN 1 s of the flight
-  const std::string one_s = (dir_ / "one_s.csv").string();
+  const std::string one_s = path("one_s.csv");
   writeFlightCsv(sliceFlight(readFlightCsv(short_), 12.0, 13.0), one_s);
   // WHEN it is replayed in real time, and as fast as possible
   const auto t0 = std::chrono::steady_clock::now();

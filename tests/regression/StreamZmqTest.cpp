@@ -17,7 +17,7 @@
 #include <unistd.h>
 #include <zmq.hpp>
 
-#include "support/TestSupport.h"
+#include "support/CliFixture.h"
 #include "uwb/io/FlightWindow.h"
 #include "uwb/io/UtilCsv.h"
 #include "uwb/stream/ZmqWire.h"
@@ -27,26 +27,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class StreamZmq : public ::testing::Test {
+class StreamZmq : public test::PilotFlightCliTest {
  protected:
+  StreamZmq() : PilotFlightCliTest("stream_zmq", "0425-traj1") {}
   void SetUp() override {
-    if (!fs::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
-    flight_ = test::pilotFlight("0425-traj1");
-    UWB_REQUIRE_REAL_DATA(flight_);
-    survey_ = test::pilotSurvey("0425").string();
-    dir_ = fs::temp_directory_path() / ("uwb_stream_zmq_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-    short_ = (dir_ / "short.csv").string();
+    PilotFlightCliTest::SetUp();
+    if (IsSkipped()) return;
+    short_ = path("short.csv");
     writeFlightCsv(sliceFlight(readFlightCsv(flight_->string()), 12.0, 17.0), short_);
-  }
-  void TearDown() override {
-    if (!dir_.empty()) fs::remove_all(dir_);
   }
   /// Two loopback endpoints unlikely to be in use (per process).
   static std::string endpoint(int k) { return "tcp://127.0.0.1:" + std::to_string(40000 + (::getpid() * 2 + k) % 20000); }
-  std::optional<fs::path> flight_;
-  std::string survey_, short_;
-  fs::path dir_;
+  std::string short_;
 };
 
 /// Runs `timeout 60 uwbtdoa <args>`; stdout and stderr to their own files (several run at once).
@@ -80,10 +72,10 @@ TEST_F(StreamZmq, LoopbackGivesTheStdinEstimatesWithNoneDropped) {
   // WHEN the same flight goes replay → stream → subscriber over ZeroMQ on loopback
   const std::string in = endpoint(0), out = endpoint(1);
   zmq::context_t ctx;
-  auto stream = runAsync("stream --anchors " + survey_ + " --in " + in + " --out " + out, dir_, "stream");
+  auto stream = runAsync("stream --anchors " + survey_ + " --in " + in + " --out " + out, dir(), "stream");
   ZmqLineSubscriber consumer(ctx, out, kEstimateTopic);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // both subscriptions in place
-  auto replay = runAsync("replay " + short_ + " --to " + in, dir_, "replay");
+  auto replay = runAsync("replay " + short_ + " --to " + in, dir(), "replay");
   std::string received, line;
   volatile std::sig_atomic_t give_up = 0;
   std::thread watchdog([&give_up] {
@@ -113,11 +105,11 @@ TEST_F(StreamZmq, AConsumerThatDoesNotReadLosesEstimatesButNoSensorEvent) {
   idle.set(zmq::sockopt::rcvbuf, 4096);
   idle.set(zmq::sockopt::linger, 0);
   auto stream =
-      runAsync("stream --anchors " + survey_ + " --output-period 0 --in " + in + " --out " + out, dir_, "stream");
+      runAsync("stream --anchors " + survey_ + " --output-period 0 --in " + in + " --out " + out, dir(), "stream");
   idle.connect(out);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   // WHEN the flight is replayed at full speed
-  const test::CliResult r_replay = runCli("replay " + flight_->string() + " --to " + in, dir_, "replay");
+  const test::CliResult r_replay = runCli("replay " + flight_->string() + " --to " + in, dir(), "replay");
   const test::CliResult r_stream = stream.get();
   // THEN every sensor event reached the filter, and the estimates that did not fit were counted as dropped
   ASSERT_EQ(r_replay.exit_code, 0) << r_replay.err;

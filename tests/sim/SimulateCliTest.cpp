@@ -10,7 +10,7 @@
 
 #include <unistd.h>
 
-#include "support/TestSupport.h"
+#include "support/CliFixture.h"
 #include "uwb/io/UtilCsv.h"
 
 namespace {
@@ -18,21 +18,15 @@ namespace {
 using RunResult = uwb::test::CliResult;
 RunResult run(const std::string& args) { return uwb::test::runCli(args); }
 
-class SimulateCli : public ::testing::Test {
+class SimulateCli : public uwb::test::CliTest {
  protected:
-  void SetUp() override {
-    if (!std::filesystem::exists(uwb::test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << uwb::test::cliPath();
-    dir_ = std::filesystem::temp_directory_path() / ("uwb_sim_cli_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-  std::filesystem::path dir_;
+  SimulateCli() : CliTest("sim_cli") {}
 };
 
 TEST_F(SimulateCli, JsonModePrintsOneObjectAndWritesReadableFiles) {
   // GIVEN a short figure-eight simulation with --json
-  const std::string flight = (dir_ / "f.csv").string();
-  const std::string survey = (dir_ / "s.txt").string();
+  const std::string flight = path("f.csv");
+  const std::string survey = path("s.txt");
   const RunResult r = run("simulate --trajectory figure8 --duration 30 --seed 5 --json --out " + flight +
                           " --survey-out " + survey);
   // THEN it succeeds with exactly one JSON object on stdout
@@ -50,11 +44,11 @@ TEST_F(SimulateCli, JsonModePrintsOneObjectAndWritesReadableFiles) {
 
 TEST_F(SimulateCli, ConfigOverridesParametersAndRejectsUnknownKeys) {
   // GIVEN a config that switches the bias off, and one with a typo
-  const auto good = dir_ / "good.json";
-  const auto bad = dir_ / "bad.json";
+  const auto good = dir() / "good.json";
+  const auto bad = dir() / "bad.json";
   std::ofstream(good) << R"({"bias": {"enabled": false}, "trajectory": {"radius_m": 1.0}})";
   std::ofstream(bad) << R"({"bias": {"noise_sdt_m": 0.1}})";
-  const std::string outs = " --out " + (dir_ / "f.csv").string() + " --survey-out " + (dir_ / "s.txt").string();
+  const std::string outs = " --out " + path("f.csv") + " --survey-out " + path("s.txt");
   // WHEN we run with each
   const RunResult ok = run("simulate --duration 30 --json --config " + good.string() + outs);
   const RunResult err = run("simulate --duration 30 --json --config " + bad.string() + outs);
@@ -65,7 +59,7 @@ TEST_F(SimulateCli, ConfigOverridesParametersAndRejectsUnknownKeys) {
 }
 
 TEST_F(SimulateCli, BadArgumentsExitNonZero) {
-  const std::string outs = " --out " + (dir_ / "f.csv").string() + " --survey-out " + (dir_ / "s.txt").string();
+  const std::string outs = " --out " + path("f.csv") + " --survey-out " + path("s.txt");
   EXPECT_NE(run("simulate --trajectory spiral" + outs).exit_code, 0);
   EXPECT_NE(run("simulate --duration 5" + outs).exit_code, 0);  // shorter than the ground and ramp phases
   EXPECT_NE(run("simulate --anchors-preset nowhere" + outs).exit_code, 0);

@@ -22,7 +22,7 @@
 
 #include <sys/wait.h>
 
-#include "support/TestSupport.h"
+#include "support/CliFixture.h"
 
 namespace uwb {
 namespace {
@@ -32,27 +32,19 @@ using ::testing::HasSubstr;
 using ::testing::ContainsRegex;
 
 /// A 30 s simulated circle, its survey and its events in the line protocol, shared by the tests of this file.
-class StreamFaults : public ::testing::Test {
+class StreamFaults : public test::SimulatedCircleSuite<StreamFaults> {
+ public:
+  static constexpr const char* kTag = "stream_faults";
+
  protected:
   static void SetUpTestSuite() {
-    if (!fs::exists(test::cliPath())) return;
-    dir_ = fs::temp_directory_path() / ("uwb_stream_faults_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-    flight_ = (dir_ / "flight.csv").string();
-    survey_ = (dir_ / "survey.txt").string();
-    const test::CliResult sim = test::simulateCircleFiles(flight_, survey_);
-    ASSERT_EQ(sim.exit_code, 0) << sim.err;
+    SimulatedCircleSuite::SetUpTestSuite();
+    if (dir_.empty() || HasFatalFailure()) return;
     const test::CliResult replay = test::runCli("replay " + flight_);
     ASSERT_EQ(replay.exit_code, 0) << replay.err;
     std::istringstream in(replay.out);
     for (std::string line; std::getline(in, line);) events_.push_back(line);
     ASSERT_GT(events_.size(), 10000u);
-  }
-  static void TearDownTestSuite() {
-    if (!dir_.empty()) fs::remove_all(dir_);
-  }
-  void SetUp() override {
-    if (!fs::exists(test::cliPath())) GTEST_SKIP() << "uwbtdoa not built: " << test::cliPath();
   }
 
   /// The stamp of an event line (its second field).
@@ -95,8 +87,6 @@ class StreamFaults : public ::testing::Test {
     return std::stoul(m[1]);
   }
 
-  static inline fs::path dir_;
-  static inline std::string flight_, survey_;
   static inline std::vector<std::string> events_;
 };
 

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <random>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -56,6 +57,27 @@ CliResult simulateCircleFiles(const std::string& flight_csv, const std::string& 
 std::string readFileBytes(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::filesystem::path makeTempDir(const std::string& tag) {
+  std::random_device rd;
+  const auto path =
+      std::filesystem::temp_directory_path() / ("uwb_" + tag + "_" + std::to_string(rd()) + std::to_string(rd()));
+  std::filesystem::create_directories(path);
+  return path;
+}
+
+TempDir::TempDir(const std::string& tag) : path_(makeTempDir(tag)) {}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  std::filesystem::remove_all(path_, ec);
+}
+
+std::string TempDir::write(const std::string& name, const std::string& text) const {
+  const auto p = path_ / name;
+  std::ofstream(p, std::ios::binary) << text;
+  return p.string();
 }
 
 double relativeError(const MatX& a, const MatX& b) {

@@ -37,6 +37,35 @@ CliResult simulateCircleFiles(const std::string& flight_csv, const std::string& 
 /// The whole file as bytes (empty when it cannot be read).
 std::string readFileBytes(const std::filesystem::path& path);
 
+/// A fresh folder <tmp>/uwb_<tag>_<random>, created.
+std::filesystem::path makeTempDir(const std::string& tag);
+
+/// A fresh folder under the system temp dir (makeTempDir), removed at destruction.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& tag = "io_test");
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  const std::filesystem::path& path() const { return path_; }
+  /// The path of a file named `name` in the folder.
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+  /// Writes `text` to a file named `name` in the folder and returns its path.
+  std::string write(const std::string& name, const std::string& text) const;
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// Skips the current test while the `uwbtdoa` executable is not built (from the calling function only: a fixture's
+/// SetUp that calls a base SetUp using it returns when IsSkipped()).
+#define UWB_REQUIRE_CLI()                                                                                 \
+  do {                                                                                                  \
+    if (!std::filesystem::exists(::uwb::test::cliPath()))                                               \
+      GTEST_SKIP() << "uwbtdoa not built: " << ::uwb::test::cliPath();                                  \
+  } while (0)
+
 /// Skips the current test with a clear message when the real data is absent.
 #define UWB_REQUIRE_REAL_DATA(path_opt)                                                           \
   do {                                                                                           \
