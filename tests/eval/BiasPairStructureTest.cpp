@@ -10,11 +10,22 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include "support/KernelGradients.h"
 #include "support/TestSupport.h"
 #include "uwb/eval/BiasModel.h"
 
 namespace uwb {
 namespace {
+
+/// A sample of anchor pair (p, p + 1) whose body-frame anchor directions turn with `phase` (rad).
+BiasSample pairSample(int p, double phase) {
+  BiasSample s;
+  s.feature.id_a = p;
+  s.feature.id_b = p + 1;
+  s.feature.b_p_a = Vec3(3 * std::cos(phase), 3 * std::sin(phase), 1.0);
+  s.feature.b_p_b = Vec3(3 * std::cos(phase + 1), 3 * std::sin(phase + 1), -1.0);
+  return s;
+}
 
 /// Samples of three anchor pairs with constant offsets and white noise; features vary smoothly.
 std::vector<BiasSample> offsetSamples(const std::vector<double>& offsets_m, int n_per_pair, double noise_m) {
@@ -23,12 +34,7 @@ std::vector<BiasSample> offsetSamples(const std::vector<double>& offsets_m, int 
   std::vector<BiasSample> out;
   for (int k = 0; k < n_per_pair; ++k) {
     for (int p = 0; p < static_cast<int>(offsets_m.size()); ++p) {
-      BiasSample s;
-      s.feature.id_a = p;
-      s.feature.id_b = p + 1;
-      const double phase = 0.01 * k + p;
-      s.feature.b_p_a = Vec3(3 * std::cos(phase), 3 * std::sin(phase), 1.0);
-      s.feature.b_p_b = Vec3(3 * std::cos(phase + 1), 3 * std::sin(phase + 1), -1.0);
+      BiasSample s = pairSample(p, 0.01 * k + p);
       s.feature.w_p_anchor_a = Vec3(p, 0, 0);
       s.feature.w_p_anchor_b = Vec3(p + 1, 0, 0);
       s.error_m = offsets_m[p] + noise(rng);
@@ -37,6 +43,15 @@ std::vector<BiasSample> offsetSamples(const std::vector<double>& offsets_m, int 
     }
   }
   return out;
+}
+
+/// The defaults with the preset, its number of inducing points and of epochs.
+BiasTrainParams trainParams(const std::string& preset, int num_inducing, int epochs) {
+  BiasTrainParams tp;
+  tp.preset = preset;
+  tp.num_inducing = num_inducing;
+  tp.svgp.epochs = epochs;
+  return tp;
 }
 
 TEST(PairMeans, GivenSamplesWhenComputedThenShrunkMeanPerOrderedPair) {
@@ -63,10 +78,7 @@ TEST(PairMeans, GivenConstantPairOffsetsWhenTrainedWithPmPresetThenRecoveredAndS
   const std::vector<double> offsets{0.25, -0.15, 0.05};
   BiasDataset data;
   data.samples = offsetSamples(offsets, 400, 0.05);
-  BiasTrainParams tp;
-  tp.preset = "tdoa-pm";
-  tp.num_inducing = 10;
-  tp.svgp.epochs = 3;
+  BiasTrainParams tp = trainParams("tdoa-pm", 10, 3);
   // WHEN the tdoa-pm model is trained
   BiasTrainReport rep;
   const BiasModel model = trainBiasModel(data, tp, &rep);
@@ -127,11 +139,9 @@ TEST(AnchorTdoaKernel, GivenRandomInputsWhenDifferentiatedThenMatchesFiniteDiffe
   MatX G(4, 3);
   for (Eigen::Index i = 0; i < G.size(); ++i) G.data()[i] = u(rng);
   // WHEN the analytic gradients of Σ G ∘ K w.r.t. θ and X1 are computed
-  std::vector<MatX> blocks;
-  k.cross(X1, X2, &blocks);
-  VecX g_theta = VecX::Zero(k.numParams());
-  MatX g_X1 = MatX::Zero(X1.rows(), X1.cols());
-  k.accumulateCrossGradient(X1, X2, G, blocks, g_theta, &g_X1);
+  const test::CrossGradients grad = test::crossGradients(k, X1, X2, G);
+  const VecX& g_theta = grad.theta;
+  const MatX& g_X1 = grad.x;
   // THEN they match central differences
   const auto objective_theta = [&](const VecX& th) {
     gp::Kernel kk = k;
@@ -208,12 +218,7 @@ TEST(PairTdoaPos, GivenAPairErrorThatDependsOnThePositionWhenTrainedThenTheMapLe
   std::normal_distribution<double> noise(0.0, 0.03);
   for (int k = 0; k < 600; ++k) {
     for (int p = 0; p < 2; ++p) {
-      BiasSample s;
-      s.feature.id_a = p;
-      s.feature.id_b = p + 1;
-      const double phase = 0.37 * k + p;
-      s.feature.b_p_a = Vec3(3 * std::cos(phase), 3 * std::sin(phase), 1.0);
-      s.feature.b_p_b = Vec3(3 * std::cos(phase + 1), 3 * std::sin(phase + 1), -1.0);
+      BiasSample s = pairSample(p, 0.37 * k + p);
       s.feature.w_p_b = Vec3(1.5 * std::cos(0.011 * k), 1.5 * std::sin(0.017 * k), 1.2);
       s.error_m = (p == 0 ? 0.2 : -0.2) * std::sin(2.0 * s.feature.w_p_b.x()) + noise(rng);
       s.t_s = 0.1 * k;
@@ -222,13 +227,9 @@ TEST(PairTdoaPos, GivenAPairErrorThatDependsOnThePositionWhenTrainedThenTheMapLe
   }
   BiasDataset data;
   data.samples = samples;
-  BiasTrainParams tp;
-  tp.preset = "pair-tdoa-pos";
-  tp.num_inducing = 20;
-  tp.svgp.epochs = 20;
   // WHEN trained
   BiasTrainReport rep;
-  const BiasModel model = trainBiasModel(data, tp, &rep);
+  const BiasModel model = trainBiasModel(data, trainParams("pair-tdoa-pos", 20, 20), &rep);
   // THEN the held-out bias RMSE falls from ≈ 0.14 m to near the noise, and the file round trip is bit-identical
   EXPECT_GT(rep.bias_rmse_before_m, 0.1);
   EXPECT_LT(rep.bias_rmse_after_m, 0.06);

@@ -104,6 +104,14 @@ void checkGradient(ElboMode mode) {
   EXPECT_EQ(g.L.triangularView<Eigen::StrictlyUpper>().toDenseMatrix().cwiseAbs().maxCoeff(), 0.0);
 }
 
+/// The default training with `epochs` passes over mini-batches of `batch_size`.
+SvgpTrainParams miniBatches(int epochs, int batch_size) {
+  SvgpTrainParams tp;
+  tp.epochs = epochs;
+  tp.batch_size = batch_size;
+  return tp;
+}
+
 TEST(Svgp, ElboGradientMatchesFiniteDifferencesExactPath) { checkGradient(ElboMode::kExact); }
 TEST(Svgp, ElboGradientMatchesFiniteDifferencesFastPath) { checkGradient(ElboMode::kFast); }
 
@@ -134,9 +142,7 @@ TEST(Svgp, FullBatchNaturalGradientStepOfOneReachesTheOptimalQ) {
 TEST(Svgp, TrainingIsDeterministicForASeedAndImprovesTheElbo) {
   // GIVEN data from a smooth function
   Problem p = makeProblem(5, 600, 5);
-  SvgpTrainParams tp;
-  tp.epochs = 4;
-  tp.batch_size = 128;
+  SvgpTrainParams tp = miniBatches(4, 128);
   tp.seed = 17;
   Svgp a = initSvgp(p.gp.kernel(), p.X, p.y, 12, 17);
   Svgp b = initSvgp(p.gp.kernel(), p.X, p.y, 12, 17);
@@ -151,9 +157,7 @@ TEST(Svgp, TrainingIsDeterministicForASeedAndImprovesTheElbo) {
 
 TEST(Svgp, AdamOnlyTrainingAlsoWorks) {
   Problem p = makeProblem(6, 400, 5);
-  SvgpTrainParams tp;
-  tp.epochs = 5;
-  tp.batch_size = 100;
+  SvgpTrainParams tp = miniBatches(5, 100);
   tp.natgrad_step = 0.0;
   tp.lr_variational = 0.05;
   Svgp a = initSvgp(p.gp.kernel(), p.X, p.y, 10, 1, InputNormalization::kStandardize);
@@ -206,10 +210,7 @@ TEST(SvgpPredictor, BatchedAndSinglePredictionsAgreeWithTheReferencePath) {
     Problem p = makeProblem(11, 700, M);
     if (M > 7) p.gp = initSvgp(p.gp.kernel(), p.X, p.y, M, 3, InputNormalization::kStandardize);
     if (M > 7) {
-      SvgpTrainParams tp;
-      tp.epochs = 3;
-      tp.batch_size = 128;
-      trainSvgp(p.gp, p.X, p.y, tp);
+      trainSvgp(p.gp, p.X, p.y, miniBatches(3, 128));
     } else {
       p.gp.setInputTransform(VecX::Constant(3, 0.1), VecX::Constant(3, 1.5));
     }

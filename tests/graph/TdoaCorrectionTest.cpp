@@ -63,13 +63,24 @@ TdoaNodeMessages nodeMessages(const FilterScene& s, Vec3* p_tag_out) {
   return tdoaNodeForward(*lin, s.anchor_b, s.anchor_a, s.z_m, s.var_m2);
 }
 
+/// A random scene (randomFilterScene) with its tag position and the TDoA node's messages (nodeMessages).
+struct SceneMessages {
+  FilterScene s;
+  Vec3 p_tag;
+  TdoaNodeMessages msg;
+};
+
+SceneMessages sceneMessages(unsigned seed) {
+  SceneMessages r{randomFilterScene(seed), Vec3::Zero(), {}};
+  r.msg = nodeMessages(r.s, &r.p_tag);
+  return r;
+}
+
 TEST(TdoaCorrection, EqualsTextbookEkfJosephUpdate) {
   for (unsigned seed = 1; seed <= 50; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     // GIVEN a random 15-dim error-state prior, pose, lever arm, uncertain anchors and a TDoA
-    const FilterScene s = randomFilterScene(seed);
-    Vec3 p_tag;
-    const TdoaNodeMessages msg = nodeMessages(s, &p_tag);
+    const auto [s, p_tag, msg] = sceneMessages(seed);
     // WHEN we run the graph correction (Fig. 3)
     const auto graph = correctTdoa<kN>(GaussianMoments<kN>{s.m, s.P}, tagJacobian(s), p_tag, msg);
     ASSERT_TRUE(graph);
@@ -104,9 +115,7 @@ TEST(TdoaCorrection, FastPathEqualsGenericMessagePassing) {
   for (unsigned seed = 1; seed <= 20; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     // GIVEN a random scene
-    const FilterScene s = randomFilterScene(seed);
-    Vec3 p_tag;
-    const TdoaNodeMessages msg = nodeMessages(s, &p_tag);
+    const auto [s, p_tag, msg] = sceneMessages(seed);
     const Mat3N C = tagJacobian(s);
     // WHEN we correct with the fixed-size fast path, the dynamic-size instantiation, and the generic node route
     //      (ξ8, W8 → G9' → G7 → G4, information form with singular W)
@@ -124,9 +133,7 @@ TEST(TdoaCorrection, FastPathEqualsGenericMessagePassing) {
 
 TEST(TdoaCorrection, InnovationBeforeUpdateMatchesUpdateStats) {
   // GIVEN a scene and its rank-one message on the state
-  const FilterScene s = randomFilterScene(7);
-  Vec3 p_tag;
-  const TdoaNodeMessages msg = nodeMessages(s, &p_tag);
+  const auto [s, p_tag, msg] = sceneMessages(7);
   const ScalarLinearMessage<kN> on_state = tdoaMessageOnState<kN>(msg, tagJacobian(s), p_tag);
   // WHEN we compute the innovation for gating and then apply the update in place
   const InnovationStats before = innovationOf<kN>(on_state, s.m, s.P);
@@ -171,9 +178,7 @@ TEST(TdoaCorrection, ExactPriorAndExactMessageIsRefusedUntouched) {
 
 TEST(TdoaCorrection, UpdateReducesVarianceAlongTheMeasurement) {
   // GIVEN a scene
-  const FilterScene s = randomFilterScene(12);
-  Vec3 p_tag;
-  const TdoaNodeMessages msg = nodeMessages(s, &p_tag);
+  const auto [s, p_tag, msg] = sceneMessages(12);
   const auto post = correctTdoa<kN>(GaussianMoments<kN>{s.m, s.P}, tagJacobian(s), p_tag, msg);
   ASSERT_TRUE(post);
   // WHEN we look at the variance along a = B12 C, THEN it shrank, and the posterior stays PD

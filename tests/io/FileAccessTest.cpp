@@ -26,19 +26,6 @@ namespace fs = std::filesystem;
 using test::TempDir;
 using ::testing::HasSubstr;
 
-/// Runs `f`, expects a FileError whose message contains every part.
-template <class F>
-void expectFileError(F&& f, const std::vector<std::string>& parts) {
-  try {
-    f();
-    ADD_FAILURE() << "expected FileError";
-  } catch (const FileError& e) {
-    for (const auto& p : parts) EXPECT_THAT(e.what(), HasSubstr(p));
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected FileError, got " << typeid(e).name() << ": " << e.what();
-  }
-}
-
 /// Names in `dir` (temporary files included).
 std::vector<std::string> listing(const fs::path& dir) {
   std::vector<std::string> out;
@@ -58,19 +45,19 @@ TEST(FileAccess, ADirectoryAsInputIsAClearFileErrorForEveryReader) {
   TempDir dir;
   const std::string d = dir.file("");
   // THEN each reader refuses it, naming the path and saying what it is
-  expectFileError([&] { (void)readFlightCsv(d); }, {"flight file", "is a directory"});
-  expectFileError([&] { (void)readAnchorSurvey(d); }, {"anchor survey", "is a directory"});
-  expectFileError([&] { (void)readTrajectoryCsv(d); }, {"trajectory file", "is a directory"});
+  test::expectThrows<FileError>([&] { (void)readFlightCsv(d); }, {"flight file", "is a directory"});
+  test::expectThrows<FileError>([&] { (void)readAnchorSurvey(d); }, {"anchor survey", "is a directory"});
+  test::expectThrows<FileError>([&] { (void)readTrajectoryCsv(d); }, {"trajectory file", "is a directory"});
 }
 
 TEST(FileAccess, ADeviceAsInputIsRefused) {
   if (!fs::exists("/dev/zero")) GTEST_SKIP() << "no /dev/zero";
-  expectFileError([] { (void)readFlightCsv("/dev/zero"); }, {"/dev/zero", "character device"});
+  test::expectThrows<FileError>([] { (void)readFlightCsv("/dev/zero"); }, {"/dev/zero", "character device"});
 }
 
 TEST(FileAccess, AMissingInputNamesThePath) {
   TempDir dir;
-  expectFileError([&] { (void)readTextFile(dir.file("none.csv"), "flight file"); }, {"none.csv", "cannot open"});
+  test::expectThrows<FileError>([&] { (void)readTextFile(dir.file("none.csv"), "flight file"); }, {"none.csv", "cannot open"});
 }
 
 TEST(FileAccess, AtomicWriteReplacesTheFileAndLeavesNoTemporary) {
@@ -86,9 +73,9 @@ TEST(FileAccess, AFailedWriteLeavesNeitherTheFileNorATemporary) {
   TempDir dir;
   fs::create_directories(dir.file("sub"));
   // WHEN writing fails
-  expectFileError([&] { writeFileAtomically(dir.file("missing/out.csv"), "x", "test output"); },
+  test::expectThrows<FileError>([&] { writeFileAtomically(dir.file("missing/out.csv"), "x", "test output"); },
                   {"missing/out.csv", "test output"});
-  expectFileError([&] { writeFileAtomically(dir.file("sub"), "x", "test output"); }, {"is a directory"});
+  test::expectThrows<FileError>([&] { writeFileAtomically(dir.file("sub"), "x", "test output"); }, {"is a directory"});
   // THEN nothing was created
   EXPECT_EQ(listing(dir.file("")), std::vector<std::string>{"sub"});
   EXPECT_TRUE(fs::is_empty(dir.file("sub")));
@@ -124,10 +111,10 @@ TEST(FileAccess, CheckOutputFileFindsProblemsBeforeTheWorkAndCreatesNothing) {
   TempDir dir;
   fs::create_directories(dir.file("sub"));
   checkOutputFile(dir.file("ok.csv"), "test output");  // fine: no exception
-  expectFileError([&] { checkOutputFile(dir.file("nofolder/x.csv"), "trajectory file"); },
+  test::expectThrows<FileError>([&] { checkOutputFile(dir.file("nofolder/x.csv"), "trajectory file"); },
                   {"trajectory file", "does not exist"});
-  expectFileError([&] { checkOutputFile(dir.file("sub"), "trajectory file"); }, {"is a directory"});
-  expectFileError([&] { checkOutputFile("", "trajectory file"); }, {"empty"});
+  test::expectThrows<FileError>([&] { checkOutputFile(dir.file("sub"), "trajectory file"); }, {"is a directory"});
+  test::expectThrows<FileError>([&] { checkOutputFile("", "trajectory file"); }, {"empty"});
   EXPECT_EQ(listing(dir.file("")), std::vector<std::string>{"sub"});
 }
 
@@ -136,7 +123,7 @@ TEST(FileAccess, CheckOutputDirectoryAcceptsAFolderToBeCreated) {
   checkOutputDirectory(dir.file("a/b/c"), "report folder");  // parents will be created
   EXPECT_FALSE(fs::exists(dir.file("a")));
   const std::string file = dir.write("plain", "x");
-  expectFileError([&] { checkOutputDirectory(file + "/report", "report folder"); }, {"is not a folder"});
+  test::expectThrows<FileError>([&] { checkOutputDirectory(file + "/report", "report folder"); }, {"is not a folder"});
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
  */
 #pragma once
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -10,8 +11,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <string>
+#include <typeinfo>
+#include <utility>
 #include <vector>
 
 #include "support/TestSupport.h"
@@ -40,6 +44,34 @@ inline AnchorSurvey cornerSurvey() {
   const double xy[8][2] = {{-3, -4}, {-3.2, 3.8}, {3.7, 3.7}, {4.1, -4.3}, {-3, -4.4}, {3.9, -3.8}, {4, 3.9}, {-3.2, 3.3}};
   for (int i = 0; i < 8; ++i) s.anchors.push_back({i, Vec3(xy[i][0], xy[i][1], z[i]), Quat::Identity()});
   return s;
+}
+
+/// The `E` that `f()` throws; nullopt, and a failure of the calling test, when it throws nothing or another type.
+template <class E, class F>
+std::optional<E> caught(F&& f) {
+  try {
+    f();
+    ADD_FAILURE() << "expected " << typeid(E).name() << ", nothing thrown";
+  } catch (const E& e) {
+    return e;
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected " << typeid(E).name() << ", got " << typeid(e).name() << ": " << e.what();
+  }
+  return std::nullopt;
+}
+
+/// The message of the `E` that `f()` throws (caught); a placeholder that names no file when there is none.
+template <class E, class F>
+std::string messageOf(F&& f) {
+  const std::optional<E> e = caught<E>(std::forward<F>(f));
+  return e ? std::string(e->what()) : std::string("(no exception of the expected type)");
+}
+
+/// Expects `f()` to throw an `E` whose message contains every part.
+template <class E, class F>
+void expectThrows(F&& f, const std::vector<std::string>& parts) {
+  const std::string message = messageOf<E>(std::forward<F>(f));
+  for (const auto& p : parts) EXPECT_THAT(message, ::testing::HasSubstr(p));
 }
 
 inline bool sameBits(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }

@@ -23,28 +23,21 @@ using ::testing::Not;
 TEST(JsonFile, SyntaxErrorNamesFileLineAndColumn) {
   TempDir dir;
   const std::string path = dir.write("cfg.json", "{\n  \"a\": 1,\n  \"b\": tru\n}\n");
-  try {
-    (void)readJsonFile(path, "config file");
-    ADD_FAILURE() << "expected InputError";
-  } catch (const InputError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("cfg.json:3:"));
-    EXPECT_THAT(e.what(), HasSubstr("invalid JSON in config file"));
-    EXPECT_THAT(e.what(), Not(HasSubstr("json.exception")));
-    EXPECT_EQ(e.where().line, 3u);
-  }
+  const std::optional<InputError> e = test::caught<InputError>([&] { (void)readJsonFile(path, "config file"); });
+  ASSERT_TRUE(e);
+  EXPECT_THAT(e->what(), HasSubstr("cfg.json:3:"));
+  EXPECT_THAT(e->what(), HasSubstr("invalid JSON in config file"));
+  EXPECT_THAT(e->what(), Not(HasSubstr("json.exception")));
+  EXPECT_EQ(e->where().line, 3u);
 }
 
 TEST(JsonFile, ANumberBeyondDoubleIsAnInputErrorWithoutLibraryText) {
   TempDir dir;
   const std::string path = dir.write("big.json", R"({"version": 1e400})");
-  try {
-    (void)readJsonFile(path, "bias model");
-    ADD_FAILURE() << "expected InputError";
-  } catch (const InputError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("big.json"));
-    EXPECT_THAT(e.what(), HasSubstr("1e400"));
-    EXPECT_THAT(e.what(), Not(HasSubstr("json.exception")));
-  }
+  const std::string message = test::messageOf<InputError>([&] { (void)readJsonFile(path, "bias model"); });
+  EXPECT_THAT(message, HasSubstr("big.json"));
+  EXPECT_THAT(message, HasSubstr("1e400"));
+  EXPECT_THAT(message, Not(HasSubstr("json.exception")));
 }
 
 TEST(JsonFile, ADirectoryIsAFileError) {

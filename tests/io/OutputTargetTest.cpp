@@ -25,16 +25,6 @@ namespace fs = std::filesystem;
 using test::TempDir;
 using ::testing::HasSubstr;
 
-template <class F>
-std::string fileErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const FileError& e) {
-    return e.what();
-  }
-  return "(no FileError)";
-}
-
 /// Runs `f` in a child process (so that process-wide state it sets does not leak into other tests); its exit code.
 template <class F>
 int inChild(F&& f) {
@@ -58,15 +48,15 @@ TEST(OutputTarget, ANonRegularTargetIsRefusedAndLeftAsItIs) {
   const std::string fifo = dir.file("p.fifo"), link = dir.file("link.csv"), target = dir.write("target.csv", "keep");
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
   fs::create_symlink(target, link);
-  EXPECT_THAT(fileErrorOf([&] { writeFileAtomically(fifo, "x", "trajectory"); }), HasSubstr("FIFO"));
-  EXPECT_THAT(fileErrorOf([&] { checkOutputFile(fifo, "trajectory"); }), HasSubstr("FIFO"));
-  EXPECT_THAT(fileErrorOf([&] { writeFileAtomically(link, "x", "trajectory"); }), HasSubstr("symbolic link"));
-  EXPECT_THAT(fileErrorOf([&] { checkOutputFile(link, "trajectory"); }), HasSubstr("symbolic link"));
+  test::expectThrows<FileError>([&] { writeFileAtomically(fifo, "x", "trajectory"); }, {"FIFO"});
+  test::expectThrows<FileError>([&] { checkOutputFile(fifo, "trajectory"); }, {"FIFO"});
+  test::expectThrows<FileError>([&] { writeFileAtomically(link, "x", "trajectory"); }, {"symbolic link"});
+  test::expectThrows<FileError>([&] { checkOutputFile(link, "trajectory"); }, {"symbolic link"});
   EXPECT_TRUE(fs::is_fifo(fifo));
   EXPECT_TRUE(fs::is_symlink(link));
   EXPECT_EQ(readTextFile(target, "t"), "keep");
   if (fs::exists("/dev/null")) {
-    EXPECT_THAT(fileErrorOf([] { writeFileAtomically("/dev/null", "x", "trajectory"); }), HasSubstr("character device"));
+    test::expectThrows<FileError>([] { writeFileAtomically("/dev/null", "x", "trajectory"); }, {"character device"});
   }
 }
 
@@ -85,8 +75,8 @@ TEST(OutputTarget, CheckOutputFileRefusesAnInputUnderAnyName) {
   TempDir dir;
   const std::string input = dir.write("flight.csv", "data"), hard = dir.file("other.csv");
   fs::create_hard_link(input, hard);
-  EXPECT_THAT(fileErrorOf([&] { checkOutputFile(input, "trajectory", {input}); }), HasSubstr("input file"));
-  EXPECT_THAT(fileErrorOf([&] { checkOutputFile(hard, "trajectory", {"", input}); }), HasSubstr("input file"));
+  test::expectThrows<FileError>([&] { checkOutputFile(input, "trajectory", {input}); }, {"input file"});
+  test::expectThrows<FileError>([&] { checkOutputFile(hard, "trajectory", {"", input}); }, {"input file"});
   EXPECT_NO_THROW(checkOutputFile(dir.file("new.csv"), "trajectory", {input}));
 }
 
@@ -149,7 +139,7 @@ TEST(OutputTarget, AFileOfExactlyTwoGibibytesIsRefused) {
   ASSERT_GE(fd, 0);
   ASSERT_EQ(::ftruncate(fd, off_t{1} << 31), 0);  // sparse: no disk space used
   ::close(fd);
-  EXPECT_THAT(fileErrorOf([&] { readTextFile(path, "flight file"); }), HasSubstr("too large (2147483648 bytes"));
+  test::expectThrows<FileError>([&] { readTextFile(path, "flight file"); }, {"too large (2147483648 bytes"});
 }
 
 TEST(JsonNesting, TheCapCountsBracketsOutsideStringsOnly) {

@@ -81,12 +81,9 @@ TEST(TrajectoryCsv, ATrajectoryWithoutImuBiasesHasNoBiasColumnsAndAPartialSetIsA
             "gyro_bias_z");
   // a partial set of bias columns is an error naming the first one missing
   const std::string head = "t,x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz,acc_bias_x,acc_bias_y,acc_bias_z";
-  try {
-    (void)readTrajectoryCsv(dir.write("p.csv", head + "\n0,1,2,3,0,0,0,1,0.1,0.1,0.1,0,0,0,0,0,0\n"));
-    ADD_FAILURE() << "no error";
-  } catch (const InputError& e) {
-    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr("missing column 'gyro_bias_x'"));
-  }
+  test::expectThrows<InputError>(
+      [&] { (void)readTrajectoryCsv(dir.write("p.csv", head + "\n0,1,2,3,0,0,0,1,0.1,0.1,0.1,0,0,0,0,0,0\n")); },
+      {"missing column 'gyro_bias_x'"});
 }
 
 TEST(TrajectoryCsv, EmptyTrajectoryRoundTrips) {
@@ -109,13 +106,9 @@ TEST(TrajectoryCsv, ReadsFilesSavedWithAByteOrderMarkAndCrlfLineEnds) {
   ASSERT_EQ(t.size(), 2u);
   EXPECT_EQ(t[0].t_s, 0.5);
   EXPECT_EQ(t[1].w_p_b.z(), 3.5);
-  try {
-    (void)readTrajectoryCsv(dir.write("bad.csv", "\xEF\xBB\xBFt,x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz\r\n\r\n"
-                                                 "0,1,2,3,0,0,0,1,0.1,0.1,0.1,0,0,x\r\n"));
-    ADD_FAILURE() << "no error";
-  } catch (const InputError& e) {
-    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr(":3:14 (vz)"));
-  }
+  const std::string bad = dir.write("bad.csv", "\xEF\xBB\xBFt,x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz\r\n\r\n"
+                                              "0,1,2,3,0,0,0,1,0.1,0.1,0.1,0,0,x\r\n");
+  test::expectThrows<InputError>([&] { (void)readTrajectoryCsv(bad); }, {":3:14 (vz)"});
 }
 
 TEST(TrajectoryCsv, MalformedInputNamesTheLocation) {
@@ -123,12 +116,8 @@ TEST(TrajectoryCsv, MalformedInputNamesTheLocation) {
   const std::string header = "t,x,y,z,qx,qy,qz,qw,std_x,std_y,std_z,vx,vy,vz\n";
   const auto expectError = [&](const std::string& text, const std::string& part) {
     const std::string path = dir.write("m.csv", text);
-    try {
-      (void)readTrajectoryCsv(path);
-      ADD_FAILURE() << text;
-    } catch (const InputError& e) {
-      EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr(part));
-    }
+    SCOPED_TRACE(text);
+    test::expectThrows<InputError>([&] { (void)readTrajectoryCsv(path); }, {part});
   };
   expectError("", "missing header");
   expectError("t,x,y\n", "missing column 'z'");

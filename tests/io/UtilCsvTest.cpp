@@ -35,14 +35,10 @@ void expectInputError(const std::string& text, const std::vector<std::string>& p
                       const FlightReadOptions& options = {}) {
   TempDir dir;
   const std::string path = dir.write("bad.csv", text);
-  try {
-    (void)readFlightCsv(path, options);
-    ADD_FAILURE() << "expected InputError for:\n" << text;
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_THAT(msg, HasSubstr(path)) << "message must name the file";
-    for (const auto& p : parts) EXPECT_THAT(msg, HasSubstr(p));
-  }
+  SCOPED_TRACE("input:\n" + text);
+  const std::string msg = test::messageOf<InputError>([&] { (void)readFlightCsv(path, options); });
+  EXPECT_THAT(msg, HasSubstr(path)) << "message must name the file";
+  for (const auto& p : parts) EXPECT_THAT(msg, HasSubstr(p));
 }
 
 // ------------------------------------------------------------------------------------------------ layouts
@@ -292,15 +288,12 @@ TEST(UtilCsvMalformed, MissingFileIsAFileError) {
 TEST(UtilCsvMalformed, ErrorCarriesTheLocation) {
   TempDir dir;
   const std::string path = dir.write("loc.csv", kSmallHeader + "0.1,1,2,x,0.1,1,2,3\n");
-  try {
-    (void)readFlightCsv(path);
-    FAIL();
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.where().file, path);
-    EXPECT_EQ(e.where().line, 2u);
-    EXPECT_EQ(e.where().column, 4u);
-    EXPECT_EQ(e.where().field, "tdoa_meas");
-  }
+  const std::optional<InputError> e = test::caught<InputError>([&] { (void)readFlightCsv(path); });
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->where().file, path);
+  EXPECT_EQ(e->where().line, 2u);
+  EXPECT_EQ(e->where().column, 4u);
+  EXPECT_EQ(e->where().field, "tdoa_meas");
 }
 
 // ------------------------------------------------------------------------------------------------ round trip

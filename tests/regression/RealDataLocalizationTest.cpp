@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -28,19 +29,25 @@ LocalizationRun replay(const std::filesystem::path& flight, const std::filesyste
   return localizeFlight(f, s);
 }
 
+/// replay() of a util-pilot flight with its session's survey; nullopt when the real data is absent.
+std::optional<LocalizationRun> replayPilot(const std::string& name) {
+  const auto flight = test::pilotFlight(name);
+  if (!flight) return std::nullopt;
+  return replay(*flight, test::pilotSurvey(name.substr(0, 4)));
+}
+
 TEST(RealDataLocalization, Pilot0425Traj2AirborneRmseUnderBound) {
   // GIVEN a real circle flight with ground phase and the 0425 accelerometer offset
-  const auto flight = test::pilotFlight("0425-traj2");
-  UWB_REQUIRE_REAL_DATA(flight);
   // WHEN localizing with the defaults (no ground-truth start)
-  const LocalizationRun run = replay(*flight, test::pilotSurvey("0425"));
+  const std::optional<LocalizationRun> run = replayPilot("0425-traj2");
+  UWB_REQUIRE_REAL_DATA(run);
   // THEN the airborne RMSE stays under the committed bound and nothing diverged
-  ASSERT_TRUE(run.metrics);
-  EXPECT_LT(run.metrics->airborne.rmse_m, 0.23);
-  EXPECT_LT(run.metrics->whole.rmse_m, 0.28);
-  EXPECT_LT(run.metrics->airborne.p99_m, 1.0);
-  EXPECT_GT(run.summary.n_tdoa_used, 10000u);
-  EXPECT_FALSE(std::isnan(run.summary.takeoff_t_s));
+  ASSERT_TRUE(run->metrics);
+  EXPECT_LT(run->metrics->airborne.rmse_m, 0.23);
+  EXPECT_LT(run->metrics->whole.rmse_m, 0.28);
+  EXPECT_LT(run->metrics->airborne.p99_m, 1.0);
+  EXPECT_GT(run->summary.n_tdoa_used, 10000u);
+  EXPECT_FALSE(std::isnan(run->summary.takeoff_t_s));
 }
 
 TEST(RealDataLocalization, GarbageTdoaMidFlightAreCaughtAndCostLittle) {
@@ -77,28 +84,26 @@ TEST(RealDataLocalization, Pilot0425LandingDetectedAndPositionHeld) {
   // GIVEN the 0425 flights whose touchdown has no strong vibration burst at first (the estimate used to run away
   // upwards after ground contact: whole-flight RMSE 0.94, 0.53, 0.75 m)
   for (const char* name : {"0425-traj1", "0425-traj5", "0425-traj7"}) {
-    const auto flight = test::pilotFlight(name);
-    UWB_REQUIRE_REAL_DATA(flight);
     // WHEN localizing with the defaults
-    const LocalizationRun run = replay(*flight, test::pilotSurvey("0425"));
+    const std::optional<LocalizationRun> run = replayPilot(name);
+    UWB_REQUIRE_REAL_DATA(run);
     // THEN the landing is detected after the take-off and the whole-flight RMSE stays near the airborne one
-    ASSERT_TRUE(run.metrics) << name;
-    EXPECT_FALSE(std::isnan(run.summary.landing_t_s)) << name;
-    EXPECT_GT(run.summary.landing_t_s, run.summary.takeoff_t_s) << name;
-    EXPECT_LT(run.metrics->whole.rmse_m, 0.45) << name;
-    EXPECT_LT(run.metrics->airborne.rmse_m, 0.40) << name;
+    ASSERT_TRUE(run->metrics) << name;
+    EXPECT_FALSE(std::isnan(run->summary.landing_t_s)) << name;
+    EXPECT_GT(run->summary.landing_t_s, run->summary.takeoff_t_s) << name;
+    EXPECT_LT(run->metrics->whole.rmse_m, 0.45) << name;
+    EXPECT_LT(run->metrics->airborne.rmse_m, 0.40) << name;
   }
 }
 
 TEST(RealDataLocalization, Pilot0426Traj11WithObstaclesUnderBound) {
   // GIVEN an obstacle (NLOS) flight
-  const auto flight = test::pilotFlight("0426-traj11");
-  UWB_REQUIRE_REAL_DATA(flight);
   // WHEN localizing with the defaults
-  const LocalizationRun run = replay(*flight, test::pilotSurvey("0426"));
+  const std::optional<LocalizationRun> run = replayPilot("0426-traj11");
+  UWB_REQUIRE_REAL_DATA(run);
   // THEN
-  ASSERT_TRUE(run.metrics);
-  EXPECT_LT(run.metrics->airborne.rmse_m, 0.29);
+  ASSERT_TRUE(run->metrics);
+  EXPECT_LT(run->metrics->airborne.rmse_m, 0.29);
 }
 
 TEST(RealDataLocalization, PilotTdoa2MedianAirborneRmseUnderBound) {
@@ -108,13 +113,12 @@ TEST(RealDataLocalization, PilotTdoa2MedianAirborneRmseUnderBound) {
   for (int i : {1, 2, 11, 12}) flights.emplace_back("0426-traj" + std::to_string(i), "0426");
   std::vector<double> rmse;
   for (const auto& [name, day] : flights) {
-    const auto flight = test::pilotFlight(name);
-    UWB_REQUIRE_REAL_DATA(flight);
     // WHEN localizing each with the defaults
-    const LocalizationRun run = replay(*flight, test::pilotSurvey(day));
-    ASSERT_TRUE(run.metrics) << name;
-    EXPECT_LT(run.metrics->airborne.rmse_m, 0.40) << name;
-    rmse.push_back(run.metrics->airborne.rmse_m);
+    const std::optional<LocalizationRun> run = replayPilot(name);
+    UWB_REQUIRE_REAL_DATA(run);
+    ASSERT_TRUE(run->metrics) << name;
+    EXPECT_LT(run->metrics->airborne.rmse_m, 0.40) << name;
+    rmse.push_back(run->metrics->airborne.rmse_m);
   }
   // THEN the median airborne RMSE stays under the committed bound (0.260 m with the defaults)
   std::sort(rmse.begin(), rmse.end());

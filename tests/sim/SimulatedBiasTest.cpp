@@ -32,12 +32,19 @@ TEST(SphericalHarmonics, AreOrthonormalOnTheSphere) {
   EXPECT_LT((G - Eigen::Matrix<double, 16, 16>::Identity()).cwiseAbs().maxCoeff(), 0.03);
 }
 
-TEST(SimulatedBias, PatternRmsMatchesTheParameter) {
-  // GIVEN a model with only the tag antenna pattern
+/// The defaults without the anchors' pattern and offsets, with the tag's antenna pattern and its NLOS shadow as asked.
+BiasParams tagPatternTerms(bool antenna, bool nlos) {
   BiasParams p;
   p.anchor_pattern_rms_m = 0.0;
   p.anchor_offset_std_m = 0.0;
-  p.nlos_bias_m = 0.0;
+  if (!antenna) p.antenna_rms_m = 0.0;
+  if (!nlos) p.nlos_bias_m = 0.0;
+  return p;
+}
+
+TEST(SimulatedBias, PatternRmsMatchesTheParameter) {
+  // GIVEN a model with only the tag antenna pattern
+  const BiasParams p = tagPatternTerms(/*antenna=*/true, /*nlos=*/false);
   std::mt19937_64 rng(3);
   const SimulatedBias model(p, paperAnchors(), rng);
   // WHEN we average its square over the sphere
@@ -87,10 +94,7 @@ TEST(SimulatedBias, PatternDependsOnlyOnTheBodyFrameDirection) {
 
 TEST(SimulatedBias, BodyOcclusionAddsPositiveBiasBelowTheRotorPlane) {
   // GIVEN a model whose only term is the NLOS shadow
-  BiasParams p;
-  p.antenna_rms_m = 0.0;
-  p.anchor_pattern_rms_m = 0.0;
-  p.anchor_offset_std_m = 0.0;
+  const BiasParams p = tagPatternTerms(/*antenna=*/false, /*nlos=*/true);
   std::mt19937_64 rng(7);
   const SimulatedBias model(p, paperAnchors(), rng);
   // THEN directions above the plane get no bias, far below get the full positive bias (more toward the battery)

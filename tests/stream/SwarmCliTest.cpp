@@ -114,6 +114,28 @@ std::vector<pid_t> childrenOf(pid_t parent) {
   return out;
 }
 
+/// The child processes of `pid` once `n` of them run; fewer when they did not start within 15 s.
+std::vector<pid_t> startedAgents(pid_t pid, std::size_t n) {
+  std::vector<pid_t> agents;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(15);
+  while (agents.size() < n && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    agents = childrenOf(pid);
+  }
+  return agents;
+}
+
+/// Whether `pid` exits within `polls` × 50 ms (its wait status in `status`); killed when it does not.
+bool exitedWithin(pid_t pid, int polls, int* status) {
+  bool exited = false;
+  for (int k = 0; k < polls && !exited; ++k) {
+    exited = ::waitpid(pid, status, WNOHANG) == pid;
+    if (!exited) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  if (!exited) ::kill(pid, SIGKILL);
+  return exited;
+}
+
 TEST(SwarmCli, AKilledAgentIsNamedWithWhatKilledIt) {
   // GIVEN a real-time swarm of 3 agents
   const std::filesystem::path err = std::filesystem::temp_directory_path() / ("swarm_kill_" + std::to_string(::getpid()));
@@ -127,24 +149,14 @@ TEST(SwarmCli, AKilledAgentIsNamedWithWhatKilledIt) {
             static_cast<char*>(nullptr));
     ::_exit(127);
   }
-  std::vector<pid_t> agents;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(15);
-  while (agents.size() < 3 && std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    agents = childrenOf(pid);
-  }
+  std::vector<pid_t> agents = startedAgents(pid, 3);
   ASSERT_EQ(agents.size(), 3u) << "the agent processes did not start";
   std::this_thread::sleep_for(std::chrono::milliseconds(1500));
   // WHEN one agent is killed (as the OOM killer would)
   std::sort(agents.begin(), agents.end());
   ASSERT_EQ(::kill(agents[1], SIGKILL), 0);
   int status = 0;
-  bool exited = false;
-  for (int k = 0; k < 300 && !exited; ++k) {
-    exited = ::waitpid(pid, &status, WNOHANG) == pid;
-    if (!exited) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  if (!exited) ::kill(pid, SIGKILL);
+  const bool exited = exitedWithin(pid, 300, &status);
   std::ifstream e(err);
   const std::string text{std::istreambuf_iterator<char>(e), std::istreambuf_iterator<char>()};
   std::filesystem::remove(err);
@@ -170,23 +182,13 @@ TEST(SwarmCli, SigintStopsEveryAgentAndWritesNothing) {
             out.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
-  std::vector<pid_t> agents;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(15);
-  while (agents.size() < 3 && std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    agents = childrenOf(pid);
-  }
+  std::vector<pid_t> agents = startedAgents(pid, 3);
   ASSERT_EQ(agents.size(), 3u) << "the agent processes did not start";
   std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // flying
   // WHEN SIGINT arrives mid-flight
   ASSERT_EQ(::kill(pid, SIGINT), 0);
   int status = 0;
-  bool exited = false;
-  for (int k = 0; k < 200 && !exited; ++k) {
-    exited = ::waitpid(pid, &status, WNOHANG) == pid;
-    if (!exited) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  if (!exited) ::kill(pid, SIGKILL);
+  const bool exited = exitedWithin(pid, 200, &status);
   // THEN it exits 130, no agent process remains, and no (partial) output file exists
   ASSERT_TRUE(exited);
   ASSERT_TRUE(WIFEXITED(status));
