@@ -49,6 +49,14 @@ double circleRmsFrom(const LocalizerResult& r, double t0_s) {
   return std::sqrt(se / n);
 }
 
+/// TdoaLocalizer::run on `log` over the arena's anchors, an estimate every 0.1 s, with the bias model when given.
+LocalizerResult runInArena(const EkfParams& params, const SensorLog& log, const BiasPredictor& bias = {}) {
+  return runInArena(params, log, bias);
+}
+
+/// The position RMSE against the circle from 20 s on (circleRmsFrom).
+double circleRms(const LocalizerResult& r) { return circleRmsFrom(r, 20.0); }
+
 TEST(Estimator, BatchRunEqualsTheOnlineLoop) {
   // GIVEN a synthetic take-off log and the default parameters
   filtertest::TakeoffLogSpec spec;
@@ -346,8 +354,8 @@ TEST(Estimator, ReportedCovarianceAddsTheBiasFloor) {
   with.output_bias_sigma_m = 0.2;
   EkfParams without = with;
   without.output_bias_sigma_m = 0.0;
-  const LocalizerResult a = TdoaLocalizer(with, arenaAnchors()).run(log, 0.1);
-  const LocalizerResult b = TdoaLocalizer(without, arenaAnchors()).run(log, 0.1);
+  const LocalizerResult a = runInArena(with, log);
+  const LocalizerResult b = runInArena(without, log);
   // THEN the states are the same, the reported σ larger by at least σ_b · (smallest singular value of H)⁻¹
   ASSERT_EQ(a.estimates.size(), b.estimates.size());
   const LocalizerEstimate& ea = a.estimates.back();
@@ -374,9 +382,9 @@ TEST(Estimator, TheVerticalScaleActsOnTheBiasTermsHeightAlone) {
   halved.output_bias_vertical_scale = 0.5;
   EkfParams none = derived;
   none.output_bias_sigma_m = 0.0;
-  const LocalizerResult a = TdoaLocalizer(derived, arenaAnchors()).run(log, 0.1);
-  const LocalizerResult b = TdoaLocalizer(halved, arenaAnchors()).run(log, 0.1);
-  const LocalizerResult c = TdoaLocalizer(none, arenaAnchors()).run(log, 0.1);
+  const LocalizerResult a = runInArena(derived, log);
+  const LocalizerResult b = runInArena(halved, log);
+  const LocalizerResult c = runInArena(none, log);
   ASSERT_EQ(a.estimates.size(), b.estimates.size());
   ASSERT_EQ(a.estimates.size(), c.estimates.size());
   // THEN the estimate and the horizontal σ are unchanged, the bias term's vertical variance is s² of the derived one
@@ -410,10 +418,9 @@ TEST(Estimator, ABiasModelOfAMoreBiasedFlightIsScaledDownByThisFlightsLevel) {
   off.bias_model_level_exponent = 0.0;
   EkfParams unknown = scaled;
   unknown.bias_model_training_level_m = 0.0;  // an older model file
-  const LocalizerResult a = TdoaLocalizer(scaled, arenaAnchors(), wrong).run(log, 0.1);
-  const LocalizerResult b = TdoaLocalizer(off, arenaAnchors(), wrong).run(log, 0.1);
-  const LocalizerResult c = TdoaLocalizer(unknown, arenaAnchors(), wrong).run(log, 0.1);
-  const auto rms = [](const LocalizerResult& r) { return circleRmsFrom(r, 20.0); };
+  const LocalizerResult a = runInArena(scaled, log, wrong);
+  const LocalizerResult b = runInArena(off, log, wrong);
+  const LocalizerResult c = runInArena(unknown, log, wrong);
   // THEN the flight's own level (measured before the correction, F24b) is far below the model's: it starts from the
   // training level (ρ = 1), which keeps the weight of 10 windows against the ≈ 50 windows of 40 s flown
   // (√((10 · 0.5²) / 60) ≈ 0.2 m even with no bias at all), the mean is scaled down by (0.2 / 0.5)² and below,
@@ -421,10 +428,10 @@ TEST(Estimator, ABiasModelOfAMoreBiasedFlightIsScaledDownByThisFlightsLevel) {
   EXPECT_LT(a.summary.raw_bias_level_m, 0.25);
   EXPECT_LT(a.summary.bias_model_mean_scale, 0.25);
   EXPECT_LE(a.summary.min_bias_model_mean_scale, a.summary.bias_model_mean_scale);
-  EXPECT_LT(rms(a), 0.5 * rms(b));
+  EXPECT_LT(circleRms(a), 0.5 * circleRms(b));
   // the model as trained when the scaling is off or the training level unknown: the same run
   EXPECT_EQ(b.summary.bias_model_mean_scale, 1.0);
-  EXPECT_EQ(rms(b), rms(c));
+  EXPECT_EQ(circleRms(b), circleRms(c));
   EXPECT_TRUE(std::isfinite(c.summary.raw_bias_level_m));  // still measured and reported
 }
 
@@ -444,7 +451,7 @@ TEST(Estimator, ABiasModelThatPredictsThisFlightsSmallerBiasIsNotScaledDownForIt
   EkfParams probe = lateralFullParams();
   probe.bias_model_training_level_m = 0.2;
   probe.bias_model_training_mean_level_m = 0.2;
-  const LocalizerResult measured = TdoaLocalizer(probe, arenaAnchors(), knows).run(log, 0.1);
+  const LocalizerResult measured = runInArena(probe, log, knows);
   const double level = measured.summary.raw_bias_level_m, mean_level = measured.summary.model_mean_level_m;
   ASSERT_GT(level, 0.05);
   ASSERT_GT(mean_level, 0.05);
@@ -454,18 +461,17 @@ TEST(Estimator, ABiasModelThatPredictsThisFlightsSmallerBiasIsNotScaledDownForIt
   with_mean.bias_model_training_mean_level_m = 2.0 * mean_level;
   EkfParams as_trained = levels_only;
   as_trained.bias_model_level_exponent = 0.0;
-  const LocalizerResult b = TdoaLocalizer(levels_only, arenaAnchors(), knows).run(log, 0.1);
-  const LocalizerResult c = TdoaLocalizer(with_mean, arenaAnchors(), knows).run(log, 0.1);
-  const LocalizerResult t = TdoaLocalizer(as_trained, arenaAnchors(), knows).run(log, 0.1);
-  const auto rms = [](const LocalizerResult& r) { return circleRmsFrom(r, 20.0); };
+  const LocalizerResult b = runInArena(levels_only, log, knows);
+  const LocalizerResult c = runInArena(with_mean, log, knows);
+  const LocalizerResult t = runInArena(as_trained, log, knows);
   // THEN the training level alone reads this flight as half as biased and halves the correction and more (F24b);
   // with the model's own level the ratio is about one: the model predicts here the smaller bias it sees, and is used
   // as trained (F24c)
   EXPECT_LT(b.summary.bias_model_mean_scale, 0.5);
   EXPECT_GT(c.summary.bias_model_mean_scale, 0.8);
   EXPECT_LT(c.summary.model_mean_level_m, 1.5 * mean_level);
-  EXPECT_LT(rms(c), rms(b));
-  EXPECT_LT(rms(c), 1.1 * rms(t));
+  EXPECT_LT(circleRms(c), circleRms(b));
+  EXPECT_LT(circleRms(c), 1.1 * circleRms(t));
   EXPECT_TRUE(std::isnan(b.summary.model_mean_level_m));  // not measured without the training mean level
 }
 
@@ -482,14 +488,14 @@ TEST(Estimator, AFlightMoreBiasedThanTheModelsTrainingFlightsCanWidenTheCorrecte
   };
   EkfParams probe = lateralFullParams();
   probe.bias_model_training_level_m = 0.2;
-  const double level = TdoaLocalizer(probe, arenaAnchors(), nothing).run(log, 0.1).summary.raw_bias_level_m;
+  const double level = runInArena(probe, log, nothing).summary.raw_bias_level_m;
   ASSERT_GT(level, 0.05);
   EkfParams off = lateralFullParams();
   off.bias_model_training_level_m = 0.25 * level;
   EkfParams on = off;
   on.bias_model_level_variance = true;
-  const LocalizerResult a = TdoaLocalizer(off, arenaAnchors(), nothing).run(log, 0.1);
-  const LocalizerResult b = TdoaLocalizer(on, arenaAnchors(), nothing).run(log, 0.1);
+  const LocalizerResult a = runInArena(off, log, nothing);
+  const LocalizerResult b = runInArena(on, log, nothing);
   // THEN with F24e each corrected TDoA gains ℓ² − ℓ_train² (gp.md P43c) of the level measured so far (ℓ starts
   // from the training level and keeps its weight of 10 windows, F24b); without it nothing is added
   const double train = 0.25 * level;

@@ -14,48 +14,55 @@ namespace {
 constexpr double kImuDt_s = 0.001;
 constexpr double kTdoaDt_s = 0.0025;
 
-/// Feeds `duration_s` of IMU evidence (1 kHz) and TDoA (400 Hz) whose heights scatter about `tdoa_height_m` with
-/// `spread_m` (the estimate sits at `estimate_height_m`); the vertical gains cycle through ±0.4…0.8.
-void feed(FlightModeSupervisor& s, double* t, double duration_s, const ImuModeEvidence& imu, double tdoa_height_m,
-          double spread_m, double estimate_height_m, std::mt19937& rng, bool settled_in_air = false) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  const double gains[] = {0.8, -0.5, 0.4, -0.7, 0.6};
-  const double t_end = *t + duration_s;
-  double t_next_tdoa = *t;
-  int k = 0;
-  while (*t < t_end) {
-    *t += kImuDt_s;
-    s.addImu(*t, kImuDt_s, imu, settled_in_air);
-    if (std::isfinite(tdoa_height_m) && *t >= t_next_tdoa) {
-      const double g = gains[k++ % 5];
-      const double h = tdoa_height_m + spread_m * n(rng);
-      const double r = (h - estimate_height_m) * g;
-      s.addTdoa(*t, r, r, g, estimate_height_m);
-      t_next_tdoa += kTdoaDt_s;
+/// A supervisor started in `mode`, its clock from t = 0, and the noise of the TDoA heights seeded by `seed`.
+struct SupervisorRun {
+  SupervisorRun(FlightMode mode, unsigned seed) : rng(seed) { s.reset(mode); }
+
+  /// Feeds `duration_s` of IMU evidence (1 kHz) and TDoA (400 Hz) whose heights scatter about `tdoa_height_m` with
+  /// `spread_m` (the estimate sits at `estimate_height_m`); the vertical gains cycle through ±0.4…0.8.
+  void feed(double duration_s, const ImuModeEvidence& imu, double tdoa_height_m, double spread_m,
+            double estimate_height_m, bool settled_in_air = false) {
+    std::normal_distribution<double> n(0.0, 1.0);
+    const double gains[] = {0.8, -0.5, 0.4, -0.7, 0.6};
+    const double t_end = t + duration_s;
+    double t_next_tdoa = t;
+    int k = 0;
+    while (t < t_end) {
+      t += kImuDt_s;
+      s.addImu(t, kImuDt_s, imu, settled_in_air);
+      if (std::isfinite(tdoa_height_m) && t >= t_next_tdoa) {
+        const double g = gains[k++ % 5];
+        const double h = tdoa_height_m + spread_m * n(rng);
+        const double r = (h - estimate_height_m) * g;
+        s.addTdoa(t, r, r, g, estimate_height_m);
+        t_next_tdoa += kTdoaDt_s;
+      }
+      s.decide(t);
     }
-    s.decide(*t);
   }
-}
+
+  FlightModeSupervisor s;
+  std::mt19937 rng;
+  double t = 0.0;
+};
 
 constexpr double kNoTdoa = std::numeric_limits<double>::quiet_NaN();
 
 TEST(FlightMode, TheImuAloneDecidesWithoutOtherEvidence) {
   // GIVEN a supervisor in the air and an IMU at rest, then moving, then shaking on the floor
-  FlightModeSupervisor s;
-  s.reset(FlightMode::kAirborne);
-  std::mt19937 rng(1);
-  double t = 0.0;
+  SupervisorRun run(FlightMode::kAirborne, 1);
+  FlightModeSupervisor& s = run.s;
   // WHEN the IMU reads rest for 0.1 s
-  feed(s, &t, 0.1, ImuModeEvidence{true, false, false, 0.0}, kNoTdoa, 0.0, 0.0, rng);
+  run.feed(0.1, ImuModeEvidence{true, false, false, 0.0}, kNoTdoa, 0.0, 0.0);
   // THEN the body is at rest on the floor
   EXPECT_EQ(s.mode(), FlightMode::kRest);
   EXPECT_TRUE(s.status() & kModeRest);
   EXPECT_TRUE(s.status() & kImuSaysRest);
   // WHEN it shakes with the motors running
-  feed(s, &t, 0.1, ImuModeEvidence{false, true, false, 0.1}, kNoTdoa, 0.0, 0.0, rng);
+  run.feed(0.1, ImuModeEvidence{false, true, false, 0.1}, kNoTdoa, 0.0, 0.0);
   EXPECT_EQ(s.mode(), FlightMode::kContact);
   // WHEN a climb is seen
-  feed(s, &t, 0.1, ImuModeEvidence{false, false, true, 0.0}, kNoTdoa, 0.0, 0.0, rng);
+  run.feed(0.1, ImuModeEvidence{false, false, true, 0.0}, kNoTdoa, 0.0, 0.0);
   // THEN airborne, the IMU's log-odds at their bound
   EXPECT_EQ(s.mode(), FlightMode::kAirborne);
   EXPECT_DOUBLE_EQ(s.imuLogOdds(), FlightModeParams{}.imu_max_log_odds);
@@ -64,15 +71,13 @@ TEST(FlightMode, TheImuAloneDecidesWithoutOtherEvidence) {
 
 TEST(FlightMode, TdoaThatPutTheTagHighOverruleTheImusFloorContact) {
   // GIVEN the IMU reads floor contact (a drone whose gyro shakes in flight) and the estimate sits on the floor
-  FlightModeSupervisor s;
-  s.reset(FlightMode::kContact);
-  std::mt19937 rng(2);
-  double t = 0.0;
+  SupervisorRun run(FlightMode::kContact, 2);
+  FlightModeSupervisor& s = run.s;
   const ImuModeEvidence contact{false, true, false, 0.3 * 0.3};
-  feed(s, &t, 0.3, contact, kNoTdoa, 0.0, 0.0, rng);
+  run.feed(0.3, contact, kNoTdoa, 0.0, 0.0);
   ASSERT_EQ(s.mode(), FlightMode::kContact);
   // WHEN the TDoA put the tag 1.2 m above the floor (residual spread 0.15 m)
-  feed(s, &t, 1.0, contact, 1.2, 0.15, 0.0, rng);
+  run.feed(1.0, contact, 1.2, 0.15, 0.0);
   // THEN the mode is airborne, against the IMU, and the status word says so
   EXPECT_EQ(s.mode(), FlightMode::kAirborne);
   EXPECT_NEAR(s.tdoaHeight(), 1.2, 0.1);
@@ -85,12 +90,10 @@ TEST(FlightMode, TdoaThatPutTheTagHighOverruleTheImusFloorContact) {
 
 TEST(FlightMode, FloorTdoaThatScatterByMetresDoNotLiftTheBody) {
   // GIVEN a body in floor contact whose TDoA carry a floor-level bias: heights about 0.4 m, scattered by 0.8 m
-  FlightModeSupervisor s;
-  s.reset(FlightMode::kContact);
-  std::mt19937 rng(3);
-  double t = 0.0;
+  SupervisorRun run(FlightMode::kContact, 3);
+  FlightModeSupervisor& s = run.s;
   // WHEN 3 s of them arrive
-  feed(s, &t, 3.0, ImuModeEvidence{false, true, false, 0.5 * 0.5}, 0.4, 0.8, 0.0, rng);
+  run.feed(3.0, ImuModeEvidence{false, true, false, 0.5 * 0.5}, 0.4, 0.8, 0.0);
   // THEN the IMU's floor holds: the scattered window's factor stays below the IMU's bound
   EXPECT_EQ(s.mode(), FlightMode::kContact);
   EXPECT_LT(s.tdoaLogOdds(), FlightModeParams{}.imu_max_log_odds - FlightModeParams{}.hysteresis_log_odds);
@@ -99,25 +102,21 @@ TEST(FlightMode, FloorTdoaThatScatterByMetresDoNotLiftTheBody) {
 
 TEST(FlightMode, FloorTdoaCannotHoldAClimbOnTheFloor) {
   // GIVEN a body on the floor whose TDoA say so precisely
-  FlightModeSupervisor s;
-  s.reset(FlightMode::kContact);
-  std::mt19937 rng(4);
-  double t = 0.0;
-  feed(s, &t, 1.0, ImuModeEvidence{false, true, false, 0.5 * 0.5}, 0.0, 0.05, 0.0, rng);
+  SupervisorRun run(FlightMode::kContact, 4);
+  FlightModeSupervisor& s = run.s;
+  run.feed(1.0, ImuModeEvidence{false, true, false, 0.5 * 0.5}, 0.0, 0.05, 0.0);
   EXPECT_DOUBLE_EQ(s.tdoaLogOdds(), -FlightModeParams{}.tdoa_max_floor_log_odds);
   // WHEN the take-off detector sees a climb (the TDoA window still on the floor)
-  feed(s, &t, 0.05, ImuModeEvidence{false, false, true, 0.0}, 0.0, 0.05, 0.0, rng);
+  run.feed(0.05, ImuModeEvidence{false, false, true, 0.0}, 0.0, 0.05, 0.0);
   // THEN airborne at once: the floor's TDoA weigh at most tdoa_max_floor_log_odds
   EXPECT_EQ(s.mode(), FlightMode::kAirborne);
 }
 
 TEST(FlightMode, DoubtIsCountedWhileTheImuHoldsTheFloorAgainstTheTdoa) {
   // GIVEN a body at rest by the IMU whose TDoA put it 0.35 m up (not enough to overrule the IMU)
-  FlightModeSupervisor s;
-  s.reset(FlightMode::kRest);
-  std::mt19937 rng(5);
-  double t = 0.0;
-  feed(s, &t, 2.0, ImuModeEvidence{true, false, false, 0.0}, 0.35, 0.05, 0.0, rng);
+  SupervisorRun run(FlightMode::kRest, 5);
+  FlightModeSupervisor& s = run.s;
+  run.feed(2.0, ImuModeEvidence{true, false, false, 0.0}, 0.35, 0.05, 0.0);
   // THEN it stays at rest, and the doubt is counted with the TDoA's height
   EXPECT_EQ(s.mode(), FlightMode::kRest);
   EXPECT_GT(s.tdoaLogOdds(), FlightModeParams{}.tdoa_max_floor_log_odds);
@@ -127,20 +126,18 @@ TEST(FlightMode, DoubtIsCountedWhileTheImuHoldsTheFloorAgainstTheTdoa) {
 
 TEST(FlightMode, TheAirborneShakingLevelIsLearnedFromTheFlight) {
   // GIVEN the prior level: shaking of 0.3 rad/s rms stands out as floor contact
-  FlightModeSupervisor s;
-  s.reset(FlightMode::kAirborne);
+  SupervisorRun run(FlightMode::kAirborne, 6);
+  FlightModeSupervisor& s = run.s;
   EXPECT_TRUE(s.shakingStandsOut(0.3 * 0.3));
   EXPECT_FALSE(s.status() & kAirShakeLearned);
-  std::mt19937 rng(6);
-  double t = 0.0;
   // WHEN the flight shakes at 0.3 rad/s while settled in the air
-  feed(s, &t, 1.0, ImuModeEvidence{false, false, false, 0.3 * 0.3}, kNoTdoa, 0.0, 1.0, rng, true);
+  run.feed(1.0, ImuModeEvidence{false, false, false, 0.3 * 0.3}, kNoTdoa, 0.0, 1.0, true);
   // THEN that shaking is the flight's, not floor contact; the idle shaking of another drone's floor (0.7) still is
   EXPECT_FALSE(s.shakingStandsOut(0.3 * 0.3));
   EXPECT_TRUE(s.shakingStandsOut(0.7 * 0.7));
   EXPECT_TRUE(s.status() & kAirShakeLearned);
   // AND the level decays back towards the prior when the flight is quiet, never below it
-  feed(s, &t, 30.0, ImuModeEvidence{false, false, false, 0.0}, kNoTdoa, 0.0, 1.0, rng, true);
+  run.feed(30.0, ImuModeEvidence{false, false, false, 0.0}, kNoTdoa, 0.0, 1.0, true);
   EXPECT_DOUBLE_EQ(s.airShakeLevel(), FlightModeParams{}.air_shake_prior_ms);
 }
 
