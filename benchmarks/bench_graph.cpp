@@ -38,6 +38,14 @@ struct Scene {
   }
 };
 
+/// What one iteration of an in-place update leaves, its outcome and the covariance, kept from being optimized away.
+template <class Outcome>
+void keepResult(const Outcome& outcome, MatN& P) {
+  benchmark::DoNotOptimize(outcome);
+  benchmark::DoNotOptimize(P.data());
+  benchmark::ClobberMemory();
+}
+
 // One full TDoA correction as the filter would call it (everything except the prior copy is measured work).
 void BM_TdoaCorrection15(benchmark::State& state) {
   const Scene s;
@@ -54,9 +62,7 @@ void BM_TdoaCorrection15(benchmark::State& state) {
     C.block<3, 3>(0, 6) = tagPositionJacobianAttitude(s.w_q_b, s.b_t_tag);
     const ScalarLinearMessage<kN> on_state = tdoaMessageOnState<kN>(msg, C, p_tag);
     const auto st = equalityRankOneInPlace<kN>(dx, P, on_state);
-    benchmark::DoNotOptimize(st);
-    benchmark::DoNotOptimize(P.data());
-    benchmark::ClobberMemory();
+    keepResult(st, P);
   }
 }
 BENCHMARK(BM_TdoaCorrection15);
@@ -75,9 +81,7 @@ void BM_EqualityRankOne15(benchmark::State& state) {
     dx.setZero();
     P = s.P;
     const auto st = equalityRankOneInPlace<kN>(dx, P, msg);
-    benchmark::DoNotOptimize(st);
-    benchmark::DoNotOptimize(P.data());
-    benchmark::ClobberMemory();
+    keepResult(st, P);
   }
 }
 BENCHMARK(BM_EqualityRankOne15);

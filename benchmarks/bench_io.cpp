@@ -25,12 +25,16 @@ std::filesystem::path realDir() {
 
 std::string benchFlight() { return (realDir() / "util-pilot" / "0425" / "0425-traj5.csv").string(); }
 
+/// Whether benchFlight() exists; when it does not, `state` skips with a message naming it.
+bool benchFlightPresent(benchmark::State& state) {
+  if (std::filesystem::exists(benchFlight())) return true;
+  state.SkipWithError(("real flight absent: " + benchFlight()).c_str());
+  return false;
+}
+
 void BM_ReadFlightCsv(benchmark::State& state) {
   const std::string path = benchFlight();
-  if (!std::filesystem::exists(path)) {
-    state.SkipWithError(("real flight absent: " + path).c_str());
-    return;
-  }
+  if (!benchFlightPresent(state)) return;
   std::size_t bytes = 0;
   for (auto _ : state) {
     uwb::ReadReport report;
@@ -45,10 +49,7 @@ BENCHMARK(BM_ReadFlightCsv)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
 void BM_ParseFlightCsvInMemory(benchmark::State& state) {
   const std::string path = benchFlight();
-  if (!std::filesystem::exists(path)) {
-    state.SkipWithError(("real flight absent: " + path).c_str());
-    return;
-  }
+  if (!benchFlightPresent(state)) return;
   const std::string text = uwb::formatFlightCsv(uwb::readFlightCsv(path));  // same values, shortest form
   for (auto _ : state) {
     uwb::Flight f = uwb::parseFlightCsv(text, path);
@@ -60,10 +61,7 @@ BENCHMARK(BM_ParseFlightCsvInMemory)->Unit(benchmark::kMillisecond)->MinTime(1.0
 
 void BM_FormatFlightCsv(benchmark::State& state) {
   const std::string path = benchFlight();
-  if (!std::filesystem::exists(path)) {
-    state.SkipWithError(("real flight absent: " + path).c_str());
-    return;
-  }
+  if (!benchFlightPresent(state)) return;
   const uwb::Flight f = uwb::readFlightCsv(path);
   std::size_t bytes = 0;
   for (auto _ : state) {

@@ -14,13 +14,7 @@ BUILD=${1:-build}
 shift || true
 SEEDS=("$@")
 [ ${#SEEDS[@]} -gt 0 ] || SEEDS=(3 5)
-CLI="$BUILD/uwbtdoa"
-[ -x "$CLI" ] || { echo "rate_sweep: $CLI not found (build first)" >&2; exit 2; }
-PY=/usr/bin/python3
-[ -x "$PY" ] || PY=python3
-
-WORK=$(mktemp -d)
-trap 'rm -rf "$WORK"' EXIT
+source "$(dirname "$0")/sweep_env.sh" rate_sweep "$BUILD"
 
 PRESETS=(paper)
 if [ -f "$("$CLI" paths)/real/util-final-extract/survey/anchor_const1_survey.txt" ]; then

@@ -24,17 +24,7 @@ import subprocess
 import sys
 import tempfile
 
-
-def option(args, name, default, kind):
-    if name not in args:
-        return default
-    i = args.index(name)
-    if i + 1 >= len(args):
-        sys.exit(f"real_window_sweep.py: {name} needs a value")
-    try:
-        return kind(args[i + 1])
-    except ValueError:
-        sys.exit(f"real_window_sweep.py: {name}: not a {kind.__name__}: {args[i + 1]}")
+from script_args import option
 
 
 def column(path, name, width):

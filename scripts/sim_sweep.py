@@ -30,19 +30,7 @@ import subprocess
 import sys
 import tempfile
 
-
-def option(args, name, default, kind):
-    if name not in args:
-        return default
-    i = args.index(name)
-    if i + 1 >= len(args):
-        sys.exit(f"sim_sweep.py: {name} needs a value")
-    try:
-        value = kind(args[i + 1])
-    except ValueError:
-        sys.exit(f"sim_sweep.py: {name} {args[i + 1]}: not a {kind.__name__}")
-    del args[i:i + 2]
-    return value
+from script_args import option
 
 
 ARGS = sys.argv[1:]

@@ -10,12 +10,7 @@ set -euo pipefail
 BUILD=${1:-build}
 shift || true
 ON_FLAGS=("$@")
-CLI="$BUILD/uwbtdoa"
-[ -x "$CLI" ] || { echo "zero_bias_drift: $CLI not found (build first)" >&2; exit 2; }
-PY=/usr/bin/python3
-[ -x "$PY" ] || PY=python3
-WORK=$(mktemp -d)
-trap 'rm -rf "$WORK"' EXIT
+source "$(dirname "$0")/sweep_env.sh" zero_bias_drift "$BUILD"
 cat > "$WORK/cfg.json" <<'JSON'
 {"bias": {"antenna_rms_m": 0, "anchor_pattern_rms_m": 0, "anchor_offset_std_m": 0, "nlos_bias_m": 0,
           "multipath_std_m": 0, "outlier_probability": 0, "burst_probability": 0, "ground_effect": false}}
