@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <ostream>
 #include <random>
 #include <string>
 #include <typeinfo>
@@ -21,6 +22,7 @@
 #include "support/TestSupport.h"
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/Flight.h"
+#include "uwb/io/UtilCsv.h"
 
 namespace uwb::test {
 
@@ -72,6 +74,27 @@ template <class E, class F>
 void expectThrows(F&& f, const std::vector<std::string>& parts) {
   const std::string message = messageOf<E>(std::forward<F>(f));
   for (const auto& p : parts) EXPECT_THAT(message, ::testing::HasSubstr(p));
+}
+
+/// The sample count of every stream of a flight, compared and printed at once.
+struct StreamSizes {
+  std::size_t tdoa = 0, twr = 0, acc = 0, gyro = 0, tof = 0, flow = 0, baro = 0, pose = 0;
+  bool operator==(const StreamSizes&) const = default;
+};
+
+inline StreamSizes streamSizes(const Flight& f) {
+  return {f.tdoa.size(), f.twr.size(), f.acc.size(), f.gyro.size(), f.tof.size(), f.flow.size(), f.baro.size(),
+          f.pose.size()};
+}
+
+inline std::ostream& operator<<(std::ostream& os, const StreamSizes& s) {
+  return os << "tdoa " << s.tdoa << ", twr " << s.twr << ", acc " << s.acc << ", gyro " << s.gyro << ", tof " << s.tof
+            << ", flow " << s.flow << ", baro " << s.baro << ", pose " << s.pose;
+}
+
+/// readFlightCsv of `text` written to the file `name` in `dir`.
+inline Flight readFlightText(const TempDir& dir, const std::string& name, const std::string& text) {
+  return readFlightCsv(dir.write(name, text));
 }
 
 inline bool sameBits(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }

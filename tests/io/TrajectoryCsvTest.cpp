@@ -18,24 +18,35 @@ namespace {
 
 using test::TempDir;
 
-TEST(TrajectoryCsv, RoundTripIsExact) {
-  // GIVEN a trajectory with arbitrary doubles (seed 3)
-  std::mt19937 rng(3);
+/// What arbitraryTrajectory draws: the whole filter state at exact times, or the pose at times off by draws of 0.1 µs.
+enum class Arbitrary { kWholeState, kTimeAndPose };
+
+/// 50 samples 10 ms apart whose values are standard normal draws (seed `seed`), in the order of the sample's fields.
+Trajectory arbitraryTrajectory(unsigned seed, Arbitrary what) {
+  std::mt19937 rng(seed);
   std::normal_distribution<double> n(0.0, 1.0);
   Trajectory traj;
   for (int i = 0; i < 50; ++i) {
     TrajectorySample s;
-    s.t_s = 0.01 * i;
+    s.t_s = what == Arbitrary::kTimeAndPose ? 0.01 * i + 1e-7 * n(rng) : 0.01 * i;
     s.w_p_b = Vec3(n(rng), n(rng), n(rng));
     s.w_q_b = Quat(n(rng), n(rng), n(rng), n(rng)).normalized();
-    s.sigma_p_m = Vec3(n(rng), n(rng), n(rng)).cwiseAbs();
-    s.w_v_b = Vec3(n(rng), n(rng), n(rng));
-    s.b_acc_bias = Vec3(n(rng), n(rng), n(rng));
-    s.b_gyro_bias = Vec3(n(rng), n(rng), n(rng));
+    if (what == Arbitrary::kWholeState) {
+      s.sigma_p_m = Vec3(n(rng), n(rng), n(rng)).cwiseAbs();
+      s.w_v_b = Vec3(n(rng), n(rng), n(rng));
+      s.b_acc_bias = Vec3(n(rng), n(rng), n(rng));
+      s.b_gyro_bias = Vec3(n(rng), n(rng), n(rng));
+    }
     traj.push_back(s);
   }
+  return traj;
+}
+
+TEST(TrajectoryCsv, RoundTripIsExact) {
+  // GIVEN a trajectory with arbitrary doubles (seed 3)
+  const Trajectory traj = arbitraryTrajectory(3, Arbitrary::kWholeState);
   // WHEN written and read back
-  TempDir dir;
+  const TempDir dir;
   writeTrajectoryCsv(traj, dir.file("t.csv"));
   const Trajectory back = readTrajectoryCsv(dir.file("t.csv"));
   // THEN bit-identical, the IMU biases included
@@ -129,16 +140,7 @@ TEST(TrajectoryCsv, MalformedInputNamesTheLocation) {
 
 TEST(TrajectoryTum, PosesReadBackExactlyAndEvoStyleFilesRead) {
   // GIVEN a trajectory with arbitrary doubles (seed 5)
-  std::mt19937 rng(5);
-  std::normal_distribution<double> n(0.0, 1.0);
-  Trajectory traj;
-  for (int i = 0; i < 50; ++i) {
-    TrajectorySample s;
-    s.t_s = 0.01 * i + 1e-7 * n(rng);
-    s.w_p_b = Vec3(n(rng), n(rng), n(rng));
-    s.w_q_b = Quat(n(rng), n(rng), n(rng), n(rng)).normalized();
-    traj.push_back(s);
-  }
+  const Trajectory traj = arbitraryTrajectory(5, Arbitrary::kTimeAndPose);
   // WHEN written as TUM and read back
   TempDir dir;
   writeTrajectoryTum(traj, dir.file("t.tum"));

@@ -56,13 +56,8 @@ TEST(UtilCsv, ReadsFullLayoutWithStreamsOfDifferentLengthsAndConvertsUnits) {
   ReadReport report;
   const Flight f = readFlightCsv(path, {}, &report);
   // THEN every stream has its own length, and acc/gyro are in SI
-  ASSERT_EQ(f.tdoa.size(), 2u);
-  EXPECT_EQ(f.acc.size(), 3u);
-  EXPECT_EQ(f.gyro.size(), 3u);
-  EXPECT_EQ(f.tof.size(), 1u);
-  EXPECT_EQ(f.flow.size(), 1u);
-  EXPECT_EQ(f.baro.size(), 1u);
-  ASSERT_EQ(f.pose.size(), 1u);
+  ASSERT_EQ(test::streamSizes(f),
+            (test::StreamSizes{.tdoa = 2, .twr = 0, .acc = 3, .gyro = 3, .tof = 1, .flow = 1, .baro = 1, .pose = 1}));
   EXPECT_TRUE(f.pose_has_orientation);
   EXPECT_EQ(f.tdoa[1].id_a, 2);
   EXPECT_EQ(f.tdoa[1].id_b, 3);
@@ -94,12 +89,10 @@ TEST(UtilCsv, ReadsExtractLayoutAsPositionOnlyPose) {
 }
 
 TEST(UtilCsv, ReadsTwrVariantAndColumnsInAnyOrder) {
-  TempDir dir;
-  const std::string path = dir.write("t.csv",
-                                     "t_twr,anchor_id,twr_range,t_pose,pose_z,pose_y,pose_x\n"
-                                     "0.01,3,2.5,0.0,1,2,3\n"
-                                     "0.02,4,2.75,,,,\n");
-  const Flight f = readFlightCsv(path);
+  const Flight f = test::readFlightText(TempDir(), "t.csv",
+                                        "t_twr,anchor_id,twr_range,t_pose,pose_z,pose_y,pose_x\n"
+                                        "0.01,3,2.5,0.0,1,2,3\n"
+                                        "0.02,4,2.75,,,,\n");
   ASSERT_EQ(f.twr.size(), 2u);
   EXPECT_EQ(f.twr[1].anchor_id, 4);
   EXPECT_DOUBLE_EQ(f.twr[1].range_m, 2.75);
@@ -169,40 +162,50 @@ TEST(UtilCsv, ParsesNumbersBitIdenticallyToFromChars) {
 
 // ------------------------------------------------------------------------------------------------ malformed input
 
-TEST(UtilCsvMalformed, EmptyFileIsMissingHeader) { expectInputError("", {":1", "missing header"}); }
+/// A malformed file that is one InputError naming its place: the file's text and the parts of the message.
+struct MalformedCase {
+  const char* name;
+  std::string text;
+  std::vector<std::string> parts;
+};
 
-TEST(UtilCsvMalformed, DataWithoutHeaderIsMissingHeader) {
-  expectInputError("0.001,1,2,0.5\n0.002,2,3,0.5\n", {":1:1", "missing header"});
+const std::vector<MalformedCase> kMalformedCases = {
+    {"EmptyFileIsMissingHeader", "", {":1", "missing header"}},
+    {"DataWithoutHeaderIsMissingHeader", "0.001,1,2,0.5\n0.002,2,3,0.5\n", {":1:1", "missing header"}},
+    {"UnknownColumnIsNamed", "t_tdoa,idA,idB,tdoa_meas,pose_roll\n",
+     {":1:5 (pose_roll)", "unknown column 'pose_roll'"}},
+    {"DuplicatedColumnIsNamed", "t_tdoa,idA,idB,tdoa_meas,idA\n", {":1:5 (idA)", "duplicated column 'idA'"}},
+    {"IncompleteStreamColumns", "t_tdoa,idA,idB\n0.1,1,2\n", {":1:", "'tdoa' is incomplete", "tdoa_meas"}},
+    {"IncompletePoseQuaternion", "t_pose,pose_x,pose_y,pose_z,pose_qx,pose_qw\n",
+     {":1:", "quaternion is incomplete", "pose_qy"}},
+    {"NonNumericCell", kSmallHeader + "0.1,1,2,0.5,0.1,1,2,3\n0.2,1,2,abc,0.2,1,2,3\n",
+     {":3:4 (tdoa_meas)", "not a number: 'abc'"}},
+    {"NaNCell", kSmallHeader + "0.1,1,2,0.5,0.1,nan,2,3\n", {":2:6 (pose_x)", "NaN or Inf"}},
+    {"InfCell", kSmallHeader + "0.1,1,2,-inf,0.1,1,2,3\n", {":2:4 (tdoa_meas)", "NaN or Inf"}},
+    {"NonIntegerAnchorId", kSmallHeader + "0.1,1.5,2,0.5,0.1,1,2,3\n", {":2:2 (idA)", "anchor id must be an integer"}},
+    {"TimeGoingBackwardsWithinAStream", kSmallHeader + "0.1,1,2,0.5,0.3,1,2,3\n0.2,1,2,0.5,0.2,1,2,3\n",
+     {":3:5 (t_pose)", "time goes backwards in stream 'pose'"}},
+    {"QuaternionFarFromUnitNorm", "t_pose,pose_x,pose_y,pose_z,pose_qx,pose_qy,pose_qz,pose_qw\n0.1,0,0,0,0,0,0,0.5\n",
+     {":2:5 (pose_qx)", "far from unit norm"}},
+    {"CellAfterTheEndOfAStream", kSmallHeader + "0.1,1,2,0.5,0.1,1,2,3\n0.2,1,2,0.5,,,,\n0.3,1,2,0.5,0.3,1,2,3\n",
+     {":4:5 (t_pose)", "continues after it ended", "line 3"}},
+    {"PartlyFilledRowWithEmptyTime", kSmallHeader + "0.1,1,2,0.5,,1,,\n",
+     {":2:6 (pose_x)", "partly filled row of stream 'pose'"}},
+    {"PartlyFilledRowWithEmptyValue", kSmallHeader + "0.1,1,2,,0.1,1,2,3\n", {":2:4 (tdoa_meas)", "partly filled row"}},
+    {"RowWithTooFewFields", kSmallHeader + "0.1,1,2,0.5,0.1,1\n", {":2:", "row has 6 fields, the header has 8"}},
+    {"RowWithTooManyFields", kSmallHeader + "0.1,1,2,0.5,0.1,1,2,3,4\n",
+     {":2:9", "row has 9 fields, the header has 8"}},
+    {"NumberOutOfRange", kSmallHeader + "0.1,1,2,1e999,0.1,1,2,3\n", {":2:4 (tdoa_meas)", "out of range"}},
+};
+
+class UtilCsvMalformedText : public ::testing::TestWithParam<MalformedCase> {};
+
+TEST_P(UtilCsvMalformedText, IsAnInputErrorNamingTheFileAndThePlace) {
+  expectInputError(GetParam().text, GetParam().parts);
 }
 
-TEST(UtilCsvMalformed, UnknownColumnIsNamed) {
-  expectInputError("t_tdoa,idA,idB,tdoa_meas,pose_roll\n", {":1:5 (pose_roll)", "unknown column 'pose_roll'"});
-}
-
-TEST(UtilCsvMalformed, DuplicatedColumnIsNamed) {
-  expectInputError("t_tdoa,idA,idB,tdoa_meas,idA\n", {":1:5 (idA)", "duplicated column 'idA'"});
-}
-
-TEST(UtilCsvMalformed, IncompleteStreamColumns) {
-  expectInputError("t_tdoa,idA,idB\n0.1,1,2\n", {":1:", "'tdoa' is incomplete", "tdoa_meas"});
-}
-
-TEST(UtilCsvMalformed, IncompletePoseQuaternion) {
-  expectInputError("t_pose,pose_x,pose_y,pose_z,pose_qx,pose_qw\n", {":1:", "quaternion is incomplete", "pose_qy"});
-}
-
-TEST(UtilCsvMalformed, NonNumericCell) {
-  expectInputError(kSmallHeader + "0.1,1,2,0.5,0.1,1,2,3\n0.2,1,2,abc,0.2,1,2,3\n",
-                   {":3:4 (tdoa_meas)", "not a number: 'abc'"});
-}
-
-TEST(UtilCsvMalformed, NaNCell) {
-  expectInputError(kSmallHeader + "0.1,1,2,0.5,0.1,nan,2,3\n", {":2:6 (pose_x)", "NaN or Inf"});
-}
-
-TEST(UtilCsvMalformed, InfCell) {
-  expectInputError(kSmallHeader + "0.1,1,2,-inf,0.1,1,2,3\n", {":2:4 (tdoa_meas)", "NaN or Inf"});
-}
+INSTANTIATE_TEST_SUITE_P(UtilCsvMalformed, UtilCsvMalformedText, ::testing::ValuesIn(kMalformedCases),
+                         [](const ::testing::TestParamInfo<MalformedCase>& info) { return info.param.name; });
 
 TEST(UtilCsvMalformed, AnchorIdWithoutSurveyEntry) {
   AnchorSurvey survey;
@@ -214,21 +217,12 @@ TEST(UtilCsvMalformed, AnchorIdWithoutSurveyEntry) {
                    {":3:3 (idB)", "anchor id 7 has no entry in the survey", "mini_survey.txt"}, options);
 }
 
-TEST(UtilCsvMalformed, NonIntegerAnchorId) {
-  expectInputError(kSmallHeader + "0.1,1.5,2,0.5,0.1,1,2,3\n", {":2:2 (idA)", "anchor id must be an integer"});
-}
-
 TEST(UtilCsvMalformed, AnAnchorIdBeyondTheLimitIsAnErrorNotATable) {
   // GIVEN the two-line CSV that made `inspect` allocate gigabytes (a table sized by the largest id)
   expectInputError("t_tdoa,idA,idB,tdoa_meas\n0.1,2147483647,0,0.5\n", {":2:2 (idA)", "[0, 255]", "2147483647"});
   expectInputError("t_tdoa,idA,idB,tdoa_meas\n0.1,0,256,0.5\n", {":2:3 (idB)", "[0, 255]"});
   expectInputError("t_tdoa,idA,idB,tdoa_meas\n0.1,-1,2,0.5\n", {":2:2 (idA)", "[0, 255]"});
   expectInputError("t_tdoa,idA,idB,tdoa_meas\n0.1,1e300,2,0.5\n", {":2:2 (idA)", "[0, 255]"});
-}
-
-TEST(UtilCsvMalformed, TimeGoingBackwardsWithinAStream) {
-  expectInputError(kSmallHeader + "0.1,1,2,0.5,0.3,1,2,3\n0.2,1,2,0.5,0.2,1,2,3\n",
-                   {":3:5 (t_pose)", "time goes backwards in stream 'pose'"});
 }
 
 TEST(UtilCsvMalformed, RequiredStreamWithoutColumns) {
@@ -248,36 +242,6 @@ TEST(UtilCsvMalformed, HeaderOnlyFileFailsWhenTdoaIsRequired) {
   FlightReadOptions options;
   options.required = {Stream::kTdoa};
   expectInputError(kSmallHeader, {"required stream 'tdoa' has no samples"}, options);
-}
-
-TEST(UtilCsvMalformed, QuaternionFarFromUnitNorm) {
-  expectInputError("t_pose,pose_x,pose_y,pose_z,pose_qx,pose_qy,pose_qz,pose_qw\n0.1,0,0,0,0,0,0,0.5\n",
-                   {":2:5 (pose_qx)", "far from unit norm"});
-}
-
-TEST(UtilCsvMalformed, CellAfterTheEndOfAStream) {
-  expectInputError(kSmallHeader + "0.1,1,2,0.5,0.1,1,2,3\n0.2,1,2,0.5,,,,\n0.3,1,2,0.5,0.3,1,2,3\n",
-                   {":4:5 (t_pose)", "continues after it ended", "line 3"});
-}
-
-TEST(UtilCsvMalformed, PartlyFilledRowWithEmptyTime) {
-  expectInputError(kSmallHeader + "0.1,1,2,0.5,,1,,\n", {":2:6 (pose_x)", "partly filled row of stream 'pose'"});
-}
-
-TEST(UtilCsvMalformed, PartlyFilledRowWithEmptyValue) {
-  expectInputError(kSmallHeader + "0.1,1,2,,0.1,1,2,3\n", {":2:4 (tdoa_meas)", "partly filled row"});
-}
-
-TEST(UtilCsvMalformed, RowWithTooFewFields) {
-  expectInputError(kSmallHeader + "0.1,1,2,0.5,0.1,1\n", {":2:", "row has 6 fields, the header has 8"});
-}
-
-TEST(UtilCsvMalformed, RowWithTooManyFields) {
-  expectInputError(kSmallHeader + "0.1,1,2,0.5,0.1,1,2,3,4\n", {":2:9", "row has 9 fields, the header has 8"});
-}
-
-TEST(UtilCsvMalformed, NumberOutOfRange) {
-  expectInputError(kSmallHeader + "0.1,1,2,1e999,0.1,1,2,3\n", {":2:4 (tdoa_meas)", "out of range"});
 }
 
 TEST(UtilCsvMalformed, MissingFileIsAFileError) {
@@ -369,12 +333,11 @@ TEST(UtilCsvRoundTrip, ExtractLayoutKeepsItsColumns) {
 
 TEST(UtilCsvRoundTrip, TwrLayout) {
   TempDir dir;
-  const std::string path = dir.write("t.csv",
-                                     "t_twr,anchor_id,twr_range,t_acc,acc_x,acc_y,acc_z\n"
-                                     "0.01,3,2.5,0,0.01,-0.02,0.999\n"
-                                     "0.02,4,2.75,0.001,0.011,-0.021,1.001\n"
-                                     ",,,0.002,0.3,0.1,0.7\n");
-  const Flight first = readFlightCsv(path);
+  const Flight first = test::readFlightText(dir, "t.csv",
+                                            "t_twr,anchor_id,twr_range,t_acc,acc_x,acc_y,acc_z\n"
+                                            "0.01,3,2.5,0,0.01,-0.02,0.999\n"
+                                            "0.02,4,2.75,0.001,0.011,-0.021,1.001\n"
+                                            ",,,0.002,0.3,0.1,0.7\n");
   writeFlightCsv(first, dir.file("t2.csv"));
   EXPECT_TRUE(test::flightsIdentical(first, readFlightCsv(dir.file("t2.csv"))));
 }

@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 
 class SlowCrazyflieGuide : public test::PilotFlightCliTest {
  protected:
-  SlowCrazyflieGuide() : PilotFlightCliTest("guide", "0425-traj2") {}
+  SlowCrazyflieGuide() : PilotFlightCliTest("0425-traj2") {}
   /// `uwbtdoa <command> <args>` as the guide writes it, its file names taken in the test's directory.
   test::CliResult run(const std::string& command_line) const {
     std::istringstream in(command_line);

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <optional>
 #include <set>
 #include <utility>
 
@@ -38,20 +40,57 @@ const SimScenarioRun& scenario(const std::vector<SimScenarioRun>& runs, const st
   throw std::runtime_error("no scenario " + name);
 }
 
-/// A 40 s simulated flight of the given shape at the paper's anchors with the given sensors, localized with the
-/// defaults.
-LocalizationRun localizeSimulated(sim::TrajectoryShape shape, const sim::SimParams& sp, std::uint64_t seed) {
+/// A util-pilot flight and the survey of its session.
+struct PilotFlight {
+  Flight flight;
+  AnchorSurvey survey;
+};
+
+/// The util-pilot flight `name` (e.g. "0425-traj3") and its session's survey; nullopt when the real data is absent.
+std::optional<PilotFlight> readPilotFlight(const std::string& name) {
+  const auto path = test::pilotFlight(name);
+  if (!path) return std::nullopt;
+  return PilotFlight{readFlightCsv(path->string()), readAnchorSurvey(test::pilotSurvey(name.substr(0, 4)).string())};
+}
+
+/// The run was scored against the truth, its airborne RMSE below `rmse_m` and its largest airborne error below `max_m`.
+void expectAirborneErrorBelow(const LocalizationRun& run, double rmse_m, double max_m) {
+  ASSERT_TRUE(run.metrics);
+  EXPECT_LT(run.metrics->airborne.rmse_m, rmse_m);
+  EXPECT_LT(run.metrics->airborne.max_m, max_m);
+}
+
+/// The TDoA the run used, rejected or spent on its start (of n_tdoa_total).
+double tdoaAccountedFor(const LocalizerSummary& sum) {
+  return static_cast<double>(sum.n_tdoa_used + sum.n_tdoa_rejected + sum.n_tdoa_start);
+}
+
+/// A log started in the air: the run is scored, its position found within 1 s of the first TDoA, its airborne RMSE
+/// below 0.30 m and below 0.40 m 3–5 s after the start; its checks in `c`.
+void expectFoundAtOnce(const LocalizationRun& run, const SimScenarioRun& s, EstimateChecks* c) {
+  ASSERT_TRUE(run.metrics);
+  EXPECT_LT(run.summary.ready_t_s - s.flight.tdoa.front().t_s, 1.0);
+  EXPECT_LT(run.metrics->airborne.rmse_m, 0.30);
+  *c = checks(run, s.flight, s.survey);
+  EXPECT_LT(c->rmse_3_to_5s_m, 0.40);
+}
+
+/// A 40 s simulated flight of the given shape at the paper's anchors, its sensors the simulator's defaults as
+/// `sensors` changes them, localized with the defaults.
+LocalizationRun localizeSimulated(sim::TrajectoryShape shape, std::uint64_t seed,
+                                  const std::function<void(sim::SimParams&)>& sensors) {
+  sim::SimParams sp;
+  sensors(sp);
   const sim::SimResult s = sim::simulateFlight(sim::makeScenario(sim::paperAnchors(), shape, 40.0), sp, seed);
   return localizeFlight(s.flight, s.survey);
 }
 
 TEST(Generalization, RealFlightLoggedFromMidAir) {
   // GIVEN a real dev flight cut to start 10 s after power-up (in the air) and to end 1 s before the landing
-  const auto path = test::pilotFlight("0425-traj3");
-  UWB_REQUIRE_REAL_DATA(path);
-  const AnchorSurvey survey = readAnchorSurvey(test::pilotSurvey("0425").string());
-  const Flight full = readFlightCsv(path->string());
-  const Flight cut = sliceFlight(full, 10.0, 29.5);
+  const std::optional<PilotFlight> pilot = readPilotFlight("0425-traj3");
+  UWB_REQUIRE_REAL_DATA(pilot);
+  const AnchorSurvey& survey = pilot->survey;
+  const Flight cut = sliceFlight(pilot->flight, 10.0, 29.5);
   // WHEN localizing it with the defaults
   const LocalizationRun run = localizeFlight(cut, survey);
   // THEN the airborne RMSE is that of a whole flight, 3–5 s after the first TDoA the error is small, no step jumps
@@ -67,17 +106,15 @@ TEST(Generalization, RealLogBegunDuringAShakingBurstInFlightIsNotPutOnTheFloor) 
   // GIVEN real dev flights cut to start in the air where the IMU shakes as on the floor with the motors running
   // (F18 contact: 0426-traj12 at 2 m from 13.70 s for 0.47 s, 0425-traj2 at 1.5 m from 9.13 s for 0.04 s)
   const struct {
-    const char *flight, *session;
+    const char* flight;
     double t0_s, t1_s;
-  } cuts[] = {{"0426-traj12", "0426", 13.56, 30.04}, {"0425-traj2", "0425", 8.46, 24.98}};
+  } cuts[] = {{"0426-traj12", 13.56, 30.04}, {"0425-traj2", 8.46, 24.98}};
   for (const auto& k : cuts) {
     SCOPED_TRACE(k.flight);
-    const auto path = test::pilotFlight(k.flight);
-    UWB_REQUIRE_REAL_DATA(path);
-    const AnchorSurvey survey = readAnchorSurvey(test::pilotSurvey(k.session).string());
-    const Flight cut = sliceFlight(readFlightCsv(path->string()), k.t0_s, k.t1_s);
+    const std::optional<PilotFlight> pilot = readPilotFlight(k.flight);
+    UWB_REQUIRE_REAL_DATA(pilot);
     // WHEN localizing with the defaults
-    const LocalizationRun run = localizeFlight(cut, survey);
+    const LocalizationRun run = localizeFlight(sliceFlight(pilot->flight, k.t0_s, k.t1_s), pilot->survey);
     // THEN the first fix refutes the ground evidence (F16j): the estimate is never on the floor (before: 2.1 and
     // 1.5 m off for a second, airborne RMSE 0.49 and 0.39 m), and no take-off is reported
     ASSERT_TRUE(run.metrics);
@@ -91,12 +128,10 @@ TEST(Generalization, RealLogBegunDuringAShakingBurstInFlightIsNotPutOnTheFloor) 
 
 TEST(Generalization, RealLogBegunInAPlaceOfBiasedTdoaDoesNotRunAway) {
   // GIVEN a real dev flight logged from 29.45 s, in the air at a place whose TDoA are off by about 1 m
-  const auto path = test::pilotFlight("0426-traj11");
-  UWB_REQUIRE_REAL_DATA(path);
-  const AnchorSurvey survey = readAnchorSurvey(test::pilotSurvey("0426").string());
-  const Flight cut = sliceFlight(readFlightCsv(path->string()), 29.45, 48.59);
+  const std::optional<PilotFlight> pilot = readPilotFlight("0426-traj11");
+  UWB_REQUIRE_REAL_DATA(pilot);
   // WHEN localizing it with the defaults
-  const LocalizationRun run = localizeFlight(cut, survey);
+  const LocalizationRun run = localizeFlight(sliceFlight(pilot->flight, 29.45, 48.59), pilot->survey);
   // THEN the acquisition after the replayed start (F16g′) does not carry the estimate away: before, its second second
   // of gate-free updates turned the roll, the estimate ran 8.6 m off and was re-acquired (airborne RMSE 1.72 m)
   ASSERT_TRUE(run.metrics);
@@ -109,10 +144,9 @@ TEST(Generalization, RealLogBegunInAPlaceOfBiasedTdoaDoesNotRunAway) {
 TEST(Generalization, RealStartOnTheFloorSeesTheFloorLevelAnchorsLate) {
   // GIVEN a real flight of the other session whose first 1 s on the floor carries the floor-level delays (0426-traj1:
   // the pairs with one anchor at 0.2 m and one at 3 m are off by 3 m)
-  const auto path = test::pilotFlight("0426-traj1");
-  UWB_REQUIRE_REAL_DATA(path);
-  const AnchorSurvey survey = readAnchorSurvey(test::pilotSurvey("0426").string());
-  const Flight flight = readFlightCsv(path->string());
+  const std::optional<PilotFlight> pilot = readPilotFlight("0426-traj1");
+  UWB_REQUIRE_REAL_DATA(pilot);
+  const auto& [flight, survey] = *pilot;
   // WHEN localizing with the defaults, and with the floor-level delays not modelled (F16f off)
   const LocalizationRun run = localizeFlight(flight, survey);
   LocalizationOptions off;
@@ -162,13 +196,9 @@ TEST(Generalization, SimulatedStartInHover) {
   // WHEN localizing
   const LocalizationRun run = localizeFlight(s.flight, s.survey);
   // THEN the position is found at once and the error is that of the rest of the flight within 3 s
-  ASSERT_TRUE(run.metrics);
-  EXPECT_LT(run.summary.ready_t_s - s.flight.tdoa.front().t_s, 1.0);
-  EXPECT_LT(run.metrics->airborne.rmse_m, 0.30);
-  const EstimateChecks c = checks(run, s.flight, s.survey);
-  EXPECT_LT(c.rmse_3_to_5s_m, 0.40);
-  const LocalizerSummary& sum = run.summary;
-  EXPECT_GE(static_cast<double>(sum.n_tdoa_used + sum.n_tdoa_rejected + sum.n_tdoa_start), 0.9 * sum.n_tdoa_total);
+  EstimateChecks c;
+  ASSERT_NO_FATAL_FAILURE(expectFoundAtOnce(run, s, &c));
+  EXPECT_GE(tdoaAccountedFor(run.summary), 0.9 * run.summary.n_tdoa_total);
 }
 
 TEST(Generalization, StartInTheAirAddsLittleToTheSameFlightFromTheGround) {
@@ -205,15 +235,11 @@ TEST(Generalization, SimulatedHandCarriedStartWhileWalking) {
   // WHEN localizing
   const LocalizationRun run = localizeFlight(s.flight, s.survey);
   // THEN it is found within a second, tracked like a flight, nothing is read as on the ground, no output jumps
-  ASSERT_TRUE(run.metrics);
-  EXPECT_LT(run.summary.ready_t_s - s.flight.tdoa.front().t_s, 1.0);
-  EXPECT_LT(run.metrics->airborne.rmse_m, 0.30);
-  const EstimateChecks c = checks(run, s.flight, s.survey);
-  EXPECT_LT(c.rmse_3_to_5s_m, 0.40);
+  EstimateChecks c;
+  ASSERT_NO_FATAL_FAILURE(expectFoundAtOnce(run, s, &c));
   EXPECT_LT(c.max_airborne_step_m, 0.2);
   EXPECT_EQ(run.summary.n_reacquisitions, 0u);
-  const LocalizerSummary& sum = run.summary;
-  EXPECT_GE(static_cast<double>(sum.n_tdoa_used + sum.n_tdoa_rejected + sum.n_tdoa_start), 0.95 * sum.n_tdoa_total);
+  EXPECT_GE(tdoaAccountedFor(run.summary), 0.95 * run.summary.n_tdoa_total);
 }
 
 TEST(Generalization, SimulatedTwoTakeoffs) {
@@ -230,8 +256,7 @@ TEST(Generalization, SimulatedTwoTakeoffs) {
   const EstimateChecks c = checks(run, s.flight, s.survey);
   EXPECT_FALSE(c.floor_or_ceiling_violated);
   EXPECT_LT(c.max_airborne_step_m, 0.3);
-  const LocalizerSummary& sum = run.summary;
-  EXPECT_GE(static_cast<double>(sum.n_tdoa_used + sum.n_tdoa_rejected + sum.n_tdoa_start), 0.9 * sum.n_tdoa_total);
+  EXPECT_GE(tdoaAccountedFor(run.summary), 0.9 * run.summary.n_tdoa_total);
 }
 
 TEST(Generalization, SimulatedLandingsAreNotPulledAwayByTheFloorLevelAnchors) {
@@ -321,16 +346,14 @@ TEST(Generalization, SimulatedLogBegunInTheAirLearnsTheFloorAtItsLanding) {
 TEST(Generalization, SimulatedImuLoggedAt100HzWithAStillHover) {
   // GIVEN a simulated zigzag whose IMU is logged at 100 Hz and TDoA at 100 Hz (a radio or uSD log): its still hover
   // before the landing reads as quiet as the motors off
-  sim::SimParams sp;
-  sp.imu.rate_hz = 100.0;
-  sp.tdoa.rate_hz = 100.0;
   // WHEN localizing with the defaults
-  const LocalizationRun run = localizeSimulated(sim::TrajectoryShape::kZigzag, sp, 5);
+  const LocalizationRun run = localizeSimulated(sim::TrajectoryShape::kZigzag, 5, [](sim::SimParams& sp) {
+    sp.imu.rate_hz = 100.0;
+    sp.tdoa.rate_hz = 100.0;
+  });
   // THEN the hover is not taken for the ground (at 2 m the floor height pulled the estimate 2 m down: airborne RMSE
   // 0.37 m, largest error 2.0 m), and the flight is as accurate as at 1 kHz (0.23 m)
-  ASSERT_TRUE(run.metrics);
-  EXPECT_LT(run.metrics->airborne.rmse_m, 0.27);
-  EXPECT_LT(run.metrics->airborne.max_m, 0.8);
+  ASSERT_NO_FATAL_FAILURE(expectAirborneErrorBelow(run, 0.27, 0.8));
   EXPECT_EQ(run.summary.n_rest_periods, 2u);
   EXPECT_EQ(run.summary.n_reacquisitions, 0u);
 }
@@ -338,10 +361,9 @@ TEST(Generalization, SimulatedImuLoggedAt100HzWithAStillHover) {
 TEST(Generalization, RealTdoa3FlightAndItsReportedSigma) {
   // GIVEN the util-pilot TDoA3 flight (random anchor pairs at about 200 Hz, the LPS mode of current firmware; no
   // default was chosen on it): the same eight anchors as the TDoA2 flights of its session, seen through up to 28 pairs
-  const auto path = test::pilotFlight("0425-traj13");
-  UWB_REQUIRE_REAL_DATA(path);
-  const AnchorSurvey survey = readAnchorSurvey(test::pilotSurvey("0425").string());
-  const Flight flight = readFlightCsv(path->string());
+  const std::optional<PilotFlight> pilot = readPilotFlight("0425-traj13");
+  UWB_REQUIRE_REAL_DATA(pilot);
+  const auto& [flight, survey] = *pilot;
   // WHEN localizing with the defaults
   const LocalizationRun run = localizeFlight(flight, survey);
   // THEN the error is that of the same circle flown with TDoA2 (0425-traj1: 0.356 m; here 0.371 m), and the reported
@@ -359,10 +381,9 @@ TEST(Generalization, RealTdoa3FlightAndItsReportedSigma) {
 TEST(Generalization, RealFlightWithALargeBiasWidensItsReportedSigma) {
   // GIVEN the development flight with the largest TDoA bias (0425-traj1: airborne RMSE 0.34 m, of it 0.28 m in z;
   // its residuals that no position explains read a pair-bias level of ≈ 0.39 m against 0.2–0.3 m on the others)
-  const auto path = test::pilotFlight("0425-traj1");
-  UWB_REQUIRE_REAL_DATA(path);
-  const AnchorSurvey survey = readAnchorSurvey(test::pilotSurvey("0425").string());
-  const Flight flight = readFlightCsv(path->string());
+  const std::optional<PilotFlight> pilot = readPilotFlight("0425-traj1");
+  UWB_REQUIRE_REAL_DATA(pilot);
+  const auto& [flight, survey] = *pilot;
   // WHEN localizing with the bias term as derived (F23d's vertical factor 1), once with the band widened by the
   // level measured in flight and once with the reported pair-bias std fixed at 0.2 m (F23c off); and with the defaults
   LocalizationOptions derived;
@@ -421,16 +442,14 @@ TEST(Generalization, SimulatedTdoa3) {
 TEST(Generalization, SimulatedQuietAccelerometerDuringTheClimb) {
   // GIVEN a simulated circle whose accelerometer is quiet (0.04 m/s² per sample instead of 0.15, a soft-mounted or
   // filtered IMU): the steady climb after the take-off and the hover before the circle read as quiet as the motors off
-  sim::SimParams sp;
-  sp.imu.acc_noise_std_mps2 = 0.04;
   // WHEN localizing with the defaults
-  const LocalizationRun run = localizeSimulated(sim::TrajectoryShape::kCircle, sp, 3);
+  const LocalizationRun run = localizeSimulated(sim::TrajectoryShape::kCircle, 3, [](sim::SimParams& sp) {
+    sp.imu.acc_noise_std_mps2 = 0.04;
+  });
   // THEN the climb is not taken for the ground (rest put the climbing body back on the floor and the ZUPT took the
   // climb for accelerometer bias: airborne RMSE 0.73 m, largest error 2.1 m, six rest periods), and the flight is as
   // accurate as with the noisier accelerometer (0.31 m, 0.84 m; this seed's bias field is the hard one)
-  ASSERT_TRUE(run.metrics);
-  EXPECT_LT(run.metrics->airborne.rmse_m, 0.34);
-  EXPECT_LT(run.metrics->airborne.max_m, 1.0);
+  ASSERT_NO_FATAL_FAILURE(expectAirborneErrorBelow(run, 0.34, 1.0));
   EXPECT_LE(run.summary.n_rest_periods, 3u);
   EXPECT_EQ(run.summary.n_reacquisitions, 0u);
 }
@@ -438,10 +457,10 @@ TEST(Generalization, SimulatedQuietAccelerometerDuringTheClimb) {
 TEST(Generalization, SimulatedUncalibratedGyro) {
   // GIVEN a simulated circle whose gyro has a turn-on bias of 0.03 rad/s per axis (1.7 deg/s; a raw MEMS gyro without
   // the Crazyflie's start-up calibration): at rest on the floor it reads above the rest test's 0.03 rad/s rms
-  sim::SimParams sp;
-  sp.imu.gyro_bias_std_rps = 0.03;
   // WHEN localizing with the defaults
-  const LocalizationRun run = localizeSimulated(sim::TrajectoryShape::kCircle, sp, 5);
+  const LocalizationRun run = localizeSimulated(sim::TrajectoryShape::kCircle, 5, [](sim::SimParams& sp) {
+    sp.imu.gyro_bias_std_rps = 0.03;
+  });
   // THEN rest is found against the gyro's reading in the still levelling window: the start and the landing are on
   // the ground (without the reference: no rest period, the position lost after the landing, 78 % of the TDoA used)
   ASSERT_TRUE(run.metrics);

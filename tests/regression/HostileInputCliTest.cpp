@@ -85,9 +85,6 @@ std::vector<std::string> temporaryFiles(const fs::path& dir) {
 
 /// A 30 s simulated flight with ground truth, its survey and a tiny bias model, shared by the tests of this file.
 class HostileCli : public test::SimulatedCircleSuite<HostileCli> {
- public:
-  static constexpr const char* kTag = "hostile_cli";
-
  protected:
   void SetUp() override {
     SimulatedCircleSuite::SetUp();

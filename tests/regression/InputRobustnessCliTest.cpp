@@ -30,14 +30,7 @@ using ::testing::Not;
 
 /// A 30 s simulated flight, its survey and a tiny trained bias model, shared by the tests of this file.
 class RobustCli : public test::SimulatedCircleSuite<RobustCli> {
- public:
-  static constexpr const char* kTag = "robust_cli";
-
  protected:
-  static std::string read(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  }
   static std::string localizeArgs(const std::string& flight, const std::string& survey) {
     return "localize " + flight + " --anchors " + survey + " --json";
   }
@@ -102,7 +95,7 @@ TEST_F(RobustCli, SimulateRefusesAnAbsurdDurationBeforeAllocating) {
 
 TEST_F(RobustCli, ASurveyWithAllAnchorsAtOnePointIsAnError) {
   // GIVEN the survey's ids, every anchor at the same point (localize used to answer with a 145 m RMSE, rc 0)
-  std::istringstream lines(read(survey_));
+  std::istringstream lines(test::readFileBytes(survey_));
   std::string text;
   for (std::string line; std::getline(lines, line);) {
     const auto comma = line.find(',');
@@ -192,7 +185,7 @@ TEST_F(RobustCli, ConfigErrorsNameTheFileAndTheKey) {
 // ------------------------------------------------------------------------------------------------ bias models
 
 TEST_F(RobustCli, CorruptBiasModelValuesAreErrorsNamingTheFileAndKey) {
-  const nlohmann::json good = nlohmann::json::parse(read(model()));
+  const nlohmann::json good = nlohmann::json::parse(test::readFileBytes(model()));
   ASSERT_TRUE(good.contains("models"));
   struct Case {
     const char* name;
@@ -234,7 +227,7 @@ TEST_F(RobustCli, PredictBiasWritesTheMeasuredTdoaAndThePredictiveDistributionIn
     const test::CliResult r = test::runCli("predict-bias " + flight_ + " --anchors " + survey_ + " --model " + model() +
                                            " --inputs " + inputs + " --json --out " + out);
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    std::istringstream lines(read(out));
+    std::istringstream lines(test::readFileBytes(out));
     std::string line;
     std::getline(lines, line);
     ASSERT_EQ(line, "t,idA,idB,tdoa_meas,error_m,bias_mean_m,bias_std_m,airborne,predictive_std_m");

@@ -22,7 +22,7 @@ namespace {
 
 class LocalizeCli : public test::PilotFlightCliTest {
  protected:
-  LocalizeCli() : PilotFlightCliTest("localize_cli", "0425-traj3") {}
+  LocalizeCli() : PilotFlightCliTest("0425-traj3") {}
   nlohmann::json localize(const std::string& extra) {
     const test::CliResult r = test::runCli("localize " + flight_->string() + " --anchors " +
                                            test::pilotSurvey("0425").string() + " --json " + extra);

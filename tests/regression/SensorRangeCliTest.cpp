@@ -74,7 +74,7 @@ std::string spiked(const std::string& text, const std::string& time_column, cons
 
 class SensorRangeCli : public test::PilotFlightCliTest {
  protected:
-  SensorRangeCli() : PilotFlightCliTest("sensor_range", "0425-traj2") {}
+  SensorRangeCli() : PilotFlightCliTest("0425-traj2") {}
   void SetUp() override {
     PilotFlightCliTest::SetUp();
     if (IsSkipped()) return;

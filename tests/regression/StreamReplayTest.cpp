@@ -28,19 +28,10 @@
 namespace uwb {
 namespace {
 
-namespace fs = std::filesystem;
-
+/// 5 s of a flight in the air (12–17 s), as a log started in flight would hold them.
 class StreamCli : public test::PilotFlightCliTest {
  protected:
-  StreamCli() : PilotFlightCliTest("stream_cli", "0425-traj1") {}
-  void SetUp() override {
-    PilotFlightCliTest::SetUp();
-    if (IsSkipped()) return;
-    // 5 s in the air, as a log started in flight would hold them
-    short_ = path("short.csv");
-    writeFlightCsv(sliceFlight(readFlightCsv(flight_->string()), 12.0, 17.0), short_);
-  }
-  std::string short_;
+  StreamCli() : PilotFlightCliTest("0425-traj1", {{12.0, 17.0}}) {}
 };
 
 std::vector<LocalizerEstimate> parseLines(const std::string& text, EstimateFormat f, bool header) {

@@ -29,16 +29,9 @@ namespace fs = std::filesystem;
 
 class StreamZmq : public test::PilotFlightCliTest {
  protected:
-  StreamZmq() : PilotFlightCliTest("stream_zmq", "0425-traj1") {}
-  void SetUp() override {
-    PilotFlightCliTest::SetUp();
-    if (IsSkipped()) return;
-    short_ = path("short.csv");
-    writeFlightCsv(sliceFlight(readFlightCsv(flight_->string()), 12.0, 17.0), short_);
-  }
+  StreamZmq() : PilotFlightCliTest("0425-traj1", {{12.0, 17.0}}) {}
   /// Two loopback endpoints unlikely to be in use (per process).
   static std::string endpoint(int k) { return "tcp://127.0.0.1:" + std::to_string(40000 + (::getpid() * 2 + k) % 20000); }
-  std::string short_;
 };
 
 /// Runs `timeout 60 uwbtdoa <args>`; stdout and stderr to their own files (several run at once).

@@ -18,10 +18,7 @@ namespace {
 using RunResult = uwb::test::CliResult;
 RunResult run(const std::string& args) { return uwb::test::runCli(args); }
 
-class SimulateCli : public uwb::test::CliTest {
- protected:
-  SimulateCli() : CliTest("sim_cli") {}
-};
+class SimulateCli : public uwb::test::CliTest {};
 
 TEST_F(SimulateCli, JsonModePrintsOneObjectAndWritesReadableFiles) {
   // GIVEN a short figure-eight simulation with --json

@@ -14,17 +14,12 @@
 namespace uwb {
 namespace {
 
-using test::circle;
-using test::cornerSurvey;
-using test::roll;
-using test::yaw;
-
 TEST(TdoaResiduals, NoiseFreeMeasurementsHaveZeroResidualWithTheLeverArmInTheBodyFrame) {
   // GIVEN a flight whose TDoA is generated from the ground truth with the UTIL lever arm, rolled 20°
-  const AnchorSurvey survey = cornerSurvey();
+  const AnchorSurvey survey = test::cornerSurvey();
   Flight f;
-  f.pose = circle(200.0, 2.0);
-  for (auto& p : f.pose) p.w_q_b = p.w_q_b * roll(0.35);
+  f.pose = test::circle(200.0, 2.0);
+  for (auto& p : f.pose) p.w_q_b = p.w_q_b * test::roll(0.35);
   f.pose_has_orientation = true;
   for (int i = 0; i < 300; ++i) {
     const double t = 0.0033 * i + 0.001;
@@ -66,7 +61,7 @@ TEST(TdoaResiduals, SignConventionIsRangeToBMinusRangeToA) {
 }
 
 TEST(TdoaResiduals, PositionOnlyTrackAddsTheLeverArmInTheWorldFrame) {
-  const AnchorSurvey survey = cornerSurvey();
+  const AnchorSurvey survey = test::cornerSurvey();
   Flight f;
   f.pose = {{0.0, Vec3(0.5, 0.2, 1.0), Quat::Identity()}, {0.01, Vec3(0.5, 0.2, 1.0), Quat::Identity()}};
   f.pose_has_orientation = false;
@@ -79,9 +74,9 @@ TEST(TdoaResiduals, PositionOnlyTrackAddsTheLeverArmInTheWorldFrame) {
 }
 
 TEST(TdoaResiduals, MeasurementsWithoutTruthOrAnchorAreCountedNotDropped) {
-  const AnchorSurvey survey = cornerSurvey();
+  const AnchorSurvey survey = test::cornerSurvey();
   Flight f;
-  f.pose = circle(200.0, 1.0);
+  f.pose = test::circle(200.0, 1.0);
   f.pose_has_orientation = true;
   f.tdoa = {{-0.5, 0, 1, 0.0}, {0.5, 0, 1, 0.0}, {0.6, 0, 9, 0.0}, {2.0, 1, 2, 0.0}};
   TdoaResidualReport report;

@@ -33,9 +33,6 @@ using ::testing::ContainsRegex;
 
 /// A 30 s simulated circle, its survey and its events in the line protocol, shared by the tests of this file.
 class StreamFaults : public test::SimulatedCircleSuite<StreamFaults> {
- public:
-  static constexpr const char* kTag = "stream_faults";
-
  protected:
   static void SetUpTestSuite() {
     SimulatedCircleSuite::SetUpTestSuite();
