@@ -205,7 +205,9 @@ TEST_P(UtilCsvMalformedText, IsAnInputErrorNamingTheFileAndThePlace) {
 }
 
 INSTANTIATE_TEST_SUITE_P(UtilCsvMalformed, UtilCsvMalformedText, ::testing::ValuesIn(kMalformedCases),
-                         [](const ::testing::TestParamInfo<MalformedCase>& info) { return info.param.name; });
+                         [](const ::testing::TestParamInfo<MalformedCase>& tested) {
+                           return std::string(tested.param.name);
+                         });
 
 TEST(UtilCsvMalformed, AnchorIdWithoutSurveyEntry) {
   AnchorSurvey survey;
