@@ -51,7 +51,7 @@ double circleRmsFrom(const LocalizerResult& r, double t0_s) {
 
 /// TdoaLocalizer::run on `log` over the arena's anchors, an estimate every 0.1 s, with the bias model when given.
 LocalizerResult runInArena(const EkfParams& params, const SensorLog& log, const BiasPredictor& bias = {}) {
-  return runInArena(params, log, bias);
+  return TdoaLocalizer(params, arenaAnchors(), bias).run(log, 0.1);
 }
 
 /// The position RMSE against the circle from 20 s on (circleRmsFrom).
