@@ -78,7 +78,14 @@ std::vector<SignatureCell> signatureCells(bool transplant) {
     c.signature.floor_acc_vib_rms_mps2 = 0.05 * kG;
     cells.push_back(c);
   }
-  for (double hz : {100.0, 500.0}) {
+  for (double hand : {10.0, 30.0}) {
+    SignatureCell c;
+    c.name = "floor hand-held " + std::to_string(static_cast<int>(hand)) + "°/s";
+    c.signature.floor = sim::FloorImu::kHandHeld;
+    c.signature.floor_gyro_vib_rms_radps = hand * kDeg;
+    cells.push_back(c);
+  }
+  for (double hz : {100.0, 500.0, 1000.0}) {
     SignatureCell c;
     c.name = "IMU " + std::to_string(static_cast<int>(hz)) + " Hz";
     c.signature.rate_hz = hz;
@@ -105,6 +112,26 @@ std::vector<SignatureCell> signatureCells(bool transplant) {
     c.signature.floor = sim::FloorImu::kMotorsOff;
     cells.push_back(c);
   }
+  // combined cells: the worst of several rows at once
+  SignatureCell slow = cell("combined: floor off, gyro 40°/s, acc 0.3 g, 100 Hz, biases, lag 30 ms", 40.0, 0.3, true);
+  slow.signature.floor = sim::FloorImu::kMotorsOff;
+  slow.signature.rate_hz = 100.0;
+  slow.signature.gyro_bias_radps = gb.signature.gyro_bias_radps;
+  slow.signature.acc_bias_mps2 = ab.signature.acc_bias_mps2;
+  slow.signature.lag_s = 0.03;
+  cells.push_back(slow);
+  SignatureCell idle = cell("combined: floor idle 40°/s, gyro 20°/s, 1000 Hz, lag 10 ms", 20.0, acc, transplant);
+  idle.signature.floor = sim::FloorImu::kIdle;
+  idle.signature.floor_gyro_vib_rms_radps = 40.0 * kDeg;
+  idle.signature.floor_acc_vib_rms_mps2 = 0.05 * kG;
+  idle.signature.rate_hz = 1000.0;
+  idle.signature.lag_s = 0.01;
+  cells.push_back(idle);
+  SignatureCell held = cell("combined: hand-held 30°/s, gyro 20°/s, gyro bias 3°/s", 20.0, acc, transplant);
+  held.signature.floor = sim::FloorImu::kHandHeld;
+  held.signature.floor_gyro_vib_rms_radps = 30.0 * kDeg;
+  held.signature.gyro_bias_radps = gb.signature.gyro_bias_radps;
+  cells.push_back(held);
   return cells;
 }
 

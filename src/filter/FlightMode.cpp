@@ -172,7 +172,11 @@ bool FlightModeSupervisor::decide(double t_s) {
   } else if ((imu_log_odds_ > 0.0) == airborne_now) {
     overruled_ = false;
   }
-  if (!airborne_now && tdoa_log_odds_ > params_.tdoa_max_floor_log_odds) {
+  // (F29d) doubt is counted only while TDoA keep coming: a window that none has refreshed for a fifth of its
+  // forgetting time (a landing's re-acquisition batch, a dropout) still weighs in the mode, but it is not the TDoA
+  // disagreeing now
+  const bool fresh = t_s - t_tdoa_ <= 0.2 * params_.tdoa_window_s;
+  if (!airborne_now && fresh && tdoa_log_odds_ > params_.tdoa_max_floor_log_odds) {
     doubted_floor_s_ += dt;
     doubted_floor_max_height_m_ = std::max(doubted_floor_max_height_m_, tdoa_height_m_);
   }

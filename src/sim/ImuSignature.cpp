@@ -3,12 +3,14 @@
  */
 #include "uwb/sim/ImuSignature.h"
 
+#include "uwb/core/Smoothstep.h"
 #include "uwb/io/PoseTrack.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <limits>
 #include <optional>
 #include <random>
@@ -29,6 +31,10 @@ constexpr double kMotorsOffGyro_radps = 0.004;
 constexpr double kToneMin_hz = 150.0, kToneMax_hz = 240.0;
 constexpr int kTonesPerAxis = 3;
 constexpr double kBroadbandFraction = 0.25;
+/// A hand's wobble (docs/math/simulation.md S24b): per axis two sway tones and one tremor tone in these bands [Hz],
+/// faded in and out over kHandFade_s at a floor phase's ends, so that the attitude is continuous at take-off [s].
+constexpr double kSwayMin_hz = 0.3, kSwayMax_hz = 1.5, kTremorMin_hz = 6.0, kTremorMax_hz = 12.0;
+constexpr double kHandFade_s = 0.5;
 
 /// The floor level: the 2nd percentile of the pose heights.
 double floorLevel(const std::vector<PoseSample>& pose) {
@@ -95,8 +101,53 @@ struct Vibration {
   }
 };
 
+/// The times at which the truth crosses between floor and air (pose sorted by time).
+std::vector<double> phaseEdges(const std::vector<PoseSample>& pose, double floor_z, double air_height_m) {
+  std::vector<double> edges;
+  for (std::size_t i = 1; i < pose.size(); ++i)
+    if ((pose[i].w_p_b.z() > floor_z + air_height_m) != (pose[i - 1].w_p_b.z() > floor_z + air_height_m))
+      edges.push_back(pose[i].t_s);
+  return edges;
+}
+
+/// A hand's wobble of the body about its origin (S24b): small angles θ(t) per axis, faded to zero within kHandFade_s of
+/// a floor phase's ends. The gyro reads θ̇, the accelerometer f − θ × f (the body turned by θ under a still origin).
+struct HandWobble {
+  std::array<double, 9> f_hz{}, phase{}, amp{};  ///< per axis: two sway tones and one tremor tone
+  std::vector<double> edges;                     ///< floor/air crossings of the truth [s]
+  HandWobble(double rms_radps, std::vector<double> phase_edges, std::mt19937_64& rng) : edges(std::move(phase_edges)) {
+    std::uniform_real_distribution<double> sway(kSwayMin_hz, kSwayMax_hz), tremor(kTremorMin_hz, kTremorMax_hz),
+        ph(0.0, 2.0 * kPi);
+    // each tone carries a third of the per-axis rate variance (rms²/3): rate amplitude b = (rms/√3)·√(2/3), θ = b/(2πf)
+    const double rate_amp = rms_radps / std::sqrt(3.0) * std::sqrt(2.0 / 3.0);
+    for (int k = 0; k < 9; ++k) {
+      f_hz[k] = k % 3 == 2 ? tremor(rng) : sway(rng);
+      phase[k] = ph(rng);
+      amp[k] = rate_amp / (2.0 * kPi * f_hz[k]);
+    }
+  }
+  /// Fade weight: 0 at a floor/air crossing, 1 from kHandFade_s away (the cubic smoothstep, core/Smoothstep.h).
+  double weight(double t) const {
+    double d = std::numeric_limits<double>::infinity();
+    const auto it = std::lower_bound(edges.begin(), edges.end(), t);
+    if (it != edges.end()) d = std::min(d, *it - t);
+    if (it != edges.begin()) d = std::min(d, t - *std::prev(it));
+    return smoothstep3(d / kHandFade_s);
+  }
+  Vec3 angle(double t) const {
+    Vec3 th = Vec3::Zero();
+    for (int k = 0; k < 9; ++k) th[k / 3] += amp[k] * std::sin(2.0 * kPi * f_hz[k] * t + phase[k]);
+    return weight(t) * th;
+  }
+  /// θ̇ by a central difference of the faded angle (the fade's own rate included).
+  Vec3 rate(double t) const {
+    constexpr double h = 1e-4;
+    return (angle(t + h) - angle(t - h)) / (2.0 * h);
+  }
+};
+
 void applyToStream(std::vector<ImuSample>& s, const ImuSignature& sig, bool gyro, const std::vector<PoseSample>& pose,
-                   double floor_z, std::mt19937_64& rng) {
+                   double floor_z, const HandWobble* hand, std::mt19937_64& rng) {
   if (s.size() < 2) return;
   const double flight_rms = gyro ? sig.flight_gyro_vib_rms_radps : sig.flight_acc_vib_rms_mps2;
   const double idle_rms = gyro ? sig.floor_gyro_vib_rms_radps : sig.floor_acc_vib_rms_mps2;
@@ -118,6 +169,9 @@ void applyToStream(std::vector<ImuSample>& s, const ImuSignature& sig, bool gyro
         s[i].b_value = low[i] + (quiet / std::sqrt(3.0)) * Vec3(unit(rng), unit(rng), unit(rng));
       } else if (sig.floor == FloorImu::kIdle) {
         s[i].b_value = low[i] + idle_vib.at(t, rng);
+      } else if (sig.floor == FloorImu::kHandHeld && hand != nullptr) {
+        const Vec3 turn = gyro ? hand->rate(t) : Vec3(-hand->angle(t).cross(low[i]));
+        s[i].b_value = low[i] + turn + (quiet / std::sqrt(3.0)) * Vec3(unit(rng), unit(rng), unit(rng));
       }
     }
   }
@@ -138,6 +192,27 @@ void decimate(std::vector<ImuSample>& s, std::size_t factor) {
   s = std::move(out);
 }
 
+/// Linear interpolation onto a uniform grid at rate_hz from the first stamp to the last (an IMU faster than the log).
+void interpolate(std::vector<ImuSample>& s, double rate_hz) {
+  std::vector<ImuSample> out;
+  const double t0 = s.front().t_s, dt = 1.0 / rate_hz;
+  out.reserve(static_cast<std::size_t>((s.back().t_s - t0) * rate_hz) + 2);
+  std::size_t j = 0;
+  for (std::size_t k = 0;; ++k) {
+    const double t = t0 + static_cast<double>(k) * dt;
+    if (t > s.back().t_s) break;
+    while (j + 2 < s.size() && s[j + 1].t_s <= t) ++j;
+    const double span = s[j + 1].t_s - s[j].t_s;
+    const double w = span > 0.0 ? std::clamp((t - s[j].t_s) / span, 0.0, 1.0) : 0.0;
+    out.push_back({t, (1.0 - w) * s[j].b_value + w * s[j + 1].b_value});
+  }
+  s = std::move(out);
+}
+
+double meanPeriod(const std::vector<ImuSample>& s) {
+  return (s.back().t_s - s.front().t_s) / static_cast<double>(s.size() - 1);
+}
+
 }  // namespace
 
 std::string toString(FloorImu floor) {
@@ -145,6 +220,7 @@ std::string toString(FloorImu floor) {
     case FloorImu::kUnchanged: return "as logged";
     case FloorImu::kMotorsOff: return "motors off";
     case FloorImu::kIdle: return "idle";
+    case FloorImu::kHandHeld: return "hand-held";
   }
   return "unknown";
 }
@@ -171,7 +247,7 @@ std::string ImuSignature::label() const {
   std::snprintf(buf, sizeof buf, "gyro %.0f°/s, acc %.3g g, floor %s", flight_gyro_vib_rms_radps * kDegPerRad,
                 flight_acc_vib_rms_mps2 / kG, toString(floor).c_str());
   std::string s = buf;
-  if (floor == FloorImu::kIdle) {
+  if (floor == FloorImu::kIdle || floor == FloorImu::kHandHeld) {
     std::snprintf(buf, sizeof buf, " %.0f°/s", floor_gyro_vib_rms_radps * kDegPerRad);
     s += buf;
   }
@@ -199,12 +275,23 @@ void applyImuSignature(Flight& flight, const ImuSignature& sig, std::uint64_t se
   if (flight.pose.size() < 2) throw std::invalid_argument("applyImuSignature: the flight has no ground-truth pose");
   if (flight.acc.size() < 2 || flight.gyro.size() < 2) throw std::invalid_argument("applyImuSignature: no IMU");
   const double floor_z = floorLevel(flight.pose);
+  // a faster IMU than the log: interpolated first, so that the vibration is drawn at the new rate (S24)
+  const bool faster = sig.rate_hz > 0.0 && sig.rate_hz * meanPeriod(flight.gyro) > 1.05;
+  if (faster) {
+    interpolate(flight.gyro, sig.rate_hz);
+    interpolate(flight.acc, sig.rate_hz);
+  }
   std::mt19937_64 rng(seed);
-  applyToStream(flight.gyro, sig, true, flight.pose, floor_z, rng);
-  applyToStream(flight.acc, sig, false, flight.pose, floor_z, rng);
-  if (sig.rate_hz > 0.0) {
-    const double dt = (flight.gyro.back().t_s - flight.gyro.front().t_s) / static_cast<double>(flight.gyro.size() - 1);
-    const auto factor = static_cast<std::size_t>(std::max(1.0, std::round(1.0 / (sig.rate_hz * dt))));
+  // the hand's draws come from a stream of their own: the other signatures' draws stay as they were
+  std::optional<HandWobble> hand;
+  if (sig.floor == FloorImu::kHandHeld) {
+    std::mt19937_64 hand_rng(seed ^ 0x68616e64ULL);
+    hand.emplace(sig.floor_gyro_vib_rms_radps, phaseEdges(flight.pose, floor_z, sig.air_height_m), hand_rng);
+  }
+  applyToStream(flight.gyro, sig, true, flight.pose, floor_z, hand ? &*hand : nullptr, rng);
+  applyToStream(flight.acc, sig, false, flight.pose, floor_z, hand ? &*hand : nullptr, rng);
+  if (sig.rate_hz > 0.0 && !faster) {
+    const auto factor = static_cast<std::size_t>(std::max(1.0, std::round(1.0 / (sig.rate_hz * meanPeriod(flight.gyro)))));
     decimate(flight.gyro, factor);
     decimate(flight.acc, factor);
   }

@@ -3,6 +3,7 @@
  */
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "uwb/sim/FlightSimulator.h"
@@ -74,6 +75,68 @@ TEST(ImuSignature, RateBiasAndLag) {
   Vec3 acc_block = Vec3::Zero();
   for (int k = 0; k < 10; ++k) acc_block += before.acc[k].b_value;
   EXPECT_NEAR(sim.flight.acc[0].b_value.z(), acc_block.z() / 10.0 + 0.980665, 1e-12);
+}
+
+TEST(ImuSignature, AHandHeldFloorTurnsTheBodyAndGravityWithIt) {
+  // GIVEN a simulated flight from the floor without IMU noise, and a hand that wobbles the drone at 20°/s RMS while it
+  // is on the floor
+  SimResult sim = simulateFlight(makeScenario(paperAnchors(), TrajectoryShape::kCircle, 30.0), SimParams::noiseFree(), 7);
+  const Flight before = sim.flight;
+  ImuSignature sig;
+  sig.floor = FloorImu::kHandHeld;
+  sig.floor_gyro_vib_rms_radps = 20.0 * kDeg;
+  applyImuSignature(sim.flight, sig, 5);
+  ASSERT_EQ(sim.flight.gyro.size(), before.gyro.size());
+  // THEN, away from the take-off, the gyro's deviation from the plain flight has about the asked RMS
+  const double t0 = sim.flight.gyro.front().t_s;
+  double sq = 0.0;
+  int n = 0;
+  for (std::size_t i = 0; i < before.gyro.size(); ++i) {
+    const double t = before.gyro[i].t_s;
+    if (t < t0 + 0.6 || t > t0 + 3.0) continue;
+    sq += (sim.flight.gyro[i].b_value - before.gyro[i].b_value).squaredNorm();
+    ++n;
+  }
+  EXPECT_NEAR(std::sqrt(sq / n), 20.0 * kDeg, 0.3 * 20.0 * kDeg);
+  // AND the accelerometer sees gravity turn by the angle the gyro integrates, f' ≈ f − θ × f (S24b), with θ = 0 where
+  // the wobble has faded out at the take-off
+  const double floor_z = truthFloorLevel(before.pose);
+  std::size_t edge = 0;
+  while (edge + 1 < before.gyro.size() && truthHeightAt(before.pose, before.gyro[edge].t_s) <= floor_z + sig.air_height_m)
+    ++edge;
+  ASSERT_GT(before.gyro[edge].t_s, t0 + 3.0);
+  Vec3 theta = Vec3::Zero();
+  double sq_residual = 0.0, sq_predicted = 0.0;
+  for (std::size_t i = edge; i > 0 && before.gyro[i].t_s > before.gyro[edge].t_s - 3.0; --i) {
+    const double dt = before.gyro[i].t_s - before.gyro[i - 1].t_s;
+    theta -= 0.5 * dt * ((sim.flight.gyro[i].b_value - before.gyro[i].b_value) +
+                         (sim.flight.gyro[i - 1].b_value - before.gyro[i - 1].b_value));
+    const Vec3 predicted = -theta.cross(before.acc[i - 1].b_value);
+    sq_residual += (sim.flight.acc[i - 1].b_value - before.acc[i - 1].b_value - predicted).squaredNorm();
+    sq_predicted += predicted.squaredNorm();
+  }
+  EXPECT_GT(std::sqrt(sq_predicted / 3000.0), 0.05);  // gravity swings by more than 0.05 m/s² RMS (3 s at 1 kHz)
+  EXPECT_LT(std::sqrt(sq_residual / sq_predicted), 0.15);  // the still IMU's own noise: ≈ 0.09
+  // AND the flight itself is untouched
+  const std::size_t mid = before.gyro.size() / 2;
+  EXPECT_EQ(sim.flight.gyro[mid].b_value, before.gyro[mid].b_value);
+  EXPECT_EQ(sig.label(), "gyro 0°/s, acc 0 g, floor hand-held 20°/s");
+}
+
+TEST(ImuSignature, AFasterImuIsInterpolatedBeforeItShakes) {
+  // GIVEN a 1 kHz flight and a 2 kHz IMU without vibration
+  SimResult sim = flight();
+  const Flight before = sim.flight;
+  ImuSignature sig;
+  sig.rate_hz = 2000.0;
+  applyImuSignature(sim.flight, sig, 3);
+  // THEN twice the samples, evenly stamped from the first, each between its two neighbours of the log
+  ASSERT_NEAR(static_cast<double>(sim.flight.gyro.size()), 2.0 * static_cast<double>(before.gyro.size()), 2.0);
+  EXPECT_EQ(sim.flight.gyro.front().t_s, before.gyro.front().t_s);
+  EXPECT_NEAR(sim.flight.gyro[1001].t_s - sim.flight.gyro[1000].t_s, 0.0005, 1e-9);
+  const Vec3 mid = 0.5 * (before.gyro[500].b_value + before.gyro[501].b_value);
+  EXPECT_NEAR((sim.flight.gyro[1001].b_value - mid).norm(), 0.0, 1e-9);
+  EXPECT_NEAR((sim.flight.acc[1000].b_value - before.acc[500].b_value).norm(), 0.0, 1e-9);
 }
 
 TEST(ImuSignature, TheSameSeedGivesTheSameFlight) {

@@ -4,9 +4,10 @@
  *
  *  Flights: simulated flights from the floor (the simulator's plain IMU) and transplants of real development flights
  *  (their own IMU low-passed, then the signature added by phase). Cells: in-flight gyro vibration 0–40 °/s, in-flight
- *  accelerometer vibration 0.005–0.3 g, the floor with the motors off or idling at 10–40 °/s, the IMU at 100 and
- *  500 Hz, a gyro bias of 3 °/s, an accelerometer bias of 0.1 g, IMU stamps 10 and 30 ms behind the TDoA, and the
- *  signature of a drone whose floor is quiet and whose gyro shakes in flight.
+ *  accelerometer vibration 0.005–0.3 g, the floor with the motors off, idling at 10–40 °/s or hand-held (a wobble of
+ *  10–30 °/s), the IMU at 100, 500 and 1000 Hz, a gyro bias of 3 °/s, an accelerometer bias of 0.1 g, IMU stamps 10
+ *  and 30 ms behind the TDoA, the signature of a drone whose floor is quiet and whose gyro shakes in flight, and three
+ *  cells that combine several of these.
  */
 #pragma once
 

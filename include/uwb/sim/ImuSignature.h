@@ -5,7 +5,9 @@
  *  Applied to a simulated flight or to a real one (a transplant): the flight's own IMU is first low-passed (a centred
  *  moving mean over smooth_s, which keeps the manoeuvres and drops the rotor band), then vibration of the asked RMS is
  *  added by phase. Airborne and floor are read from the flight's ground-truth height against its floor level (the 2nd
- *  percentile of the pose heights). The TDoA, pose and other streams are left as they are.
+ *  percentile of the pose heights). The TDoA, pose and other streams are left as they are. A hand-held floor turns the
+ *  body about its origin (the pose keeps it still): the gyro sees the wobble's rate and the accelerometer the gravity
+ *  that swings with it, so that the two agree with a tag that stays put.
  */
 #pragma once
 
@@ -22,6 +24,7 @@ enum class FloorImu : unsigned char {
   kUnchanged,  ///< the flight's own floor phases, untouched
   kMotorsOff,  ///< quiet: white noise of a still MEMS IMU
   kIdle,       ///< motors idling on the floor: vibration of floor_gyro_vib_rms_radps / floor_acc_vib_rms_mps2
+  kHandHeld,   ///< motors off, held in a hand: an attitude wobble of floor_gyro_vib_rms_radps, gravity swinging with it
 };
 std::string toString(FloorImu floor);
 
@@ -30,9 +33,10 @@ struct ImuSignature {
   double flight_acc_vib_rms_mps2 = 0.0;    ///< … of the accelerometer [m/s²]
   bool replace_flight = false;             ///< low-pass the flight phases before adding (a transplant)
   FloorImu floor = FloorImu::kUnchanged;
-  double floor_gyro_vib_rms_radps = 0.0;   ///< idle vibration on the floor (kIdle) [rad/s]
-  double floor_acc_vib_rms_mps2 = 0.0;     ///< [m/s²]
-  double rate_hz = 0.0;                    ///< the IMU decimated to this rate; 0 = as logged
+  double floor_gyro_vib_rms_radps = 0.0;   ///< idle vibration (kIdle) or the hand's wobble (kHandHeld) [rad/s]
+  double floor_acc_vib_rms_mps2 = 0.0;     ///< idle vibration of the accelerometer (kIdle) [m/s²]
+  double rate_hz = 0.0;                    ///< the IMU resampled to this rate (S24): block means below the logged
+                                           ///< rate, linear interpolation above it; 0 = as logged
   Vec3 gyro_bias_radps = Vec3::Zero();     ///< added turn-on bias [rad/s]
   Vec3 acc_bias_mps2 = Vec3::Zero();       ///< [m/s²]
   double lag_s = 0.0;                      ///< the IMU's stamps lag the TDoA by this [s]
