@@ -157,25 +157,23 @@ TEST(FlightMode, ABadWindowSaysNothing) {
 
 TEST(FlightMode, DoubtIsCountedOnlyWhileTdoaKeepComing) {
   // GIVEN floor contact by the IMU while TDoA with scattered heights put the tag above the floor: doubt is counted
-  FlightModeSupervisor s;
-  s.reset(FlightMode::kContact);
-  std::mt19937 rng(5);
-  double t = 0.0;
+  SupervisorRun run(FlightMode::kContact, 5);
+  FlightModeSupervisor& s = run.s;
   const ImuModeEvidence contact{false, true, false, 0.5 * 0.5};
-  feed(s, &t, 1.0, contact, 1.4, 1.5, 0.0, rng);
+  run.feed(1.0, contact, 1.4, 1.5, 0.0);
   ASSERT_EQ(s.mode(), FlightMode::kContact);
   ASSERT_GT(s.tdoaLogOdds(), FlightModeParams{}.tdoa_max_floor_log_odds);
   const double doubted = s.doubtedFloorTime();
   ASSERT_GT(doubted, 0.5);
   // WHEN the TDoA pause for 3 s (a landing's re-acquisition batch) while the IMU still reads contact
-  feed(s, &t, 3.0, contact, kNoTdoa, 0.0, 0.0, rng);
+  run.feed(3.0, contact, kNoTdoa, 0.0, 0.0);
   // THEN the doubt stops growing within a fifth of the window's forgetting time (the window keeps its weight in the
   // mode: F29e's floor check is decided on it)
   EXPECT_LT(s.doubtedFloorTime() - doubted, 0.2 * FlightModeParams{}.tdoa_window_s + 0.01);
   EXPECT_GT(s.tdoaLogOdds(), FlightModeParams{}.tdoa_max_floor_log_odds);
   EXPECT_EQ(s.mode(), FlightMode::kContact);
   // WHEN they come again
-  feed(s, &t, 0.5, contact, 1.4, 1.5, 0.0, rng);
+  run.feed(0.5, contact, 1.4, 1.5, 0.0);
   // THEN the doubt grows again
   EXPECT_GT(s.doubtedFloorTime() - doubted, 0.3);
 }
