@@ -111,13 +111,13 @@ BiasFlightReport addFlightSamples(const Flight& flight, std::size_t fi, const st
   rp.airborne_min_z_m = params.min_z_m;
   TdoaResidualReport rr;
   const std::vector<TdoaResidual> residuals = tdoaResiduals(flight, survey, track, rp, &rr);
-  const FilterEstimate estimate = filterEstimate(flight, survey, params);
+  const auto [estimate, bias_level_m, sensor_range] = filterEstimate(flight, survey, params);
 
   BiasFlightReport rep;
   rep.source = name;
   rep.orientation_from_truth = flight.pose_has_orientation;
-  rep.bias_level_m = estimate.bias_level_m;
-  rep.sensor_range = estimate.sensor_range;
+  rep.bias_level_m = bias_level_m;
+  rep.sensor_range = sensor_range;
   rep.n_measurements = rr.n_measurements;
   rep.n_unknown_anchor = rr.n_unknown_anchor;
   rep.n_no_ground_truth = rr.n_no_ground_truth;
@@ -131,7 +131,7 @@ BiasFlightReport addFlightSamples(const Flight& flight, std::size_t fi, const st
     Vec3 w_p_b = r.w_p_b;
     Quat w_q_b = r.w_q_b;
     if (params.inputs == BiasInputSource::kFilterEstimate) {
-      const std::optional<PoseSample> pose = interpolatePose(estimate.trajectory, r.t_s, 0.1);  // io/PoseTrack.h
+      const std::optional<PoseSample> pose = interpolatePose(estimate, r.t_s, 0.1);  // io/PoseTrack.h
       if (!pose) {
         ++rep.n_no_estimate;
         continue;

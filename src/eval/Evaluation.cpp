@@ -440,18 +440,19 @@ nlohmann::json angleFigureJson(const BiasAngleFigure& fig) {
     }
     grid.push_back(row);
   }
-  return {{"kernel", fig.kernel},
-          {"inducing", fig.inducing},
-          {"id_a", fig.id_a},
-          {"id_b", fig.id_b},
-          {"alpha_i_rad", toVector(fig.alpha_a_rad)},
-          {"alpha_j_rad", toVector(fig.alpha_b_rad)},
-          {"error_m", toVector(fig.error_m)},
-          {"grid_alpha_i_rad", toVector(fig.grid_alpha_a_rad)},
-          {"grid_alpha_j_rad", toVector(fig.grid_alpha_b_rad)},
-          {"grid_mean_m", grid},
-          {"inducing_alpha_i_rad", toVector(fig.inducing_alpha_a_rad)},
-          {"inducing_alpha_j_rad", toVector(fig.inducing_alpha_b_rad)}};
+  const nlohmann::json j = {{"kernel", fig.kernel},
+                            {"inducing", fig.inducing},
+                            {"id_a", fig.id_a},
+                            {"id_b", fig.id_b},
+                            {"alpha_i_rad", toVector(fig.alpha_a_rad)},
+                            {"alpha_j_rad", toVector(fig.alpha_b_rad)},
+                            {"error_m", toVector(fig.error_m)},
+                            {"grid_alpha_i_rad", toVector(fig.grid_alpha_a_rad)},
+                            {"grid_alpha_j_rad", toVector(fig.grid_alpha_b_rad)},
+                            {"grid_mean_m", grid},
+                            {"inducing_alpha_i_rad", toVector(fig.inducing_alpha_a_rad)},
+                            {"inducing_alpha_j_rad", toVector(fig.inducing_alpha_b_rad)}};
+  return j;
 }
 
 /// REPORT.md up to its figures: how it was made, the table (Fig. 5), the uncorrected and per-flight results.

@@ -176,24 +176,27 @@ ElboForward latentMoments(ElboMode mode, const MatX& Lz, const MatX& Kzx, const 
   return f;
 }
 
-/// Reverse pass over the batch (P16–P17 inputs): A Aᵀ, A r and K̄zx = ∂ELBO/∂Kzx.
-struct BatchAdjoints {
+/// Reverse pass over the batch: A Aᵀ and A r (P16), K̄zx = ∂ELBO/∂Kzx, and K̄zz = ∂ELBO/∂Kzz through the Cholesky
+/// factor Lz (P17–P18).
+struct ElboAdjoints {
   MatX AAt;
   VecX Ar;
   MatX Kbar_zx;
+  MatX Kbar_zz;
 };
 
-BatchAdjoints batchAdjoints(ElboMode mode, const MatX& Lz, const MatX& Kzx, const ElboForward& f, const VecX& m,
-                            const VecX& r, double beta) {
+ElboAdjoints elboAdjoints(ElboMode mode, const MatX& Lz, const MatX& Kzx, const MatX& SmI, const ElboForward& f,
+                          const VecX& m, const VecX& r, double beta) {
   const auto LzT = Lz.triangularView<Eigen::Lower>();
   const Eigen::Index M = Lz.rows();
-  BatchAdjoints out;
+  ElboAdjoints out;
   MatX& AAt = out.AAt;
+  VecX& Ar = out.Ar;
   AAt = MatX::Zero(M, M);
   if (mode == ElboMode::kExact) {
     AAt.selfadjointView<Eigen::Lower>().rankUpdate(f.A);
     AAt = AAt.selfadjointView<Eigen::Lower>();
-    out.Ar.noalias() = f.A * r;
+    Ar.noalias() = f.A * r;
     // Ā = β (m rᵀ − (S − I) A);  K̄zx = Lz⁻ᵀ Ā
     MatX Abar = -beta * f.C;
     Abar.noalias() += (beta * m) * r.transpose();
@@ -204,38 +207,31 @@ BatchAdjoints batchAdjoints(ElboMode mode, const MatX& Lz, const MatX& Kzx, cons
     KKt = KKt.selfadjointView<Eigen::Lower>();
     AAt = LzT.solve(LzT.solve(KKt).transpose());  // Lz⁻¹ Kzx Kxz Lz⁻ᵀ
     AAt = 0.5 * (AAt + AAt.transpose()).eval();
-    out.Ar = LzT.solve(Kzx * r);
+    Ar = LzT.solve(Kzx * r);
     // K̄zx = β (α rᵀ − W Kzx)
     out.Kbar_zx = -beta * f.WK;
     out.Kbar_zx.noalias() += (beta * f.alpha) * r.transpose();
   }
-  return out;
-}
 
-/// K̄zz = ∂ELBO/∂Kzz through the Cholesky factor Lz (P17–P18).
-MatX kzzAdjoint(ElboMode mode, const MatX& Lz, const MatX& SmI, const ElboForward& f, const VecX& m,
-                const BatchAdjoints& adj, double beta) {
-  const auto LzT = Lz.triangularView<Eigen::Lower>();
-  const Eigen::Index M = Lz.rows();
   // P17: ∂/∂Lz = tril(−K̄zx Aᵀ) = tril(−Lz⁻ᵀ Ā Aᵀ),  Ā Aᵀ = β (m (Ar)ᵀ − (S − I) A Aᵀ)
   MatX Lzbar;
   if (mode == ElboMode::kExact) {
-    MatX AbarAt = -beta * (SmI * adj.AAt);
-    AbarAt.noalias() += (beta * m) * adj.Ar.transpose();
+    MatX AbarAt = -beta * (SmI * AAt);
+    AbarAt.noalias() += (beta * m) * Ar.transpose();
     Lzbar = (-LzT.transpose().solve(AbarAt)).triangularView<Eigen::Lower>();
   } else {
     // Lz⁻ᵀ Ā Aᵀ = β (α (Ar)ᵀ − T1 A Aᵀ): one GEMM with the cached T1 instead of a GEMM and a triangular solve
     MatX LzAbarAt(M, M);
-    LzAbarAt.noalias() = (-beta) * f.T1 * adj.AAt;
-    LzAbarAt.noalias() += (beta * f.alpha) * adj.Ar.transpose();
+    LzAbarAt.noalias() = (-beta) * f.T1 * AAt;
+    LzAbarAt.noalias() += (beta * f.alpha) * Ar.transpose();
     Lzbar = (-LzAbarAt).triangularView<Eigen::Lower>();
   }
   // P18: Cholesky backward: K̄zz = ½ Lz⁻ᵀ (P + Pᵀ) Lz⁻¹, P = Φ(Lzᵀ L̄z)
   const MatX P = phi(Lz.transpose().triangularView<Eigen::Upper>() * Lzbar);
   const MatX Ps = P + P.transpose();
-  MatX Kbar_zz = 0.5 * LzT.transpose().solve(LzT.transpose().solve(Ps).transpose());
-  Kbar_zz = 0.5 * (Kbar_zz + Kbar_zz.transpose()).eval();
-  return Kbar_zz;
+  out.Kbar_zz = 0.5 * LzT.transpose().solve(LzT.transpose().solve(Ps).transpose());
+  out.Kbar_zz = 0.5 * (out.Kbar_zz + out.Kbar_zz.transpose()).eval();
+  return out;
 }
 
 }  // namespace
@@ -283,7 +279,7 @@ ElboTerms Svgp::elbo(const MatX& X_raw, const VecX& y, double num_data, SvgpGrad
   SvgpGradient& g = *grad;
   g.mean = beta * r.sum();
   g.noise = (-0.5 * Bd / s + 0.5 * sum_sq / (s * s)) / Bd;
-  BatchAdjoints adj = batchAdjoints(mode, Lz, Kzx, fwd, m_, r, beta);
+  ElboAdjoints adj = elboAdjoints(mode, Lz, Kzx, SmI, fwd, m_, r, beta);  // P16–P18
 
   // P16: variational parameters
   g.m = beta * adj.Ar - m_ / num_data;
@@ -292,14 +288,11 @@ ElboTerms Svgp::elbo(const MatX& X_raw, const VecX& y, double num_data, SvgpGrad
   const MatX AAtL = adj.AAt * L_.triangularView<Eigen::Lower>();
   g.L = (-beta * AAtL - (L_ - Linv_diag) / num_data).triangularView<Eigen::Lower>();
 
-  // P17–P18: through the Cholesky factor of Kzz
-  const MatX Kbar_zz = kzzAdjoint(mode, Lz, SmI, fwd, m_, adj, beta);
-
   // P19: kernel hyperparameters and inducing points
   g.kernel = VecX::Zero(kernel_.numParams());
   MatX gZ_zz = MatX::Zero(M, Z_.cols());
   g.Z = MatX::Zero(M, Z_.cols());
-  kernel_.accumulateCrossGradient(Z_, Z_, Kbar_zz, zz_blocks, g.kernel, &gZ_zz);
+  kernel_.accumulateCrossGradient(Z_, Z_, adj.Kbar_zz, zz_blocks, g.kernel, &gZ_zz);
   kernel_.accumulateCrossGradient(Z_, X, adj.Kbar_zx, zx_blocks, g.kernel, &g.Z);
   g.Z += 2.0 * gZ_zz;
   kernel_.accumulateDiagGradient(-0.5 * beta * Bd, g.kernel);  // k̄_n = −β/2 for every n
