@@ -524,82 +524,76 @@ std::vector<BiasModel::PairMean> pairMeans(const std::vector<BiasSample>& sample
   return out;
 }
 
-BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params, BiasTrainReport* report,
-                         const BiasTrainProgress& progress) {
-  params.validate();
-  const BiasPreset preset = BiasPreset::byName(params.preset);
-  const auto t_start = std::chrono::steady_clock::now();
-  const std::vector<bool> hold = holdoutMask(data.samples, params.holdout_fraction, params.holdout_block_s);
+namespace {
 
-  // groups: one per pair (per-pair presets) or one global
-  std::map<std::pair<int, int>, std::vector<std::size_t>> groups;
+using SampleGroups = std::map<std::pair<int, int>, std::vector<std::size_t>>;
+
+/// Sample indices per model: one group per pair (per-pair presets) or one global group.
+SampleGroups groupSamples(const BiasDataset& data, const BiasPreset& preset) {
+  SampleGroups groups;
   for (std::size_t i = 0; i < data.samples.size(); ++i) {
     const auto& f = data.samples[i].feature;
     groups[preset.per_pair ? std::make_pair(f.id_a, f.id_b) : std::make_pair(-1, -1)].push_back(i);
   }
-  const std::size_t need = static_cast<std::size_t>(params.min_samples_per_inducing) * params.num_inducing;
+  return groups;
+}
+
+std::size_t countTraining(const std::vector<std::size_t>& idx, const std::vector<bool>& hold) {
+  std::size_t n = 0;
+  for (std::size_t i : idx) n += hold[i] ? 0 : 1;
+  return n;
+}
+
+/// Throws unless the groups hold at least `need` training samples together.
+void requireTrainingSamples(const SampleGroups& groups, const std::vector<bool>& hold, std::size_t need,
+                            const BiasTrainParams& params) {
   std::size_t n_train_total = 0;
-  for (const auto& [key, idx] : groups)
-    for (std::size_t i : idx) n_train_total += hold[i] ? 0 : 1;
+  for (const auto& [key, idx] : groups) n_train_total += countTraining(idx, hold);
   if (n_train_total < need)
     throw std::invalid_argument("too few usable training samples: " + std::to_string(n_train_total) + " after exclusions and hold-out, need ≥ " +
                                 std::to_string(need) + " for " + std::to_string(params.num_inducing) +
                                 " inducing points (reduce --inducing or add flights)");
+}
 
-  // docs/math/gp.md (P28): per-pair constant means from the training part; the GP learns what remains.
-  std::vector<BiasModel::PairMean> means;
-  if (preset.pair_mean) {
-    std::vector<bool> use(hold.size());
-    for (std::size_t i = 0; i < hold.size(); ++i) use[i] = !hold[i];
-    means = pairMeans(data.samples, use);
+double pairMeanOf(const std::vector<BiasModel::PairMean>& means, const TdoaFeature& f) {
+  for (const auto& m : means) {
+    if (m.id_a == f.id_a && m.id_b == f.id_b) return m.mean_m;
   }
-  const auto meanOf = [&](const TdoaFeature& f) {
-    for (const auto& m : means) {
-      if (m.id_a == f.id_a && m.id_b == f.id_b) return m.mean_m;
-    }
-    return 0.0;
-  };
+  return 0.0;
+}
 
-  std::vector<BiasModel::Entry> entries;
-  double elbo_weighted = 0.0, elbo_samples = 0.0;
-  int model_index = 0;
-  const int num_models = static_cast<int>(groups.size());
-  for (const auto& [key, idx] : groups) {
-    ++model_index;
-    std::size_t n_tr = 0;
-    for (std::size_t i : idx) n_tr += hold[i] ? 0 : 1;
-    if (n_tr < need) continue;  // per-pair: too few for this pair → no model (predicts 0)
-    // The GP inputs are written straight into the matrices the trainer reads (no intermediate feature copies).
-    const int D = featureDim(preset.features);
-    MatX X(static_cast<Eigen::Index>(n_tr), D), Xh(static_cast<Eigen::Index>(idx.size() - n_tr), D);
-    VecX y(X.rows()), yh(Xh.rows());
-    Eigen::Index itr = 0, iho = 0;
-    double row[kMaxFeatureDim];
-    for (std::size_t i : idx) {
-      const TdoaFeature& f = data.samples[i].feature;
-      featureRow(preset.features, f, row);
-      MatX& dst = hold[i] ? Xh : X;
-      Eigen::Index& k = hold[i] ? iho : itr;
-      for (int d = 0; d < D; ++d) dst(k, d) = row[d];
-      (hold[i] ? yh : y)[k] = data.samples[i].error_m - meanOf(f);
-      ++k;
-    }
-    gp::Svgp svgp = gp::initSvgp(preset.kernel(), X, y, params.num_inducing, params.svgp.seed, preset.normalization);
-    const int mi = model_index;
-    const gp::SvgpTrainSummary ts =
-        gp::trainSvgp(svgp, X, y, params.svgp, yh.size() > 0 ? &Xh : nullptr, yh.size() > 0 ? &yh : nullptr,
-                      [&](const gp::EpochReport& r) {
-                        if (progress) progress(mi, num_models, r);
-                      });
-    elbo_weighted += ts.final_elbo * static_cast<double>(X.rows());
-    elbo_samples += static_cast<double>(X.rows());
-    entries.push_back({key.first, key.second, std::move(svgp)});
+/// One group's GP inputs and targets (ε minus its pair mean), training and held-out rows apart.
+struct GroupData {
+  MatX X, Xh;
+  VecX y, yh;
+};
+
+GroupData groupData(const BiasDataset& data, const std::vector<std::size_t>& idx, const std::vector<bool>& hold,
+                    std::size_t n_tr, FeatureMap features, const std::vector<BiasModel::PairMean>& means) {
+  // The GP inputs are written straight into the matrices the trainer reads (no intermediate feature copies).
+  const int D = featureDim(features);
+  GroupData g;
+  g.X.resize(static_cast<Eigen::Index>(n_tr), D);
+  g.Xh.resize(static_cast<Eigen::Index>(idx.size() - n_tr), D);
+  g.y.resize(g.X.rows());
+  g.yh.resize(g.Xh.rows());
+  Eigen::Index itr = 0, iho = 0;
+  double row[kMaxFeatureDim];
+  for (std::size_t i : idx) {
+    const TdoaFeature& f = data.samples[i].feature;
+    featureRow(features, f, row);
+    MatX& dst = hold[i] ? g.Xh : g.X;
+    Eigen::Index& k = hold[i] ? iho : itr;
+    for (int d = 0; d < D; ++d) dst(k, d) = row[d];
+    (hold[i] ? g.yh : g.y)[k] = data.samples[i].error_m - pairMeanOf(means, f);
+    ++k;
   }
-  if (entries.empty()) throw std::invalid_argument("no anchor pair has enough training samples for the requested inducing points");
-  BiasModel model(preset.name, preset.features, std::move(entries), std::move(means));
-  model.setExtraVariance(params.extra_sigma_m * params.extra_sigma_m);  // (P31)
-  model.setMeanScale(params.mean_scale);                                 // (P44)
-  model.setPredictiveShape(params.predictive_shape);                     // (P43b)
+  return g;
+}
+
+/// The levels and variance the model carries from its training data: (F24b), (F24c), (P45).
+void setTrainingLevels(BiasModel& model, const BiasDataset& data, const std::vector<bool>& hold,
+                       const BiasTrainParams& params) {
   {  // (F24b) the training flights' bias level, as the filter measured it on them
     double sum = 0.0;
     int n = 0;
@@ -623,40 +617,92 @@ BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params,
     }
     model.setFullVariance(true, sum_sq / n);
   }
+}
+
+/// The report's hold-out part: sample counts, bias RMSE before and after, predicted spread and calibration (P43).
+void scoreHoldout(const BiasModel& model, const BiasDataset& data, const std::vector<bool>& hold, BiasTrainReport& r) {
+  double se_before = 0, se_after = 0, sum_std = 0;
+  std::vector<double> residual_m, variance_m2;  // (P43) of the held-out samples with a covering GP
+  for (std::size_t i = 0; i < data.samples.size(); ++i) {
+    if (!hold[i]) {
+      ++r.n_train;
+      continue;
+    }
+    ++r.n_holdout;
+    const double eps = data.samples[i].error_m;
+    const BiasPrediction p = model.predict(data.samples[i].feature);
+    se_before += eps * eps;
+    se_after += (eps - p.mean_m) * (eps - p.mean_m);
+    sum_std += std::sqrt(p.variance_m2);
+    const BiasPredictive q = model.predictive(data.samples[i].feature);
+    if (q.covered && q.varianceM2() > 0.0) {
+      residual_m.push_back(eps - q.mean_m);
+      variance_m2.push_back(q.varianceM2());
+    }
+  }
+  const double n = static_cast<double>(r.n_holdout);
+  r.bias_rmse_before_m = n > 0 ? std::sqrt(se_before / n) : std::nan("");
+  r.bias_rmse_after_m = n > 0 ? std::sqrt(se_after / n) : std::nan("");
+  r.mean_predicted_std_m = n > 0 ? sum_std / n : std::nan("");
+  const BiasCalibration cal = biasCalibration(residual_m, variance_m2, model.predictiveShape());  // NaN when empty
+  r.mean_predictive_std_m = cal.mean_std_m;
+  r.holdout_coverage_1sigma = cal.coverage_1sigma;
+  r.holdout_coverage_2sigma = cal.coverage_2sigma;
+  r.holdout_nlpd = cal.nlpd;
+}
+
+}  // namespace
+
+BiasModel trainBiasModel(const BiasDataset& data, const BiasTrainParams& params, BiasTrainReport* report,
+                         const BiasTrainProgress& progress) {
+  params.validate();
+  const BiasPreset preset = BiasPreset::byName(params.preset);
+  const auto t_start = std::chrono::steady_clock::now();
+  const std::vector<bool> hold = holdoutMask(data.samples, params.holdout_fraction, params.holdout_block_s);
+  const SampleGroups groups = groupSamples(data, preset);
+  const std::size_t need = static_cast<std::size_t>(params.min_samples_per_inducing) * params.num_inducing;
+  requireTrainingSamples(groups, hold, need, params);
+
+  // docs/math/gp.md (P28): per-pair constant means from the training part; the GP learns what remains.
+  std::vector<BiasModel::PairMean> means;
+  if (preset.pair_mean) {
+    std::vector<bool> use(hold.size());
+    for (std::size_t i = 0; i < hold.size(); ++i) use[i] = !hold[i];
+    means = pairMeans(data.samples, use);
+  }
+
+  std::vector<BiasModel::Entry> entries;
+  double elbo_weighted = 0.0, elbo_samples = 0.0;
+  int model_index = 0;
+  const int num_models = static_cast<int>(groups.size());
+  for (const auto& [key, idx] : groups) {
+    ++model_index;
+    const std::size_t n_tr = countTraining(idx, hold);
+    if (n_tr < need) continue;  // per-pair: too few for this pair → no model (predicts 0)
+    const GroupData g = groupData(data, idx, hold, n_tr, preset.features, means);
+    gp::Svgp svgp = gp::initSvgp(preset.kernel(), g.X, g.y, params.num_inducing, params.svgp.seed, preset.normalization);
+    const int mi = model_index;
+    const gp::SvgpTrainSummary ts = gp::trainSvgp(svgp, g.X, g.y, params.svgp, g.yh.size() > 0 ? &g.Xh : nullptr,
+                                                  g.yh.size() > 0 ? &g.yh : nullptr, [&](const gp::EpochReport& r) {
+                                                    if (progress) progress(mi, num_models, r);
+                                                  });
+    elbo_weighted += ts.final_elbo * static_cast<double>(g.X.rows());
+    elbo_samples += static_cast<double>(g.X.rows());
+    entries.push_back({key.first, key.second, std::move(svgp)});
+  }
+  if (entries.empty()) throw std::invalid_argument("no anchor pair has enough training samples for the requested inducing points");
+  BiasModel model(preset.name, preset.features, std::move(entries), std::move(means));
+  model.setExtraVariance(params.extra_sigma_m * params.extra_sigma_m);  // (P31)
+  model.setMeanScale(params.mean_scale);                                 // (P44)
+  model.setPredictiveShape(params.predictive_shape);                     // (P43b)
+  setTrainingLevels(model, data, hold, params);
 
   if (report) {
     BiasTrainReport r;
     r.train_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     r.num_models = static_cast<int>(model.entries().size());
     r.final_elbo = elbo_samples > 0 ? elbo_weighted / elbo_samples : std::nan("");
-    double se_before = 0, se_after = 0, sum_std = 0;
-    std::vector<double> residual_m, variance_m2;  // (P43) of the held-out samples with a covering GP
-    for (std::size_t i = 0; i < data.samples.size(); ++i) {
-      if (!hold[i]) {
-        ++r.n_train;
-        continue;
-      }
-      ++r.n_holdout;
-      const double eps = data.samples[i].error_m;
-      const BiasPrediction p = model.predict(data.samples[i].feature);
-      se_before += eps * eps;
-      se_after += (eps - p.mean_m) * (eps - p.mean_m);
-      sum_std += std::sqrt(p.variance_m2);
-      const BiasPredictive q = model.predictive(data.samples[i].feature);
-      if (q.covered && q.varianceM2() > 0.0) {
-        residual_m.push_back(eps - q.mean_m);
-        variance_m2.push_back(q.varianceM2());
-      }
-    }
-    const double n = static_cast<double>(r.n_holdout);
-    r.bias_rmse_before_m = n > 0 ? std::sqrt(se_before / n) : std::nan("");
-    r.bias_rmse_after_m = n > 0 ? std::sqrt(se_after / n) : std::nan("");
-    r.mean_predicted_std_m = n > 0 ? sum_std / n : std::nan("");
-    const BiasCalibration cal = biasCalibration(residual_m, variance_m2, model.predictiveShape());  // NaN when empty
-    r.mean_predictive_std_m = cal.mean_std_m;
-    r.holdout_coverage_1sigma = cal.coverage_1sigma;
-    r.holdout_coverage_2sigma = cal.coverage_2sigma;
-    r.holdout_nlpd = cal.nlpd;
+    scoreHoldout(model, data, hold, r);
     *report = r;
   }
   return model;

@@ -21,16 +21,8 @@ Vec3 sigmaAt(const Trajectory& estimate, double t_s) {
   return (1.0 - w) * a.sigma_p_m + w * b.sigma_p_m;
 }
 
-}  // namespace
-
-EstimateChecks checkEstimate(const Trajectory& estimate, const TrajectoryMetrics& metrics,
-                             const EstimateCheckParams& params) {
-  EstimateChecks c;
-  if (estimate.empty()) return c;
-  c.first_estimate_t_s = estimate.front().t_s;
-  const std::vector<PositionErrorSample>& samples = metrics.samples;  // sorted by time (ground-truth order)
-
-  // coverage of the reported σ, airborne
+/// Coverage of the reported σ, airborne.
+void checkCoverage(const Trajectory& estimate, const std::vector<PositionErrorSample>& samples, EstimateChecks& c) {
   for (const PositionErrorSample& s : samples) {
     if (!s.airborne) continue;
     const Vec3 sigma = sigmaAt(estimate, s.t_s);
@@ -45,19 +37,26 @@ EstimateChecks checkEstimate(const Trajectory& estimate, const TrajectoryMetrics
     c.coverage_1sigma /= static_cast<double>(c.n_coverage);
     c.coverage_2sigma /= static_cast<double>(c.n_coverage);
   }
+}
 
-  // airborne / on-ground state of the truth at a time: the nearest compared sample
-  const auto truthAirborne = [&](double t_s, bool* known) {
-    const auto it = std::lower_bound(samples.begin(), samples.end(), t_s,
-                                     [](const PositionErrorSample& s, double t) { return s.t_s < t; });
-    *known = false;
-    const PositionErrorSample* best = nullptr;
-    if (it != samples.end()) best = &*it;
-    if (it != samples.begin() && (!best || t_s - (it - 1)->t_s < best->t_s - t_s)) best = &*(it - 1);
-    if (!best || std::abs(best->t_s - t_s) > 0.1) return false;
-    *known = true;
-    return best->airborne;
-  };
+/// Airborne / on-ground state of the truth at a time: the nearest compared sample (`samples` sorted by time);
+/// *known is false when none lies within 0.1 s.
+bool truthAirborne(const std::vector<PositionErrorSample>& samples, double t_s, bool* known) {
+  const auto it = std::lower_bound(samples.begin(), samples.end(), t_s,
+                                   [](const PositionErrorSample& s, double t) { return s.t_s < t; });
+  *known = false;
+  const PositionErrorSample* best = nullptr;
+  if (it != samples.end()) best = &*it;
+  if (it != samples.begin() && (!best || t_s - (it - 1)->t_s < best->t_s - t_s)) best = &*(it - 1);
+  if (!best || std::abs(best->t_s - t_s) > 0.1) return false;
+  *known = true;
+  return best->airborne;
+}
+
+/// The error before take-off, the largest airborne step and the estimate's height while the truth is on the ground
+/// after the first take-off.
+void checkStepsAndFloor(const Trajectory& estimate, const std::vector<PositionErrorSample>& samples,
+                        const EstimateCheckParams& params, EstimateChecks& c) {
   double t_first_air = std::numeric_limits<double>::infinity();
   for (const PositionErrorSample& s : samples)
     if (s.airborne) {
@@ -73,7 +72,7 @@ EstimateChecks checkEstimate(const Trajectory& estimate, const TrajectoryMetrics
   for (std::size_t i = 0; i < estimate.size(); ++i) {
     const TrajectorySample& e = estimate[i];
     bool known = false;
-    const bool air = truthAirborne(e.t_s, &known);
+    const bool air = truthAirborne(samples, e.t_s, &known);
     if (!known) continue;
     if (air && i > 0 && e.t_s - estimate[i - 1].t_s <= params.step_max_dt_s)
       c.max_airborne_step_m = std::max(c.max_airborne_step_m, (e.w_p_b - estimate[i - 1].w_p_b).norm());
@@ -84,8 +83,11 @@ EstimateChecks checkEstimate(const Trajectory& estimate, const TrajectoryMetrics
       if (z < params.floor_z_m - params.floor_tolerance_m || z > params.ceiling_z_m) c.floor_or_ceiling_violated = true;
     }
   }
+}
 
-  // settling: the last airborne sample above the threshold
+/// Settling: the last airborne sample above the threshold; the errors 3 s and more after the start.
+void checkSettling(const std::vector<PositionErrorSample>& samples, const EstimateCheckParams& params,
+                   EstimateChecks& c) {
   double t_last_bad = -std::numeric_limits<double>::infinity();
   bool any_air = false;
   const double t_start = std::isnan(params.t_start_s) ? c.first_estimate_t_s : params.t_start_s;
@@ -106,6 +108,19 @@ EstimateChecks checkEstimate(const Trajectory& estimate, const TrajectoryMetrics
     if (std::isinf(t_last_bad)) c.settle_time_s = 0.0;
     else if (t_last_bad < samples.back().t_s) c.settle_time_s = t_last_bad - c.first_estimate_t_s;
   }
+}
+
+}  // namespace
+
+EstimateChecks checkEstimate(const Trajectory& estimate, const TrajectoryMetrics& metrics,
+                             const EstimateCheckParams& params) {
+  EstimateChecks c;
+  if (estimate.empty()) return c;
+  c.first_estimate_t_s = estimate.front().t_s;
+  const std::vector<PositionErrorSample>& samples = metrics.samples;  // sorted by time (ground-truth order)
+  checkCoverage(estimate, samples, c);
+  checkStepsAndFloor(estimate, samples, params, c);
+  checkSettling(samples, params, c);
   return c;
 }
 

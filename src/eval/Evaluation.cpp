@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -152,18 +153,150 @@ void EvaluationParams::validate() const {
   dataset.validate();
 }
 
+namespace {
+
+/// Results are keyed by test flight name: two flights must never share one.
+void checkDistinctNames(const std::vector<NamedFlight>& test) {
+  for (std::size_t i = 0; i < test.size(); ++i) {
+    for (std::size_t k = 0; k < i; ++k) {
+      if (test[i].name == test[k].name)
+        throw std::invalid_argument(fmt::format("evaluation: two test flights are named '{}'", test[i].name));
+    }
+  }
+}
+
+/// Every (kernel, M, repeat) in the order of the parameters.
+std::vector<Job> makeJobs(const EvaluationParams& params) {
+  std::vector<Job> jobs;
+  for (const auto& kernel : params.kernels) {
+    for (int m : params.inducing) {
+      for (int r = 0; r < params.repeats; ++r) jobs.push_back({kernel, m, r});
+    }
+  }
+  return jobs;
+}
+
+/// What every job reads; nothing in it changes while the jobs run.
+struct JobInputs {
+  const std::vector<NamedFlight>& test;
+  const AnchorSurvey& survey;
+  const EvaluationParams& params;
+  const BiasDataset& train_data;
+  const std::map<std::string, BiasDataset>& test_data;  ///< by test flight
+  const std::map<std::string, LocalizationRun>& uncorrected;  ///< by test flight
+};
+
+/// One job: train the bias model, localize every test flight with its correction and score it. Returns the train
+/// time and the per-flight part of the progress line.
+std::pair<double, std::string> runJob(const Job& job, const JobInputs& in, JobOutput& out) {
+  BiasTrainParams tp = in.params.train;
+  tp.preset = job.kernel;
+  tp.num_inducing = job.inducing;
+  tp.svgp.seed = static_cast<std::uint64_t>(job.repeat + 1);
+  if (in.params.threads > 1) tp.svgp.num_threads = 1;  // the configurations already run in parallel
+  BiasTrainReport report;
+  BiasModel model = trainBiasModel(in.train_data, tp, &report);
+  const BiasPredictor predictor = model.predictor();
+  LocalizationOptions corrected = in.params.localization;
+  applyBiasModelLevel(model, &corrected.params);  // (F24b)
+  std::string line;
+  for (const auto& f : in.test) {
+    LocalizationRun run = localizeFlight(f.flight, in.survey, corrected, predictor);
+    EvaluationRun er;
+    er.kernel = job.kernel;
+    er.inducing = job.inducing;
+    er.repeat = job.repeat;
+    er.flight = f.name;
+    er.rmse_uncorrected_m = airborneRmse(in.uncorrected.at(f.name), f.name);
+    er.rmse_corrected_m = airborneRmse(run, f.name);
+    std::tie(er.bias_rmse_before_m, er.bias_rmse_after_m) = biasRmse(in.test_data.at(f.name), model);
+    const BiasCalibration cal = biasCalibration(in.test_data.at(f.name), model);  // (P43)
+    er.coverage_1sigma = cal.coverage_1sigma;
+    er.coverage_2sigma = cal.coverage_2sigma;
+    er.nlpd = cal.nlpd;
+    er.coverage = cal.coverage;
+    er.train_seconds = report.train_seconds;
+    out.runs.push_back(er);
+    for (const auto& s : decimatedAirborne(*run.metrics, in.params.figure_rate_hz)) out.errors.emplace_back(f.name, s);
+    line += fmt::format(" {} {:.3f}→{:.3f} m", f.name, er.rmse_uncorrected_m, er.rmse_corrected_m);
+    if (job.repeat == 0) out.corrected.emplace(f.name, std::move(run));
+  }
+  if (job.repeat == 0) out.model = std::move(model);
+  return {report.train_seconds, line};
+}
+
+/// Runs run_one(0 … n − 1) on up to `threads` threads, the calling one included. After the first exception no job
+/// starts; it is rethrown once every thread has stopped.
+void runInParallel(std::size_t n, int threads, const std::function<void(std::size_t)>& run_one) {
+  std::atomic<std::size_t> next{0};
+  std::mutex mutex;
+  std::exception_ptr failure;
+  const auto worker = [&] {
+    for (std::size_t j = next++; j < n; j = next++) {
+      try {
+        run_one(j);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!failure) failure = std::current_exception();
+        next = n;
+      }
+    }
+  };
+  const int n_threads = std::min<int>(threads, static_cast<int>(n));
+  std::vector<std::thread> pool;
+  for (int i = 1; i < n_threads; ++i) {
+    try {
+      pool.emplace_back(worker);
+    } catch (const std::system_error&) {
+      break;  // no more threads to be had: the jobs go to the threads started (results do not depend on which)
+    }
+  }
+  worker();
+  for (auto& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
+}
+
+/// The repeat-0 job of a configuration.
+std::size_t findJob(const std::vector<Job>& jobs, const std::string& kernel, int inducing) {
+  for (std::size_t j = 0; j < jobs.size(); ++j) {
+    if (jobs[j].kernel == kernel && jobs[j].inducing == inducing && jobs[j].repeat == 0) return j;
+  }
+  throw std::logic_error("evaluation: configuration not found");
+}
+
+/// Merges the jobs' outputs into result: runs, the table rows, the error samples and, from the best configuration
+/// (largest error reduction), the corrected trajectories and Fig. 7.
+void collectJobs(const std::vector<Job>& jobs, std::vector<JobOutput>& outputs, const BiasDataset& train_data,
+                 EvaluationResult& result) {
+  for (auto& out : outputs) {
+    result.runs.insert(result.runs.end(), out.runs.begin(), out.runs.end());
+  }
+  result.rows = aggregateRuns(result.runs);
+  for (std::size_t j = 0; j < jobs.size(); ++j) {
+    auto& dst = result.corrected_errors[configKey(jobs[j].kernel, jobs[j].inducing)];
+    dst.insert(dst.end(), outputs[j].errors.begin(), outputs[j].errors.end());
+  }
+
+  const auto best_row = std::max_element(result.rows.begin(), result.rows.end(), [](const auto& a, const auto& b) {
+    return a.change_pct > b.change_pct;  // max_element of the reverse order: the most negative change
+  });
+  result.best_kernel = best_row->kernel;
+  result.best_inducing = best_row->inducing;
+  result.best_corrected = std::move(outputs[findJob(jobs, result.best_kernel, result.best_inducing)].corrected);
+  // Fig. 7 for the best configuration (repeat 1), whatever its inputs.
+  result.angle_figure = angleFigure(outputs[findJob(jobs, result.best_kernel, result.best_inducing)].model, train_data,
+                                    result.best_kernel, result.best_inducing);
+}
+
+}  // namespace
+
 EvaluationResult runEvaluation(const std::vector<NamedFlight>& train, const std::vector<NamedFlight>& test,
                                const AnchorSurvey& survey, const EvaluationParams& params,
                                const EvaluationProgress& progress) {
   params.validate();
   if (train.empty()) throw std::invalid_argument("evaluation: no training flight given");
   if (test.empty()) throw std::invalid_argument("evaluation: no test flight given");
-  for (std::size_t i = 0; i < test.size(); ++i) {  // results are keyed by name: two flights must never share one
-    for (std::size_t k = 0; k < i; ++k) {
-      if (test[i].name == test[k].name)
-        throw std::invalid_argument(fmt::format("evaluation: two test flights are named '{}'", test[i].name));
-    }
-  }
+  checkDistinctNames(test);
   const auto t0 = std::chrono::steady_clock::now();
   const auto say = [&](const std::string& line) {
     if (progress) progress(line);
@@ -191,104 +324,20 @@ EvaluationResult runEvaluation(const std::vector<NamedFlight>& train, const std:
     result.uncorrected.emplace(f.name, std::move(run));
   }
 
-  std::vector<Job> jobs;
-  for (const auto& kernel : params.kernels) {
-    for (int m : params.inducing) {
-      for (int r = 0; r < params.repeats; ++r) jobs.push_back({kernel, m, r});
-    }
-  }
+  const std::vector<Job> jobs = makeJobs(params);
   std::vector<JobOutput> outputs(jobs.size());
-  std::atomic<std::size_t> next{0};
-  std::atomic<std::size_t> done{0};
+  const JobInputs inputs{test, survey, params, train_data, test_data, result.uncorrected};
   std::mutex mutex;
-  std::exception_ptr failure;
-
-  const auto worker = [&] {
-    for (std::size_t j = next++; j < jobs.size(); j = next++) {
-      try {
-        const Job& job = jobs[j];
-        BiasTrainParams tp = params.train;
-        tp.preset = job.kernel;
-        tp.num_inducing = job.inducing;
-        tp.svgp.seed = static_cast<std::uint64_t>(job.repeat + 1);
-        if (params.threads > 1) tp.svgp.num_threads = 1;  // the configurations already run in parallel
-        BiasTrainReport report;
-        BiasModel model = trainBiasModel(train_data, tp, &report);
-        const BiasPredictor predictor = model.predictor();
-        LocalizationOptions corrected = params.localization;
-        applyBiasModelLevel(model, &corrected.params);  // (F24b)
-        JobOutput& out = outputs[j];
-        std::string line;
-        for (const auto& f : test) {
-          LocalizationRun run = localizeFlight(f.flight, survey, corrected, predictor);
-          EvaluationRun er;
-          er.kernel = job.kernel;
-          er.inducing = job.inducing;
-          er.repeat = job.repeat;
-          er.flight = f.name;
-          er.rmse_uncorrected_m = airborneRmse(result.uncorrected.at(f.name), f.name);
-          er.rmse_corrected_m = airborneRmse(run, f.name);
-          std::tie(er.bias_rmse_before_m, er.bias_rmse_after_m) = biasRmse(test_data.at(f.name), model);
-          const BiasCalibration cal = biasCalibration(test_data.at(f.name), model);  // (P43)
-          er.coverage_1sigma = cal.coverage_1sigma;
-          er.coverage_2sigma = cal.coverage_2sigma;
-          er.nlpd = cal.nlpd;
-          er.coverage = cal.coverage;
-          er.train_seconds = report.train_seconds;
-          out.runs.push_back(er);
-          for (const auto& s : decimatedAirborne(*run.metrics, params.figure_rate_hz)) out.errors.emplace_back(f.name, s);
-          line += fmt::format(" {} {:.3f}→{:.3f} m", f.name, er.rmse_uncorrected_m, er.rmse_corrected_m);
-          if (job.repeat == 0) out.corrected.emplace(f.name, std::move(run));
-        }
-        if (job.repeat == 0) out.model = std::move(model);
-        std::lock_guard<std::mutex> lock(mutex);
-        say(fmt::format("[{}/{}] {} M={} repeat {}: trained in {:.1f} s;{}", ++done, jobs.size(), job.kernel,
-                        job.inducing, job.repeat + 1, report.train_seconds, line));
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!failure) failure = std::current_exception();
-        next = jobs.size();
-      }
-    }
-  };
-  const int n_threads = std::min<int>(params.threads, static_cast<int>(jobs.size()));
-  std::vector<std::thread> pool;
-  for (int i = 1; i < n_threads; ++i) {
-    try {
-      pool.emplace_back(worker);
-    } catch (const std::system_error&) {
-      break;  // no more threads to be had: the jobs go to the threads started (results do not depend on which)
-    }
-  }
-  worker();
-  for (auto& t : pool) t.join();
-  if (failure) std::rethrow_exception(failure);
-
-  for (auto& out : outputs) {
-    result.runs.insert(result.runs.end(), out.runs.begin(), out.runs.end());
-  }
-  result.rows = aggregateRuns(result.runs);
-  for (std::size_t j = 0; j < jobs.size(); ++j) {
-    auto& dst = result.corrected_errors[configKey(jobs[j].kernel, jobs[j].inducing)];
-    dst.insert(dst.end(), outputs[j].errors.begin(), outputs[j].errors.end());
-  }
-
-  // The best configuration (largest error reduction) gives the trajectories and Fig. 7.
-  const auto best_row = std::max_element(result.rows.begin(), result.rows.end(), [](const auto& a, const auto& b) {
-    return a.change_pct > b.change_pct;  // max_element of the reverse order: the most negative change
+  std::size_t done = 0;
+  runInParallel(jobs.size(), params.threads, [&](std::size_t j) {
+    const Job& job = jobs[j];
+    const auto [train_seconds, line] = runJob(job, inputs, outputs[j]);
+    std::lock_guard<std::mutex> lock(mutex);
+    say(fmt::format("[{}/{}] {} M={} repeat {}: trained in {:.1f} s;{}", ++done, jobs.size(), job.kernel,
+                    job.inducing, job.repeat + 1, train_seconds, line));
   });
-  result.best_kernel = best_row->kernel;
-  result.best_inducing = best_row->inducing;
-  const auto findJob = [&](const std::string& kernel, int inducing) {
-    for (std::size_t j = 0; j < jobs.size(); ++j) {
-      if (jobs[j].kernel == kernel && jobs[j].inducing == inducing && jobs[j].repeat == 0) return j;
-    }
-    throw std::logic_error("evaluation: configuration not found");
-  };
-  result.best_corrected = std::move(outputs[findJob(result.best_kernel, result.best_inducing)].corrected);
-  // Fig. 7 for the best configuration (repeat 1), whatever its inputs.
-  result.angle_figure = angleFigure(outputs[findJob(result.best_kernel, result.best_inducing)].model, train_data,
-                                    result.best_kernel, result.best_inducing);
+
+  collectJobs(jobs, outputs, train_data, result);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;
 }
@@ -315,22 +364,8 @@ std::string trajectoryRows(const std::string& flight, const std::string& variant
 
 nlohmann::json toVector(const std::vector<double>& v) { return nlohmann::json(v); }
 
-}  // namespace
-
-void writeEvaluation(const EvaluationResult& result, const AnchorSurvey& survey, const std::string& dir,
-                     const std::string& command, const std::vector<std::string>& figures) {
-  namespace fs = std::filesystem;
-  const fs::path root(dir);
-  std::error_code ec;
-  fs::create_directories(root / "figdata", ec);
-  if (ec) throw FileError(fmt::format("cannot create {}: {}", (root / "figdata").string(), ec.message()));
-
-  writeText(root / "table.md", toMarkdown(result.rows));
-  writeText(root / "table.csv", toCsv(result.rows));
-  writeText(root / "results.json", toJson(result.rows).dump(2) + "\n");
-  writeText(root / "runs.csv", runsToCsv(result.runs));
-
-  // figdata/calibration.csv (P43): coverage of the predicted bias intervals per run and nominal level.
+/// figdata/calibration.csv (P43): coverage of the predicted bias intervals per run and nominal level.
+std::string calibrationCsv(const EvaluationResult& result) {
   std::string calibration = "kernel,inducing,repeat,flight,level,coverage\n";
   for (const auto& r : result.runs) {
     for (std::size_t k = 0; k < r.coverage.size() && k < calibrationLevels().size(); ++k) {
@@ -338,13 +373,16 @@ void writeEvaluation(const EvaluationResult& result, const AnchorSurvey& survey,
                                  calibrationLevels()[k], r.coverage[k]);
     }
   }
-  writeText(root / "figdata" / "calibration.csv", calibration);
+  return calibration;
+}
 
-  // figdata/errors.csv (Fig. 6): uncorrected rows as kernel "none", inducing 0.
+constexpr double kFigureRate_hz = 50.0;  ///< decimation of the error and trajectory figure data
+
+/// figdata/errors.csv (Fig. 6): uncorrected rows as kernel "none", inducing 0.
+std::string errorsCsv(const EvaluationResult& result) {
   std::string errors = "kernel,inducing,flight,corrected,t,error_m\n";
-  const double rate_hz = 50.0;
   for (const auto& [flight, run] : result.uncorrected) {
-    for (const auto& s : decimatedAirborne(*run.metrics, rate_hz)) {
+    for (const auto& s : decimatedAirborne(*run.metrics, kFigureRate_hz)) {
       errors += fmt::format("none,0,{},0,{:.4f},{:.5f}\n", flight, s.t_s, s.error_norm_m);
     }
   }
@@ -356,9 +394,12 @@ void writeEvaluation(const EvaluationResult& result, const AnchorSurvey& survey,
       errors += fmt::format("{},{},{},1,{:.4f},{:.5f}\n", kernel, m, flight, s.t_s, s.error_norm_m);
     }
   }
-  writeText(root / "figdata" / "errors.csv", errors);
+  return errors;
+}
 
-  // figdata/trajectories.csv (top view): ground truth, uncorrected, best corrected.
+/// figdata/trajectories.csv (top view): ground truth, uncorrected, best corrected.
+std::string trajectoriesCsv(const EvaluationResult& result) {
+  const double rate_hz = kFigureRate_hz;
   std::string traj = "flight,variant,t,x,y,z\n";
   const std::string corrected_label = fmt::format("corrected {} M={}", result.best_kernel, result.best_inducing);
   for (const auto& [flight, run] : result.uncorrected) {
@@ -376,43 +417,46 @@ void writeEvaluation(const EvaluationResult& result, const AnchorSurvey& survey,
       traj += trajectoryRows(flight, corrected_label, it->second.trajectory, rate_hz);
     }
   }
-  writeText(root / "figdata" / "trajectories.csv", traj);
+  return traj;
+}
 
+/// figdata/anchors.csv
+std::string anchorsCsv(const AnchorSurvey& survey) {
   std::string anchors = "id,x,y,z\n";
   for (const auto& a : survey.anchors) {
     anchors += fmt::format("{},{:.6f},{:.6f},{:.6f}\n", a.id, a.w_p.x(), a.w_p.y(), a.w_p.z());
   }
-  writeText(root / "figdata" / "anchors.csv", anchors);
+  return anchors;
+}
 
-  const auto& fig = result.angle_figure;
-  if (fig.valid) {
-    nlohmann::json grid = nlohmann::json::array();
-    for (Eigen::Index r = 0; r < fig.grid_mean_m.rows(); ++r) {
-      nlohmann::json row = nlohmann::json::array();
-      for (Eigen::Index c = 0; c < fig.grid_mean_m.cols(); ++c) {
-        const double v = fig.grid_mean_m(r, c);
-        row.push_back(std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr));  // no data: null
-      }
-      grid.push_back(row);
+/// figdata/fig7.json (Fig. 7); a cell without data is null.
+nlohmann::json angleFigureJson(const BiasAngleFigure& fig) {
+  nlohmann::json grid = nlohmann::json::array();
+  for (Eigen::Index r = 0; r < fig.grid_mean_m.rows(); ++r) {
+    nlohmann::json row = nlohmann::json::array();
+    for (Eigen::Index c = 0; c < fig.grid_mean_m.cols(); ++c) {
+      const double v = fig.grid_mean_m(r, c);
+      row.push_back(std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr));  // no data: null
     }
-    const nlohmann::json j = {{"kernel", fig.kernel},
-                              {"inducing", fig.inducing},
-                              {"id_a", fig.id_a},
-                              {"id_b", fig.id_b},
-                              {"alpha_i_rad", toVector(fig.alpha_a_rad)},
-                              {"alpha_j_rad", toVector(fig.alpha_b_rad)},
-                              {"error_m", toVector(fig.error_m)},
-                              {"grid_alpha_i_rad", toVector(fig.grid_alpha_a_rad)},
-                              {"grid_alpha_j_rad", toVector(fig.grid_alpha_b_rad)},
-                              {"grid_mean_m", grid},
-                              {"inducing_alpha_i_rad", toVector(fig.inducing_alpha_a_rad)},
-                              {"inducing_alpha_j_rad", toVector(fig.inducing_alpha_b_rad)}};
-    writeText(root / "figdata" / "fig7.json", j.dump() + "\n");
-  } else {
-    fs::remove(root / "figdata" / "fig7.json", ec);
+    grid.push_back(row);
   }
+  const nlohmann::json j = {{"kernel", fig.kernel},
+                            {"inducing", fig.inducing},
+                            {"id_a", fig.id_a},
+                            {"id_b", fig.id_b},
+                            {"alpha_i_rad", toVector(fig.alpha_a_rad)},
+                            {"alpha_j_rad", toVector(fig.alpha_b_rad)},
+                            {"error_m", toVector(fig.error_m)},
+                            {"grid_alpha_i_rad", toVector(fig.grid_alpha_a_rad)},
+                            {"grid_alpha_j_rad", toVector(fig.grid_alpha_b_rad)},
+                            {"grid_mean_m", grid},
+                            {"inducing_alpha_i_rad", toVector(fig.inducing_alpha_a_rad)},
+                            {"inducing_alpha_j_rad", toVector(fig.inducing_alpha_b_rad)}};
+  return j;
+}
 
-  // REPORT.md
+/// REPORT.md up to its figures: how it was made, the table (Fig. 5), the uncorrected and per-flight results.
+std::string reportResultsMarkdown(const EvaluationResult& result, const std::string& command) {
   std::string md = "# uwbtdoa evaluation report\n\n";
   md += "Made by\n\n```sh\n" + command + "\n```\n\n";
   md += fmt::format(
@@ -443,42 +487,75 @@ void writeEvaluation(const EvaluationResult& result, const AnchorSurvey& survey,
       "freedom and scale, or a Gaussian) and its negative log predictive density per sample.\n\n",
       result.best_kernel, result.best_inducing);
   md += perFlightMarkdown(result.runs, result.best_kernel, result.best_inducing) + "\n";
-  const auto hasFigure = [&](const std::string& name) {
-    return figures.empty() || std::find(figures.begin(), figures.end(), name) != figures.end();
+  return md;
+}
+
+/// REPORT.md's figure section: one paragraph per figure listed (all when figures is empty).
+std::string reportFiguresMarkdown(const EvaluationResult& result, const std::vector<std::string>& figures) {
+  std::string md = "## Figures\n\n";
+  const auto addFigure = [&](const std::string& name, const std::string& text) {
+    if (figures.empty() || std::find(figures.begin(), figures.end(), name) != figures.end()) md += text;
   };
-  md += "## Figures\n\n";
-  if (hasFigure("fig5_improvement.png")) {
-    md += "Change of the airborne RMSE (negative = reduced) against the number of inducing points per kernel, with "
-          "the spread over repeats (Fig. 5):\n\n"
-          "![Fig. 5](fig5_improvement.png)\n\n";
+  addFigure("fig5_improvement.png",
+            "Change of the airborne RMSE (negative = reduced) against the number of inducing points per kernel, with "
+            "the spread over repeats (Fig. 5):\n\n"
+            "![Fig. 5](fig5_improvement.png)\n\n");
+  addFigure("fig6_error_distribution.png",
+            "Distribution of the airborne position error without and with correction, best configuration, all "
+            "airborne samples of the test flights pooled (decimated to 50 Hz; its RMSEs therefore differ from the "
+            "table's per-flight mean) (Fig. 6):\n\n"
+            "![Fig. 6](fig6_error_distribution.png)\n\n");
+  const auto& fig = result.angle_figure;
+  if (fig.valid) {
+    addFigure("fig7_bias_vs_angles.png",
+              fmt::format("Measured TDoA error of anchor pair ({}, {}) on the training flights over the two anchor "
+                          "yaw angles, next to the mean of the best model ({} with M = {}) at the same samples, "
+                          "averaged per 5° cell; cells without training data are blank (the model is not shown where "
+                          "it would extrapolate). Red: inducing points in angle coordinates (Fig. 7):\n\n"
+                          "![Fig. 7](fig7_bias_vs_angles.png)\n\n",
+                          fig.id_a, fig.id_b, fig.kernel, fig.inducing));
   }
-  if (hasFigure("fig6_error_distribution.png")) {
-    md += "Distribution of the airborne position error without and with correction, best configuration, all airborne "
-          "samples of the test flights pooled (decimated to 50 Hz; its RMSEs therefore differ from the table's "
-          "per-flight mean) (Fig. 6):\n\n"
-          "![Fig. 6](fig6_error_distribution.png)\n\n";
-  }
-  if (fig.valid && hasFigure("fig7_bias_vs_angles.png")) {
-    md += fmt::format(
-        "Measured TDoA error of anchor pair ({}, {}) on the training flights over the two anchor yaw angles, next to "
-        "the mean of the best model ({} with M = {}) at the same samples, averaged per 5° cell; cells without "
-        "training data are blank (the model is not shown where it would extrapolate). Red: inducing points in "
-        "angle coordinates (Fig. 7):\n\n![Fig. 7](fig7_bias_vs_angles.png)\n\n",
-        fig.id_a, fig.id_b, fig.kernel, fig.inducing);
-  }
-  if (hasFigure("calibration.png")) {
-    md += "Coverage of the predicted bias intervals against their nominal probability, per configuration (mean "
-          "over repeats and test flights; on the diagonal = calibrated, below = over-confident):\n\n"
-          "![calibration](calibration.png)\n\n";
-  }
-  if (hasFigure("per_flight.png")) {
-    md += "Per test flight, best configuration: airborne RMSE without and with the correction, and the 1σ/2σ "
-          "coverage of the predicted bias:\n\n![per flight](per_flight.png)\n\n";
-  }
+  addFigure("calibration.png",
+            "Coverage of the predicted bias intervals against their nominal probability, per configuration (mean "
+            "over repeats and test flights; on the diagonal = calibrated, below = over-confident):\n\n"
+            "![calibration](calibration.png)\n\n");
+  addFigure("per_flight.png",
+            "Per test flight, best configuration: airborne RMSE without and with the correction, and the 1σ/2σ "
+            "coverage of the predicted bias:\n\n![per flight](per_flight.png)\n\n");
   for (const auto& [flight, run] : result.uncorrected) {
     const std::string png = "trajectory_" + flight + ".png";
-    if (hasFigure(png)) md += fmt::format("Top view of {} (ground truth, uncorrected, corrected):\n\n![{}]({})\n\n", flight, flight, png);
+    addFigure(png, fmt::format("Top view of {} (ground truth, uncorrected, corrected):\n\n![{}]({})\n\n", flight,
+                               flight, png));
   }
+  return md;
+}
+
+}  // namespace
+
+void writeEvaluation(const EvaluationResult& result, const AnchorSurvey& survey, const std::string& dir,
+                     const std::string& command, const std::vector<std::string>& figures) {
+  namespace fs = std::filesystem;
+  const fs::path root(dir);
+  std::error_code ec;
+  fs::create_directories(root / "figdata", ec);
+  if (ec) throw FileError(fmt::format("cannot create {}: {}", (root / "figdata").string(), ec.message()));
+
+  writeText(root / "table.md", toMarkdown(result.rows));
+  writeText(root / "table.csv", toCsv(result.rows));
+  writeText(root / "results.json", toJson(result.rows).dump(2) + "\n");
+  writeText(root / "runs.csv", runsToCsv(result.runs));
+  writeText(root / "figdata" / "calibration.csv", calibrationCsv(result));
+  writeText(root / "figdata" / "errors.csv", errorsCsv(result));
+  writeText(root / "figdata" / "trajectories.csv", trajectoriesCsv(result));
+  writeText(root / "figdata" / "anchors.csv", anchorsCsv(survey));
+  if (result.angle_figure.valid) {
+    writeText(root / "figdata" / "fig7.json", angleFigureJson(result.angle_figure).dump() + "\n");
+  } else {
+    fs::remove(root / "figdata" / "fig7.json", ec);
+  }
+
+  std::string md = reportResultsMarkdown(result, command);
+  md += reportFiguresMarkdown(result, figures);
   md += "## Training data\n\n```\n" + result.dataset_report + "\n```\n\n";
   md += "Files: `table.md`, `table.csv`, `results.json` (one object per kernel and M), `runs.csv` (every repeat and "
         "flight), `figdata/` (the data behind every figure; see docs/python.md).\n";

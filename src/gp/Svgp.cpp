@@ -140,6 +140,102 @@ double Svgp::kl() const {
   return 0.5 * (L_.squaredNorm() + m_.squaredNorm() - M - L_.diagonal().array().square().log().sum());
 }
 
+namespace {
+
+/// The batch's latent moments before the constant mean and k + ε are added (P12–P13), and the products of either
+/// mode that the reverse pass reuses.
+struct ElboForward {
+  VecX mean_f, var_f;  ///< aᵀm and aᵀ(S − I)a per datum
+  MatX A, C;           ///< kExact: A = Lz⁻¹Kzx, C = (S − I)A
+  VecX alpha;          ///< kFast: Lz⁻ᵀ m
+  MatX WK;             ///< kFast: W Kzx, W = Lz⁻ᵀ (S − I) Lz⁻¹
+  MatX T1;             ///< kFast: Lz⁻ᵀ (S − I), reused by the reverse pass (P17)
+};
+
+// P12–P13: mean_f = c + aᵀm, var_f = k + ε + aᵀ(S − I)a (the last two terms here)
+ElboForward latentMoments(ElboMode mode, const MatX& Lz, const MatX& Kzx, const MatX& SmI, const VecX& m) {
+  const auto LzT = Lz.triangularView<Eigen::Lower>();
+  const Eigen::Index B = Kzx.cols();
+  ElboForward f;
+  f.mean_f.resize(B);
+  f.var_f.resize(B);
+  if (mode == ElboMode::kExact) {
+    f.A = LzT.solve(Kzx);
+    f.C.noalias() = SmI * f.A;
+    f.mean_f.noalias() = f.A.transpose() * m;
+    f.var_f = (f.A.array() * f.C.array()).colwise().sum().transpose();
+  } else {
+    f.alpha = LzT.transpose().solve(m);
+    f.T1 = LzT.transpose().solve(SmI);                           // Lz⁻ᵀ (S − I)
+    MatX W = LzT.transpose().solve(f.T1.transpose()).transpose();  // Lz⁻ᵀ (S − I) Lz⁻¹
+    W = 0.5 * (W + W.transpose()).eval();
+    f.WK.noalias() = W * Kzx;
+    f.mean_f.noalias() = Kzx.transpose() * f.alpha;
+    f.var_f = (Kzx.array() * f.WK.array()).colwise().sum().transpose();
+  }
+  return f;
+}
+
+/// Reverse pass over the batch: A Aᵀ and A r (P16), K̄zx = ∂ELBO/∂Kzx, and K̄zz = ∂ELBO/∂Kzz through the Cholesky
+/// factor Lz (P17–P18).
+struct ElboAdjoints {
+  MatX AAt;
+  VecX Ar;
+  MatX Kbar_zx;
+  MatX Kbar_zz;
+};
+
+ElboAdjoints elboAdjoints(ElboMode mode, const MatX& Lz, const MatX& Kzx, const MatX& SmI, const ElboForward& f,
+                          const VecX& m, const VecX& r, double beta) {
+  const auto LzT = Lz.triangularView<Eigen::Lower>();
+  const Eigen::Index M = Lz.rows();
+  ElboAdjoints out;
+  MatX& AAt = out.AAt;
+  VecX& Ar = out.Ar;
+  AAt = MatX::Zero(M, M);
+  if (mode == ElboMode::kExact) {
+    AAt.selfadjointView<Eigen::Lower>().rankUpdate(f.A);
+    AAt = AAt.selfadjointView<Eigen::Lower>();
+    Ar.noalias() = f.A * r;
+    // Ā = β (m rᵀ − (S − I) A);  K̄zx = Lz⁻ᵀ Ā
+    MatX Abar = -beta * f.C;
+    Abar.noalias() += (beta * m) * r.transpose();
+    out.Kbar_zx = LzT.transpose().solve(Abar);
+  } else {
+    MatX KKt = MatX::Zero(M, M);
+    KKt.selfadjointView<Eigen::Lower>().rankUpdate(Kzx);
+    KKt = KKt.selfadjointView<Eigen::Lower>();
+    AAt = LzT.solve(LzT.solve(KKt).transpose());  // Lz⁻¹ Kzx Kxz Lz⁻ᵀ
+    AAt = 0.5 * (AAt + AAt.transpose()).eval();
+    Ar = LzT.solve(Kzx * r);
+    // K̄zx = β (α rᵀ − W Kzx)
+    out.Kbar_zx = -beta * f.WK;
+    out.Kbar_zx.noalias() += (beta * f.alpha) * r.transpose();
+  }
+
+  // P17: ∂/∂Lz = tril(−K̄zx Aᵀ) = tril(−Lz⁻ᵀ Ā Aᵀ),  Ā Aᵀ = β (m (Ar)ᵀ − (S − I) A Aᵀ)
+  MatX Lzbar;
+  if (mode == ElboMode::kExact) {
+    MatX AbarAt = -beta * (SmI * AAt);
+    AbarAt.noalias() += (beta * m) * Ar.transpose();
+    Lzbar = (-LzT.transpose().solve(AbarAt)).triangularView<Eigen::Lower>();
+  } else {
+    // Lz⁻ᵀ Ā Aᵀ = β (α (Ar)ᵀ − T1 A Aᵀ): one GEMM with the cached T1 instead of a GEMM and a triangular solve
+    MatX LzAbarAt(M, M);
+    LzAbarAt.noalias() = (-beta) * f.T1 * AAt;
+    LzAbarAt.noalias() += (beta * f.alpha) * Ar.transpose();
+    Lzbar = (-LzAbarAt).triangularView<Eigen::Lower>();
+  }
+  // P18: Cholesky backward: K̄zz = ½ Lz⁻ᵀ (P + Pᵀ) Lz⁻¹, P = Φ(Lzᵀ L̄z)
+  const MatX P = phi(Lz.transpose().triangularView<Eigen::Upper>() * Lzbar);
+  const MatX Ps = P + P.transpose();
+  out.Kbar_zz = 0.5 * LzT.transpose().solve(LzT.transpose().solve(Ps).transpose());
+  out.Kbar_zz = 0.5 * (out.Kbar_zz + out.Kbar_zz.transpose()).eval();
+  return out;
+}
+
+}  // namespace
+
 ElboTerms Svgp::elbo(const MatX& X_raw, const VecX& y, double num_data, SvgpGradient* grad, ElboMode mode) const {
   if (X_raw.rows() != y.size() || X_raw.rows() == 0) throw std::invalid_argument("SVGP elbo: X and y mismatch or empty");
   if (!(num_data > 0)) throw std::invalid_argument("SVGP elbo: num_data must be positive");
@@ -153,7 +249,6 @@ ElboTerms Svgp::elbo(const MatX& X_raw, const VecX& y, double num_data, SvgpGrad
   MatX Kzz = kernel_.cross(Z_, Z_, need_grad ? &zz_blocks : nullptr);
   Kzz.diagonal().array() += jitter_;
   const MatX Lz = choleskyOrThrow(Kzz, "SVGP Kzz");
-  const auto LzT = Lz.triangularView<Eigen::Lower>();
   const MatX Kzx = kernel_.cross(Z_, X, need_grad ? &zx_blocks : nullptr);
   const double kdiag = kernel_.diagValue();
   const MatX SmI = [&] {
@@ -163,25 +258,9 @@ ElboTerms Svgp::elbo(const MatX& X_raw, const VecX& y, double num_data, SvgpGrad
   }();
 
   // P12–P13: mean_f = c + aᵀm, var_f = k + ε + aᵀ(S − I)a
-  VecX mean_f(B), var_f(B);
-  MatX A, C;      // kExact: A = Lz⁻¹Kzx, C = (S − I)A
-  VecX alpha;     // kFast: Lz⁻ᵀ m
-  MatX WK;        // kFast: W Kzx, W = Lz⁻ᵀ (S − I) Lz⁻¹
-  MatX T1;        // kFast: Lz⁻ᵀ (S − I), reused by the reverse pass (P17)
-  if (mode == ElboMode::kExact) {
-    A = LzT.solve(Kzx);
-    C.noalias() = SmI * A;
-    mean_f.noalias() = A.transpose() * m_;
-    var_f = (A.array() * C.array()).colwise().sum().transpose();
-  } else {
-    alpha = LzT.transpose().solve(m_);
-    T1 = LzT.transpose().solve(SmI);                           // Lz⁻ᵀ (S − I)
-    MatX W = LzT.transpose().solve(T1.transpose()).transpose();  // Lz⁻ᵀ (S − I) Lz⁻¹
-    W = 0.5 * (W + W.transpose()).eval();
-    WK.noalias() = W * Kzx;
-    mean_f.noalias() = Kzx.transpose() * alpha;
-    var_f = (Kzx.array() * WK.array()).colwise().sum().transpose();
-  }
+  ElboForward fwd = latentMoments(mode, Lz, Kzx, SmI, m_);
+  VecX& mean_f = fwd.mean_f;
+  VecX& var_f = fwd.var_f;
   mean_f.array() += c_;
   var_f.array() += kdiag + jitter_;
 
@@ -200,66 +279,25 @@ ElboTerms Svgp::elbo(const MatX& X_raw, const VecX& y, double num_data, SvgpGrad
   SvgpGradient& g = *grad;
   g.mean = beta * r.sum();
   g.noise = (-0.5 * Bd / s + 0.5 * sum_sq / (s * s)) / Bd;
-
-  MatX AAt = MatX::Zero(M, M);
-  VecX Ar;
-  MatX Kbar_zx;
-  if (mode == ElboMode::kExact) {
-    AAt.selfadjointView<Eigen::Lower>().rankUpdate(A);
-    AAt = AAt.selfadjointView<Eigen::Lower>();
-    Ar.noalias() = A * r;
-    // Ā = β (m rᵀ − (S − I) A);  K̄zx = Lz⁻ᵀ Ā
-    MatX Abar = -beta * C;
-    Abar.noalias() += (beta * m_) * r.transpose();
-    Kbar_zx = LzT.transpose().solve(Abar);
-  } else {
-    MatX KKt = MatX::Zero(M, M);
-    KKt.selfadjointView<Eigen::Lower>().rankUpdate(Kzx);
-    KKt = KKt.selfadjointView<Eigen::Lower>();
-    AAt = LzT.solve(LzT.solve(KKt).transpose());  // Lz⁻¹ Kzx Kxz Lz⁻ᵀ
-    AAt = 0.5 * (AAt + AAt.transpose()).eval();
-    Ar = LzT.solve(Kzx * r);
-    // K̄zx = β (α rᵀ − W Kzx)
-    Kbar_zx = -beta * WK;
-    Kbar_zx.noalias() += (beta * alpha) * r.transpose();
-  }
+  ElboAdjoints adj = elboAdjoints(mode, Lz, Kzx, SmI, fwd, m_, r, beta);  // P16–P18
 
   // P16: variational parameters
-  g.m = beta * Ar - m_ / num_data;
+  g.m = beta * adj.Ar - m_ / num_data;
   MatX Linv_diag = MatX::Zero(M, M);
   Linv_diag.diagonal() = L_.diagonal().cwiseInverse();
-  const MatX AAtL = AAt * L_.triangularView<Eigen::Lower>();
+  const MatX AAtL = adj.AAt * L_.triangularView<Eigen::Lower>();
   g.L = (-beta * AAtL - (L_ - Linv_diag) / num_data).triangularView<Eigen::Lower>();
-
-  // P17: ∂/∂Lz = tril(−K̄zx Aᵀ) = tril(−Lz⁻ᵀ Ā Aᵀ),  Ā Aᵀ = β (m (Ar)ᵀ − (S − I) A Aᵀ)
-  MatX Lzbar;
-  if (mode == ElboMode::kExact) {
-    MatX AbarAt = -beta * (SmI * AAt);
-    AbarAt.noalias() += (beta * m_) * Ar.transpose();
-    Lzbar = (-LzT.transpose().solve(AbarAt)).triangularView<Eigen::Lower>();
-  } else {
-    // Lz⁻ᵀ Ā Aᵀ = β (α (Ar)ᵀ − T1 A Aᵀ): one GEMM with the cached T1 instead of a GEMM and a triangular solve
-    MatX LzAbarAt(M, M);
-    LzAbarAt.noalias() = (-beta) * T1 * AAt;
-    LzAbarAt.noalias() += (beta * alpha) * Ar.transpose();
-    Lzbar = (-LzAbarAt).triangularView<Eigen::Lower>();
-  }
-  // P18: Cholesky backward: K̄zz = ½ Lz⁻ᵀ (P + Pᵀ) Lz⁻¹, P = Φ(Lzᵀ L̄z)
-  const MatX P = phi(Lz.transpose().triangularView<Eigen::Upper>() * Lzbar);
-  const MatX Ps = P + P.transpose();
-  MatX Kbar_zz = 0.5 * LzT.transpose().solve(LzT.transpose().solve(Ps).transpose());
-  Kbar_zz = 0.5 * (Kbar_zz + Kbar_zz.transpose()).eval();
 
   // P19: kernel hyperparameters and inducing points
   g.kernel = VecX::Zero(kernel_.numParams());
   MatX gZ_zz = MatX::Zero(M, Z_.cols());
   g.Z = MatX::Zero(M, Z_.cols());
-  kernel_.accumulateCrossGradient(Z_, Z_, Kbar_zz, zz_blocks, g.kernel, &gZ_zz);
-  kernel_.accumulateCrossGradient(Z_, X, Kbar_zx, zx_blocks, g.kernel, &g.Z);
+  kernel_.accumulateCrossGradient(Z_, Z_, adj.Kbar_zz, zz_blocks, g.kernel, &gZ_zz);
+  kernel_.accumulateCrossGradient(Z_, X, adj.Kbar_zx, zx_blocks, g.kernel, &g.Z);
   g.Z += 2.0 * gZ_zz;
   kernel_.accumulateDiagGradient(-0.5 * beta * Bd, g.kernel);  // k̄_n = −β/2 for every n
-  g.AAt = std::move(AAt);
-  g.Ar = std::move(Ar);
+  g.AAt = std::move(adj.AAt);
+  g.Ar = std::move(adj.Ar);
   return out;
 }
 

@@ -387,52 +387,172 @@ void setOptimalVariational(Svgp& gp, const MatX& X, const VecX& y, int num_threa
   setOptimalVariationalOn(team, gp, X, y);
 }
 
+namespace {
+
+/// The flat optimizer vector: [log θ (P) | log σ_n² | c | Z (M·D) | m (M) | L (M·M)] (P24); m and L only without
+/// natural-gradient steps (they own q(u) then).
+struct OptimizerLayout {
+  OptimizerLayout(const Svgp& gp, Eigen::Index num_dims, bool use_natgrad)
+      : P(gp.kernel().numParams()), M(gp.numInducing()), D(num_dims), natgrad(use_natgrad) {}
+  int P;
+  Eigen::Index M, D;
+  bool natgrad;
+  Eigen::Index oZ = P + 2, om = oZ + M * D, oL = om + M, n = natgrad ? om : oL + M * M;
+};
+
+/// Base learning rate of every coordinate (0 for a frozen one).
+VecX learningRates(const OptimizerLayout& o, const Svgp& gp, const SvgpTrainParams& params) {
+  const int P = o.P;
+  const Eigen::Index M = o.M, oL = o.oL;
+  VecX lr_base = VecX::Zero(o.n);
+  for (int i = 0; i < P; ++i)
+    lr_base[i] = (params.train_hyperparameters && gp.kernel().trainable()[static_cast<std::size_t>(i)]) ? params.lr : 0.0;
+  lr_base[P] = params.train_hyperparameters ? params.lr : 0.0;
+  lr_base[P + 1] = params.lr;
+  lr_base.segment(o.oZ, M * o.D).setConstant(params.train_inducing ? params.lr_inducing : 0.0);
+  if (!o.natgrad) {
+    lr_base.segment(o.om, M).setConstant(params.lr_variational);
+    for (Eigen::Index j = 0; j < M; ++j)
+      for (Eigen::Index i = j; i < M; ++i) lr_base[oL + j * M + i] = params.lr_variational;  // lower triangle
+  }
+  return lr_base;
+}
+
+/// The model's parameters into the optimizer vector x.
+void packParams(const OptimizerLayout& o, const Svgp& gp, VecX& x) {
+  const int P = o.P;
+  const Eigen::Index M = o.M;
+  x.head(P) = gp.kernel().theta().array().log().matrix();
+  x[P] = std::log(gp.noiseVariance());
+  x[P + 1] = gp.meanConstant();
+  x.segment(o.oZ, M * o.D) = Eigen::Map<const VecX>(gp.inducing().data(), M * o.D);
+  if (!o.natgrad) {
+    x.segment(o.om, M) = gp.variationalMean();
+    x.segment(o.oL, M * M) = Eigen::Map<const VecX>(gp.variationalCholesky().data(), M * M);
+  }
+}
+
+/// The optimizer vector x back into the model (noise variance floored at params.min_noise_variance).
+void unpackParams(const OptimizerLayout& o, const SvgpTrainParams& params, const VecX& x, Svgp& gp) {
+  const int P = o.P;
+  const Eigen::Index M = o.M;
+  gp.kernel().setTheta(x.head(P).array().exp().matrix());
+  gp.setNoiseVariance(std::max(std::exp(x[P]), params.min_noise_variance));
+  gp.setMean(x[P + 1]);
+  gp.setInducing(Eigen::Map<const MatX>(x.data() + o.oZ, M, o.D));
+  if (!o.natgrad) gp.setVariational(x.segment(o.om, M), Eigen::Map<const MatX>(x.data() + o.oL, M, M));
+}
+
+/// Ascent direction in the optimizer coordinates (log-space chain rule for positive parameters).
+void gradientVector(const OptimizerLayout& o, const SvgpGradient& g, const Svgp& gp, VecX& grad) {
+  const int P = o.P;
+  const Eigen::Index M = o.M;
+  grad.head(P) = g.kernel.cwiseProduct(gp.kernel().theta());
+  grad[P] = g.noise * gp.noiseVariance();
+  grad[P + 1] = g.mean;
+  grad.segment(o.oZ, M * o.D) = Eigen::Map<const VecX>(g.Z.data(), M * o.D);
+  if (!o.natgrad) {
+    grad.segment(o.om, M) = g.m;
+    grad.segment(o.oL, M * M) = Eigen::Map<const VecX>(g.L.data(), M * M);
+  }
+}
+
+/// Per thread: its contiguous part of the minibatch, its ELBO terms and gradient (P42).
+struct BatchParts {
+  explicit BatchParts(int T)
+      : Xb(static_cast<std::size_t>(T)),
+        yb(static_cast<std::size_t>(T)),
+        gt(static_cast<std::size_t>(T)),
+        et(static_cast<std::size_t>(T)),
+        part_size(static_cast<std::size_t>(T)) {}
+  std::vector<MatX> Xb;
+  std::vector<VecX> yb;
+  std::vector<SvgpGradient> gt;
+  std::vector<ElboTerms> et;
+  std::vector<Eigen::Index> part_size;
+};
+
+/// P42: every thread gathers and evaluates its contiguous part of the batch perm[start … start + size − 1] into w;
+/// returns the number of parts used.
+int evaluateBatchParts(ThreadTeam& team, const Svgp& gp, const MatX& X, const VecX& y,
+                       const std::vector<Eigen::Index>& perm, Eigen::Index start, Eigen::Index size, ElboMode mode,
+                       BatchParts& w) {
+  const int parts = static_cast<int>(std::min<Eigen::Index>(team.size(), size));
+  const Eigen::Index N = X.rows(), D = X.cols();
+  team.run([&](int t) {
+    const std::size_t ti = static_cast<std::size_t>(t);
+    w.part_size[ti] = 0;
+    if (t >= parts) return;
+    const auto [begin, end] = partRange(size, parts, t);
+    w.part_size[ti] = end - begin;
+    w.Xb[ti].resize(end - begin, D);
+    w.yb[ti].resize(end - begin);
+    for (Eigen::Index i = begin; i < end; ++i) {
+      const Eigen::Index src = perm[static_cast<std::size_t>(start + i)];
+      w.Xb[ti].row(i - begin) = X.row(src);
+      w.yb[ti][i - begin] = y[src];
+    }
+    w.et[ti] = gp.elbo(w.Xb[ti], w.yb[ti], static_cast<double>(N), &w.gt[ti], mode);
+  });
+  return parts;
+}
+
+/// P42: the batch ELBO and gradient are the size-weighted sums of the parts' per-datum values (every term is an
+/// average over data or data-free), A Aᵀ and A r are plain sums. Parts are added in thread order: deterministic for a
+/// given thread count. Returns the batch ELBO; g receives the gradient.
+double sumBatchParts(const BatchParts& w, int parts, Eigen::Index size, bool natgrad, SvgpGradient& g) {
+  const auto& gt = w.gt;
+  double elbo = 0.0;
+  for (int t = 0; t < parts; ++t) {
+    const std::size_t ti = static_cast<std::size_t>(t);
+    const double wt = static_cast<double>(w.part_size[ti]) / static_cast<double>(size);
+    elbo += wt * w.et[ti].elbo;
+    if (t == 0) {
+      g.kernel = wt * gt[0].kernel;
+      g.noise = wt * gt[0].noise;
+      g.mean = wt * gt[0].mean;
+      g.Z = wt * gt[0].Z;
+      g.AAt = gt[0].AAt;
+      g.Ar = gt[0].Ar;
+      if (!natgrad) {
+        g.m = wt * gt[0].m;
+        g.L = wt * gt[0].L;
+      }
+    } else {
+      g.kernel += wt * gt[ti].kernel;
+      g.noise += wt * gt[ti].noise;
+      g.mean += wt * gt[ti].mean;
+      g.Z += wt * gt[ti].Z;
+      g.AAt += gt[ti].AAt;
+      g.Ar += gt[ti].Ar;
+      if (!natgrad) {
+        g.m += wt * gt[ti].m;
+        g.L += wt * gt[ti].L;
+      }
+    }
+  }
+  return elbo;
+}
+
+}  // namespace
+
 SvgpTrainSummary trainSvgp(Svgp& gp, const MatX& X, const VecX& y, const SvgpTrainParams& params, const MatX* X_val,
                            const VecX* y_val, const std::function<void(const EpochReport&)>& on_epoch) {
   params.validate();
   if (X.rows() != y.size() || X.rows() == 0) throw std::invalid_argument("trainSvgp: X and y mismatch or empty");
   const auto t0 = std::chrono::steady_clock::now();
-  const Eigen::Index N = X.rows(), D = X.cols(), M = gp.numInducing();
+  const Eigen::Index N = X.rows();
   const std::vector<Eigen::Index> batch_sizes = balancedBatchSizes(N, std::min<Eigen::Index>(params.batch_size, N));
   const Eigen::Index nbatches = static_cast<Eigen::Index>(batch_sizes.size());
   const bool natgrad = params.natgrad_step > 0;
-  const int P = gp.kernel().numParams();
   ThreadTeam team(resolveThreads(params.num_threads));
   const int T = team.size();
 
-  // Flat optimizer vector: [log θ (P) | log σ_n² | c | Z (M·D) | m (M) | L (M·M)]  (P24)
-  const Eigen::Index oZ = P + 2, om = oZ + M * D, oL = om + M, n = natgrad ? om : oL + M * M;
-  VecX lr_base = VecX::Zero(n);
-  for (int i = 0; i < P; ++i)
-    lr_base[i] = (params.train_hyperparameters && gp.kernel().trainable()[static_cast<std::size_t>(i)]) ? params.lr : 0.0;
-  lr_base[P] = params.train_hyperparameters ? params.lr : 0.0;
-  lr_base[P + 1] = params.lr;
-  lr_base.segment(oZ, M * D).setConstant(params.train_inducing ? params.lr_inducing : 0.0);
-  if (!natgrad) {
-    lr_base.segment(om, M).setConstant(params.lr_variational);
-    for (Eigen::Index j = 0; j < M; ++j)
-      for (Eigen::Index i = j; i < M; ++i) lr_base[oL + j * M + i] = params.lr_variational;  // lower triangle
-  }
-  Adam adam(n);
-  VecX x(n);
-  auto pack = [&] {
-    x.head(P) = gp.kernel().theta().array().log().matrix();
-    x[P] = std::log(gp.noiseVariance());
-    x[P + 1] = gp.meanConstant();
-    x.segment(oZ, M * D) = Eigen::Map<const VecX>(gp.inducing().data(), M * D);
-    if (!natgrad) {
-      x.segment(om, M) = gp.variationalMean();
-      x.segment(oL, M * M) = Eigen::Map<const VecX>(gp.variationalCholesky().data(), M * M);
-    }
-  };
-  auto unpack = [&] {
-    gp.kernel().setTheta(x.head(P).array().exp().matrix());
-    gp.setNoiseVariance(std::max(std::exp(x[P]), params.min_noise_variance));
-    gp.setMean(x[P + 1]);
-    gp.setInducing(Eigen::Map<const MatX>(x.data() + oZ, M, D));
-    if (!natgrad) gp.setVariational(x.segment(om, M), Eigen::Map<const MatX>(x.data() + oL, M, M));
-  };
-  pack();
+  const OptimizerLayout layout(gp, X.cols(), natgrad);  // (P24)
+  const VecX lr_base = learningRates(layout, gp, params);
+  Adam adam(layout.n);
+  VecX x(layout.n);
+  packParams(layout, gp, x);
 
   NaturalParams nat;
   if (natgrad) nat = NaturalParams::fromSvgp(gp);
@@ -442,13 +562,8 @@ SvgpTrainSummary trainSvgp(Svgp& gp, const MatX& X, const VecX& y, const SvgpTra
   const double total_steps = static_cast<double>(params.epochs * nbatches);
   SvgpTrainSummary summary;
   summary.batches_per_epoch = static_cast<int>(nbatches);
-  // Per thread: its contiguous part of the minibatch, its ELBO terms and gradient (P42).
-  std::vector<MatX> Xb(static_cast<std::size_t>(T));
-  std::vector<VecX> yb(static_cast<std::size_t>(T));
-  std::vector<SvgpGradient> gt(static_cast<std::size_t>(T));
-  std::vector<ElboTerms> et(static_cast<std::size_t>(T));
-  std::vector<Eigen::Index> part_size(static_cast<std::size_t>(T));
-  VecX grad(n);
+  BatchParts batch_parts(T);
+  VecX grad(layout.n);
   SvgpGradient g;
   for (int epoch = 1; epoch <= params.epochs; ++epoch) {
     std::shuffle(perm.begin(), perm.end(), rng);
@@ -456,73 +571,18 @@ SvgpTrainSummary trainSvgp(Svgp& gp, const MatX& X, const VecX& y, const SvgpTra
     Eigen::Index start = 0;
     for (Eigen::Index b = 0; b < nbatches; ++b) {
       const Eigen::Index size = batch_sizes[static_cast<std::size_t>(b)];
-      const int parts = static_cast<int>(std::min<Eigen::Index>(T, size));
-      // P42: every thread gathers and evaluates its contiguous part of the batch; the batch ELBO and gradient are
-      // the size-weighted sums of the parts' per-datum values (every term is an average over data or data-free),
-      // A Aᵀ and A r are plain sums. Parts are added in thread order: deterministic for a given thread count.
-      team.run([&](int t) {
-        const std::size_t ti = static_cast<std::size_t>(t);
-        part_size[ti] = 0;
-        if (t >= parts) return;
-        const auto [begin, end] = partRange(size, parts, t);
-        part_size[ti] = end - begin;
-        Xb[ti].resize(end - begin, D);
-        yb[ti].resize(end - begin);
-        for (Eigen::Index i = begin; i < end; ++i) {
-          const Eigen::Index src = perm[static_cast<std::size_t>(start + i)];
-          Xb[ti].row(i - begin) = X.row(src);
-          yb[ti][i - begin] = y[src];
-        }
-        et[ti] = gp.elbo(Xb[ti], yb[ti], static_cast<double>(N), &gt[ti], params.mode);
-      });
+      const int parts = evaluateBatchParts(team, gp, X, y, perm, start, size, params.mode, batch_parts);
       start += size;
-      double elbo = 0.0;
-      for (int t = 0; t < parts; ++t) {
-        const std::size_t ti = static_cast<std::size_t>(t);
-        const double w = static_cast<double>(part_size[ti]) / static_cast<double>(size);
-        elbo += w * et[ti].elbo;
-        if (t == 0) {
-          g.kernel = w * gt[0].kernel;
-          g.noise = w * gt[0].noise;
-          g.mean = w * gt[0].mean;
-          g.Z = w * gt[0].Z;
-          g.AAt = gt[0].AAt;
-          g.Ar = gt[0].Ar;
-          if (!natgrad) {
-            g.m = w * gt[0].m;
-            g.L = w * gt[0].L;
-          }
-        } else {
-          g.kernel += w * gt[ti].kernel;
-          g.noise += w * gt[ti].noise;
-          g.mean += w * gt[ti].mean;
-          g.Z += w * gt[ti].Z;
-          g.AAt += gt[ti].AAt;
-          g.Ar += gt[ti].Ar;
-          if (!natgrad) {
-            g.m += w * gt[ti].m;
-            g.L += w * gt[ti].L;
-          }
-        }
-      }
-      elbo_sum += elbo;
+      elbo_sum += sumBatchParts(batch_parts, parts, size, natgrad, g);
       if (natgrad) {
         const VecX Ay = g.Ar + g.AAt * gp.variationalMean();  // A (y − c) = A r + A Aᵀ m
         naturalGradientStep(gp, nat, g.AAt, Ay, static_cast<double>(size), static_cast<double>(N), params.natgrad_step);
       }
-      // ascent direction in the optimizer coordinates (log-space chain rule for positive parameters)
-      grad.head(P) = g.kernel.cwiseProduct(gp.kernel().theta());
-      grad[P] = g.noise * gp.noiseVariance();
-      grad[P + 1] = g.mean;
-      grad.segment(oZ, M * D) = Eigen::Map<const VecX>(g.Z.data(), M * D);
-      if (!natgrad) {
-        grad.segment(om, M) = g.m;
-        grad.segment(oL, M * M) = Eigen::Map<const VecX>(g.L.data(), M * M);
-      }
+      gradientVector(layout, g, gp, grad);
       const double progress = static_cast<double>(summary.steps) / std::max(1.0, total_steps - 1.0);
       const double decay = std::pow(params.lr_final_fraction, progress);  // exponential schedule
       adam.ascend(x, grad, lr_base * decay);
-      unpack();
+      unpackParams(layout, params, x, gp);
       ++summary.steps;
     }
     const bool last = epoch == params.epochs;

@@ -17,6 +17,11 @@
 
 #include "uwb/core/Error.h"
 
+namespace uwb {
+struct Flight;
+enum class Stream;
+}  // namespace uwb
+
 namespace uwb::io_detail {
 
 /// Whole file as one string; FileError when it cannot be opened or read, or is a directory or device
@@ -87,6 +92,26 @@ inline void splitCells(const char* b, const char* e, std::vector<std::string_vie
   forEachCell(b, e, [&](std::size_t, const char* tb, const char* te) {
     cells.emplace_back(tb, static_cast<std::size_t>(te - tb));
   });
+}
+
+/// The number of samples of one stream of the flight (UtilCsv.cpp).
+std::size_t streamSize(const Flight& flight, Stream stream);
+
+/// Whether a line that starts with '#' is a comment (skipped) or data.
+enum class HashComments { kData, kSkip };
+
+/// Advances `lines` to the next line that is not blank after trimming (nor a '#' comment with kSkip) and splits it
+/// into `cells`; false at the end of the text. lines.line() is then the number of that line.
+inline bool nextCells(LineCursor& lines, std::vector<std::string_view>& cells, HashComments comments) {
+  const char* b = nullptr;
+  const char* e = nullptr;
+  while (lines.next(b, e)) {
+    trim(b, e);
+    if (b == e || (comments == HashComments::kSkip && *b == '#')) continue;  // blank lines (and comments)
+    splitCells(b, e, cells);
+    return true;
+  }
+  return false;
 }
 
 enum class NumberStatus { kOk, kNotANumber, kOutOfRange, kNonFinite };

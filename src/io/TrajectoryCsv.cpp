@@ -69,13 +69,8 @@ Trajectory parseTrajectoryCsv(std::string_view text, const std::string& path) {
   std::vector<std::string> names;
   Trajectory out;
   std::vector<std::string_view> cells;
-  const char* b = nullptr;
-  const char* e = nullptr;
-  while (lines.next(b, e)) {
+  while (io_detail::nextCells(lines, cells, io_detail::HashComments::kData)) {
     const std::size_t line = lines.line();
-    io_detail::trim(b, e);
-    if (b == e) continue;
-    io_detail::splitCells(b, e, cells);
     if (names.empty()) {  // header
       for (std::size_t i = 0; i < cells.size(); ++i) {
         names.emplace_back(cells[i]);

@@ -280,13 +280,16 @@ Flight importUsdLog(const std::string& path, const UsdReadOptions& options, UsdI
   return flightFromUsdLog(log, &rep);
 }
 
-UsdLog usdLogFromFlight(const Flight& flight) {
-  UsdLog log;
-  log.version = 2;
-  log.source = flight.source;
+namespace {
+
+/// (stream, event type index) of the types declared in a log, in UTIL column order.
+using DeclaredTypes = std::vector<std::pair<Stream, std::size_t>>;
+
+/// Declares one event type per stream (ids 1, 2, … in UTIL column order, also for the streams left out); returns
+/// those of the streams the flight has.
+DeclaredTypes declareEventTypes(const Flight& flight, UsdLog& log) {
   constexpr auto F = UsdType::kFloat;
-  // (stream, event type index) of the types declared, in UTIL column order.
-  std::vector<std::pair<Stream, std::size_t>> declared;
+  DeclaredTypes declared;
   std::uint16_t next_id = 1;
   const auto declare = [&](Stream s, const char* name, std::vector<std::pair<std::string, UsdType>> fields) {
     if (flight.has(s)) declared.emplace_back(s, log.addType(next_id, name, fields));
@@ -305,77 +308,84 @@ UsdLog usdLogFromFlight(const Flight& flight) {
   } else {
     declare(Stream::kPose, "estPose", {{"locSrv.x", F}, {"locSrv.y", F}, {"locSrv.z", F}});
   }
+  return declared;
+}
 
+double sampleTime(const Flight& flight, Stream s, std::size_t i) {
+  switch (s) {
+    case Stream::kTdoa: return flight.tdoa[i].t_s;
+    case Stream::kTwr: return flight.twr[i].t_s;
+    case Stream::kAcc: return flight.acc[i].t_s;
+    case Stream::kGyro: return flight.gyro[i].t_s;
+    case Stream::kTof: return flight.tof[i].t_s;
+    case Stream::kFlow: return flight.flow[i].t_s;
+    case Stream::kBaro: return flight.baro[i].t_s;
+    case Stream::kPose: return flight.pose[i].t_s;
+  }
+  return 0.0;
+}
+
+/// Events of all streams by time (ties: UTIL column order, then sample order): (t_us, declared index, sample).
+std::vector<std::tuple<std::uint64_t, std::size_t, std::size_t>> eventOrder(const Flight& flight,
+                                                                            const DeclaredTypes& declared) {
   const auto micros = [](double t) {
     if (!(t >= 0.0) || t * kMicro > 9.0e15) throw std::invalid_argument(fmt::format("time {} s cannot be a log timestamp", t));
     return static_cast<std::uint64_t>(std::llround(t * kMicro));
   };
-  const auto g = [](double x) { return io_detail::unscaleExactly(x, kGravity_mps2); };
-  const auto deg = [](double x) { return io_detail::unscaleExactly(x, kDegToRad); };
-  // Events of all streams by time (ties: UTIL column order, then sample order).
-  std::vector<std::tuple<std::uint64_t, std::size_t, std::size_t>> order;  // (t_us, declared index, sample)
-  const auto sizeOf = [&](Stream s) -> std::size_t {
-    switch (s) {
-      case Stream::kTdoa: return flight.tdoa.size();
-      case Stream::kTwr: return flight.twr.size();
-      case Stream::kAcc: return flight.acc.size();
-      case Stream::kGyro: return flight.gyro.size();
-      case Stream::kTof: return flight.tof.size();
-      case Stream::kFlow: return flight.flow.size();
-      case Stream::kBaro: return flight.baro.size();
-      case Stream::kPose: return flight.pose.size();
-    }
-    return 0;
-  };
-  const auto timeOf = [&](Stream s, std::size_t i) -> double {
-    switch (s) {
-      case Stream::kTdoa: return flight.tdoa[i].t_s;
-      case Stream::kTwr: return flight.twr[i].t_s;
-      case Stream::kAcc: return flight.acc[i].t_s;
-      case Stream::kGyro: return flight.gyro[i].t_s;
-      case Stream::kTof: return flight.tof[i].t_s;
-      case Stream::kFlow: return flight.flow[i].t_s;
-      case Stream::kBaro: return flight.baro[i].t_s;
-      case Stream::kPose: return flight.pose[i].t_s;
-    }
-    return 0.0;
-  };
+  std::vector<std::tuple<std::uint64_t, std::size_t, std::size_t>> order;
   for (std::size_t d = 0; d < declared.size(); ++d) {
-    for (std::size_t i = 0; i < sizeOf(declared[d].first); ++i) order.emplace_back(micros(timeOf(declared[d].first, i)), d, i);
+    const Stream s = declared[d].first;
+    for (std::size_t i = 0; i < io_detail::streamSize(flight, s); ++i) order.emplace_back(micros(sampleTime(flight, s, i)), d, i);
   }
   std::sort(order.begin(), order.end());
-  for (const auto& [t_us, d, i] : order) {
-    const std::size_t type = declared[d].second;
-    switch (declared[d].first) {
-      case Stream::kTdoa: {
-        const auto& m = flight.tdoa[i];
-        log.addEvent(type, t_us, {double(m.id_a), double(m.id_b), m.tdoa_m});
-        break;
-      }
-      case Stream::kTwr: log.addEvent(type, t_us, {double(flight.twr[i].anchor_id), flight.twr[i].range_m}); break;
-      case Stream::kAcc: {
-        const Vec3& a = flight.acc[i].b_value;
-        log.addEvent(type, t_us, {g(a.x()), g(a.y()), g(a.z())});
-        break;
-      }
-      case Stream::kGyro: {
-        const Vec3& w = flight.gyro[i].b_value;
-        log.addEvent(type, t_us, {deg(w.x()), deg(w.y()), deg(w.z())});
-        break;
-      }
-      case Stream::kTof: log.addEvent(type, t_us, {std::nearbyint(flight.tof[i].value * kMmPerM)}); break;
-      case Stream::kFlow: log.addEvent(type, t_us, {flight.flow[i].delta_x, flight.flow[i].delta_y}); break;
-      case Stream::kBaro: log.addEvent(type, t_us, {flight.baro[i].value}); break;
-      case Stream::kPose: {
-        const PoseSample& p = flight.pose[i];
-        if (flight.pose_has_orientation) {
-          log.addEvent(type, t_us, {p.w_p_b.x(), p.w_p_b.y(), p.w_p_b.z(), p.w_q_b.x(), p.w_q_b.y(), p.w_q_b.z(), p.w_q_b.w()});
-        } else {
-          log.addEvent(type, t_us, {p.w_p_b.x(), p.w_p_b.y(), p.w_p_b.z()});
-        }
-        break;
-      }
+  return order;
+}
+
+/// Sample i of stream s as an event of the given type, in the log's units (g, deg/s, mm).
+void addSampleEvent(UsdLog& log, const Flight& flight, Stream s, std::size_t type, std::uint64_t t_us, std::size_t i) {
+  const auto g = [](double x) { return io_detail::unscaleExactly(x, kGravity_mps2); };
+  const auto deg = [](double x) { return io_detail::unscaleExactly(x, kDegToRad); };
+  switch (s) {
+    case Stream::kTdoa: {
+      const auto& m = flight.tdoa[i];
+      log.addEvent(type, t_us, {double(m.id_a), double(m.id_b), m.tdoa_m});
+      break;
     }
+    case Stream::kTwr: log.addEvent(type, t_us, {double(flight.twr[i].anchor_id), flight.twr[i].range_m}); break;
+    case Stream::kAcc: {
+      const Vec3& a = flight.acc[i].b_value;
+      log.addEvent(type, t_us, {g(a.x()), g(a.y()), g(a.z())});
+      break;
+    }
+    case Stream::kGyro: {
+      const Vec3& w = flight.gyro[i].b_value;
+      log.addEvent(type, t_us, {deg(w.x()), deg(w.y()), deg(w.z())});
+      break;
+    }
+    case Stream::kTof: log.addEvent(type, t_us, {std::nearbyint(flight.tof[i].value * kMmPerM)}); break;
+    case Stream::kFlow: log.addEvent(type, t_us, {flight.flow[i].delta_x, flight.flow[i].delta_y}); break;
+    case Stream::kBaro: log.addEvent(type, t_us, {flight.baro[i].value}); break;
+    case Stream::kPose: {
+      const PoseSample& p = flight.pose[i];
+      if (flight.pose_has_orientation) {
+        log.addEvent(type, t_us, {p.w_p_b.x(), p.w_p_b.y(), p.w_p_b.z(), p.w_q_b.x(), p.w_q_b.y(), p.w_q_b.z(), p.w_q_b.w()});
+      } else {
+        log.addEvent(type, t_us, {p.w_p_b.x(), p.w_p_b.y(), p.w_p_b.z()});
+      }
+      break;
+    }
+  }
+}
+
+}  // namespace
+
+UsdLog usdLogFromFlight(const Flight& flight) {
+  UsdLog log;
+  log.version = 2;
+  log.source = flight.source;
+  const DeclaredTypes declared = declareEventTypes(flight, log);
+  for (const auto& [t_us, d, i] : eventOrder(flight, declared)) {
+    addSampleEvent(log, flight, declared[d].first, declared[d].second, t_us, i);
   }
   return log;
 }

@@ -521,6 +521,20 @@ Flight parseFlightCsv(std::string_view text, const std::string& source, const Fl
 
 // ------------------------------------------------------------------------------------------------ writer
 
+std::size_t io_detail::streamSize(const Flight& f, Stream s) {
+  switch (s) {
+    case Stream::kTdoa: return f.tdoa.size();
+    case Stream::kTwr: return f.twr.size();
+    case Stream::kAcc: return f.acc.size();
+    case Stream::kGyro: return f.gyro.size();
+    case Stream::kTof: return f.tof.size();
+    case Stream::kFlow: return f.flow.size();
+    case Stream::kBaro: return f.baro.size();
+    case Stream::kPose: return f.pose.size();
+  }
+  return 0;
+}
+
 namespace {
 
 std::vector<std::string> defaultColumns(const Flight& flight) {
@@ -535,30 +549,12 @@ std::vector<std::string> defaultColumns(const Flight& flight) {
   return cols;
 }
 
-std::size_t streamSize(const Flight& f, Stream s) {
-  switch (s) {
-    case Stream::kTdoa: return f.tdoa.size();
-    case Stream::kTwr: return f.twr.size();
-    case Stream::kAcc: return f.acc.size();
-    case Stream::kGyro: return f.gyro.size();
-    case Stream::kTof: return f.tof.size();
-    case Stream::kFlow: return f.flow.size();
-    case Stream::kBaro: return f.baro.size();
-    case Stream::kPose: return f.pose.size();
-  }
-  return 0;
-}
-
-}  // namespace
-
-std::string formatFlightCsv(const Flight& flight) {
-  const std::vector<std::string> names = flight.columns.empty() ? defaultColumns(flight) : flight.columns;
-  const Layout layout = makeLayout(names, [](std::size_t i, const std::string&, const std::string& msg) {
-    throw std::invalid_argument(fmt::format("writeFlightCsv: flight.columns[{}]: {}", i, msg));
-  });
+/// The number of rows the flight needs; throws when a stream with samples has no column or the pose quaternion
+/// columns disagree with flight.pose_has_orientation.
+std::size_t checkedRowCount(const Flight& flight, const Layout& layout) {
   std::size_t n_rows = 0;
   for (Stream s : allStreams()) {
-    const std::size_t n = streamSize(flight, s);
+    const std::size_t n = io_detail::streamSize(flight, s);
     if (n > 0 && !layout.present[streamIndex(s)]) {
       throw std::invalid_argument(fmt::format(
           "writeFlightCsv: stream '{}' holds {} samples but flight.columns has none of its columns", streamName(s), n));
@@ -570,6 +566,70 @@ std::string formatFlightCsv(const Flight& flight) {
     throw std::invalid_argument(
         "writeFlightCsv: flight.columns and flight.pose_has_orientation disagree about the pose quaternion");
   }
+  return n_rows;
+}
+
+/// Appends field f of sample r of stream s in the file's units (g, deg/s for the IMU).
+void appendCell(std::string& out, const Flight& flight, Stream s, int f, std::size_t r) {
+  using io_detail::appendDouble;
+  using io_detail::appendInt;
+  using io_detail::unscaleExactly;
+  switch (s) {
+    case Stream::kTdoa: {
+      const TdoaMeasurement& m = flight.tdoa[r];
+      if (f == 0) appendDouble(out, m.t_s);
+      else if (f == 1) appendInt(out, m.id_a);
+      else if (f == 2) appendInt(out, m.id_b);
+      else appendDouble(out, m.tdoa_m);
+      break;
+    }
+    case Stream::kTwr: {
+      const TwrMeasurement& m = flight.twr[r];
+      if (f == 0) appendDouble(out, m.t_s);
+      else if (f == 1) appendInt(out, m.anchor_id);
+      else appendDouble(out, m.range_m);
+      break;
+    }
+    case Stream::kAcc:
+    case Stream::kGyro: {
+      const bool acc = s == Stream::kAcc;
+      const ImuSample& m = acc ? flight.acc[r] : flight.gyro[r];
+      if (f == 0) appendDouble(out, m.t_s);
+      else appendDouble(out, unscaleExactly(m.b_value[f - 1], acc ? kGravity_mps2 : kDegToRad));
+      break;
+    }
+    case Stream::kTof: appendDouble(out, f == 0 ? flight.tof[r].t_s : flight.tof[r].value); break;
+    case Stream::kBaro: appendDouble(out, f == 0 ? flight.baro[r].t_s : flight.baro[r].value); break;
+    case Stream::kFlow: {
+      const FlowSample& m = flight.flow[r];
+      appendDouble(out, f == 0 ? m.t_s : f == 1 ? m.delta_x : m.delta_y);
+      break;
+    }
+    case Stream::kPose: {
+      const PoseSample& m = flight.pose[r];
+      switch (f) {
+        case 0: appendDouble(out, m.t_s); break;
+        case 1: appendDouble(out, m.w_p_b.x()); break;
+        case 2: appendDouble(out, m.w_p_b.y()); break;
+        case 3: appendDouble(out, m.w_p_b.z()); break;
+        case 4: appendDouble(out, m.w_q_b.x()); break;
+        case 5: appendDouble(out, m.w_q_b.y()); break;
+        case 6: appendDouble(out, m.w_q_b.z()); break;
+        default: appendDouble(out, m.w_q_b.w()); break;
+      }
+      break;
+    }
+  }
+}
+
+}  // namespace
+
+std::string formatFlightCsv(const Flight& flight) {
+  const std::vector<std::string> names = flight.columns.empty() ? defaultColumns(flight) : flight.columns;
+  const Layout layout = makeLayout(names, [](std::size_t i, const std::string&, const std::string& msg) {
+    throw std::invalid_argument(fmt::format("writeFlightCsv: flight.columns[{}]: {}", i, msg));
+  });
+  const std::size_t n_rows = checkedRowCount(flight, layout);
 
   // Column → (stream, field).
   struct Slot {
@@ -589,65 +649,11 @@ std::string formatFlightCsv(const Flight& flight) {
     out += names[i];
   }
   out.push_back('\n');
-
-  using io_detail::appendDouble;
-  using io_detail::appendInt;
-  using io_detail::unscaleExactly;
   for (std::size_t r = 0; r < n_rows; ++r) {
     for (std::size_t i = 0; i < slots.size(); ++i) {
       if (i > 0) out.push_back(',');
       const auto [s, f] = slots[i];
-      if (r >= streamSize(flight, s)) continue;
-      switch (s) {
-        case Stream::kTdoa: {
-          const TdoaMeasurement& m = flight.tdoa[r];
-          if (f == 0) appendDouble(out, m.t_s);
-          else if (f == 1) appendInt(out, m.id_a);
-          else if (f == 2) appendInt(out, m.id_b);
-          else appendDouble(out, m.tdoa_m);
-          break;
-        }
-        case Stream::kTwr: {
-          const TwrMeasurement& m = flight.twr[r];
-          if (f == 0) appendDouble(out, m.t_s);
-          else if (f == 1) appendInt(out, m.anchor_id);
-          else appendDouble(out, m.range_m);
-          break;
-        }
-        case Stream::kAcc: {
-          const ImuSample& m = flight.acc[r];
-          if (f == 0) appendDouble(out, m.t_s);
-          else appendDouble(out, unscaleExactly(m.b_value[f - 1], kGravity_mps2));
-          break;
-        }
-        case Stream::kGyro: {
-          const ImuSample& m = flight.gyro[r];
-          if (f == 0) appendDouble(out, m.t_s);
-          else appendDouble(out, unscaleExactly(m.b_value[f - 1], kDegToRad));
-          break;
-        }
-        case Stream::kTof: appendDouble(out, f == 0 ? flight.tof[r].t_s : flight.tof[r].value); break;
-        case Stream::kBaro: appendDouble(out, f == 0 ? flight.baro[r].t_s : flight.baro[r].value); break;
-        case Stream::kFlow: {
-          const FlowSample& m = flight.flow[r];
-          appendDouble(out, f == 0 ? m.t_s : f == 1 ? m.delta_x : m.delta_y);
-          break;
-        }
-        case Stream::kPose: {
-          const PoseSample& m = flight.pose[r];
-          switch (f) {
-            case 0: appendDouble(out, m.t_s); break;
-            case 1: appendDouble(out, m.w_p_b.x()); break;
-            case 2: appendDouble(out, m.w_p_b.y()); break;
-            case 3: appendDouble(out, m.w_p_b.z()); break;
-            case 4: appendDouble(out, m.w_q_b.x()); break;
-            case 5: appendDouble(out, m.w_q_b.y()); break;
-            case 6: appendDouble(out, m.w_q_b.z()); break;
-            default: appendDouble(out, m.w_q_b.w()); break;
-          }
-          break;
-        }
-      }
+      if (r < io_detail::streamSize(flight, s)) appendCell(out, flight, s, f, r);
     }
     out.push_back('\n');
   }

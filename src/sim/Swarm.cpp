@@ -112,41 +112,56 @@ SwarmScenario makeSwarmScenario(const std::string& name, int n_agents, double du
   return sc;
 }
 
-SwarmSimResult simulateSwarm(const SwarmScenario& scenario, const SimParams& params, std::uint64_t seed) {
-  scenario.twr.validate();
-  if (scenario.agents.empty()) throw std::invalid_argument("simulateSwarm: no agents");
-  SwarmSimResult out;
-  const int n = static_cast<int>(scenario.agents.size());
-  std::vector<Trajectory> traj;
-  traj.reserve(scenario.agents.size());
-  for (int k = 0; k < n; ++k) {
-    const SwarmAgentSpec& spec = scenario.agents[static_cast<std::size_t>(k)];
-    SimResult r = simulateFlight(Scenario{scenario.survey, spec.trajectory}, params, seed * 1000u + static_cast<unsigned>(k));
-    // (S23) occlusion: a TDoA involving a hidden anchor is not received
-    if (!spec.occlusions.empty()) {
-      std::vector<TdoaMeasurement> kept;
-      std::vector<TdoaTruth> kept_truth;
-      for (std::size_t i = 0; i < r.flight.tdoa.size(); ++i) {
-        const TdoaMeasurement& z = r.flight.tdoa[i];
-        bool hidden = false;
-        for (const Occlusion& o : spec.occlusions) {
-          if (z.t_s < o.t0_s || z.t_s > o.t1_s) continue;
-          for (int id : o.hidden_anchor_ids) hidden = hidden || id == z.id_a || id == z.id_b;
-        }
-        if (hidden) continue;
-        kept.push_back(z);
-        kept_truth.push_back(r.tdoa_truth[i]);
-      }
-      r.flight.tdoa = std::move(kept);
-      r.tdoa_truth = std::move(kept_truth);
+namespace {
+
+// (S23) occlusion: a TDoA involving a hidden anchor is not received
+void dropOccluded(const std::vector<Occlusion>& occlusions, SimResult& r) {
+  if (occlusions.empty()) return;
+  std::vector<TdoaMeasurement> kept;
+  std::vector<TdoaTruth> kept_truth;
+  for (std::size_t i = 0; i < r.flight.tdoa.size(); ++i) {
+    const TdoaMeasurement& z = r.flight.tdoa[i];
+    bool hidden = false;
+    for (const Occlusion& o : occlusions) {
+      if (z.t_s < o.t0_s || z.t_s > o.t1_s) continue;
+      for (int id : o.hidden_anchor_ids) hidden = hidden || id == z.id_a || id == z.id_b;
     }
-    if (k == 0) out.survey = r.survey;
-    out.agents.push_back(std::move(r));
-    traj.emplace_back(spec.trajectory);
+    if (hidden) continue;
+    kept.push_back(z);
+    kept_truth.push_back(r.tdoa_truth[i]);
   }
-  // (S22) TWR rounds at twr.rate_hz: each agent picks its max_partners nearest agents within radio range; every
-  // chosen pair ranges once per round at a jittered stamp, |p_tag,i − p_tag,j| + white noise, delivered to both.
-  const TwrParams& tw = scenario.twr;
+  r.flight.tdoa = std::move(kept);
+  r.tdoa_truth = std::move(kept_truth);
+}
+
+/// (S22) One round's pairs: each agent picks its max_partners nearest agents within radio range; chosen[i·n + j]
+/// (i < j) marks a pair. by_distance is scratch space.
+void chooseTwrPairs(const std::vector<Vec3>& p, const TwrParams& tw, std::vector<char>& chosen,
+                    std::vector<std::pair<double, int>>& by_distance) {
+  const int n = static_cast<int>(p.size());
+  std::fill(chosen.begin(), chosen.end(), 0);
+  for (int i = 0; i < n; ++i) {
+    by_distance.clear();
+    for (int j = 0; j < n; ++j) {
+      if (j == i) continue;
+      const double d = (p[static_cast<std::size_t>(i)] - p[static_cast<std::size_t>(j)]).norm();
+      if (d <= tw.radio_range_m) by_distance.push_back({d, j});
+    }
+    const std::size_t m = std::min<std::size_t>(by_distance.size(), static_cast<std::size_t>(tw.max_partners));
+    std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(m), by_distance.end());
+    for (std::size_t q = 0; q < m; ++q) {
+      const int j = by_distance[q].second;
+      chosen[static_cast<std::size_t>(std::min(i, j) * n + std::max(i, j))] = 1;
+    }
+  }
+}
+
+// (S22) TWR rounds at twr.rate_hz: each agent picks its max_partners nearest agents within radio range; every
+// chosen pair ranges once per round at a jittered stamp, |p_tag,i − p_tag,j| + white noise, delivered to both.
+std::vector<TwrObservation> simulateTwr(const std::vector<Trajectory>& traj, const TwrParams& tw,
+                                        const SimParams& params, std::uint64_t seed) {
+  const int n = static_cast<int>(traj.size());
+  std::vector<TwrObservation> twr;
   std::seed_seq seq{static_cast<std::uint32_t>(seed & 0xffffffffu), static_cast<std::uint32_t>(seed >> 32),
                     0x74777221u /* "twr!" */};
   std::mt19937_64 rng(seq);
@@ -166,33 +181,40 @@ SwarmSimResult simulateSwarm(const SwarmScenario& scenario, const SimParams& par
     const double t_round = static_cast<double>(round) * dt;
     if (t_round > duration) break;
     for (int k = 0; k < n; ++k) p[static_cast<std::size_t>(k)] = tagAt(k, t_round);
-    std::fill(chosen.begin(), chosen.end(), 0);
-    for (int i = 0; i < n; ++i) {
-      by_distance.clear();
-      for (int j = 0; j < n; ++j) {
-        if (j == i) continue;
-        const double d = (p[static_cast<std::size_t>(i)] - p[static_cast<std::size_t>(j)]).norm();
-        if (d <= tw.radio_range_m) by_distance.push_back({d, j});
-      }
-      const std::size_t m = std::min<std::size_t>(by_distance.size(), static_cast<std::size_t>(tw.max_partners));
-      std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(m), by_distance.end());
-      for (std::size_t q = 0; q < m; ++q) {
-        const int j = by_distance[q].second;
-        chosen[static_cast<std::size_t>(std::min(i, j) * n + std::max(i, j))] = 1;
-      }
-    }
+    chooseTwrPairs(p, tw, chosen, by_distance);
     for (int i = 0; i < n; ++i) {
       for (int j = i + 1; j < n; ++j) {
         if (!chosen[static_cast<std::size_t>(i * n + j)]) continue;
         const double t = t_round + jitter(rng) * dt;
         if (t > duration) continue;
         const double d_true = range(tagAt(i, t), tagAt(j, t));  // (S22) model range (M3)
-        out.twr.push_back({t, i, j, d_true + tw.noise_std_m * noise(rng), d_true});
+        twr.push_back({t, i, j, d_true + tw.noise_std_m * noise(rng), d_true});
       }
     }
   }
-  std::stable_sort(out.twr.begin(), out.twr.end(),
+  std::stable_sort(twr.begin(), twr.end(),
                    [](const TwrObservation& a, const TwrObservation& b) { return a.t_s < b.t_s; });
+  return twr;
+}
+
+}  // namespace
+
+SwarmSimResult simulateSwarm(const SwarmScenario& scenario, const SimParams& params, std::uint64_t seed) {
+  scenario.twr.validate();
+  if (scenario.agents.empty()) throw std::invalid_argument("simulateSwarm: no agents");
+  SwarmSimResult out;
+  const int n = static_cast<int>(scenario.agents.size());
+  std::vector<Trajectory> traj;
+  traj.reserve(scenario.agents.size());
+  for (int k = 0; k < n; ++k) {
+    const SwarmAgentSpec& spec = scenario.agents[static_cast<std::size_t>(k)];
+    SimResult r = simulateFlight(Scenario{scenario.survey, spec.trajectory}, params, seed * 1000u + static_cast<unsigned>(k));
+    dropOccluded(spec.occlusions, r);
+    if (k == 0) out.survey = r.survey;
+    out.agents.push_back(std::move(r));
+    traj.emplace_back(spec.trajectory);
+  }
+  out.twr = simulateTwr(traj, scenario.twr, params, seed);
   return out;
 }
 

@@ -149,6 +149,25 @@ void Trajectory::pattern(double s, Vec3* pos, Vec3* dpos, Vec3* ddpos) const {
   }
 }
 
+namespace {
+
+/// (S1) The vertical climb or descent from `from` to `to` (same x, y) over duration_s, at x = elapsed / duration_s;
+/// at rest (before the climb, after the descent) on the ground with zero velocity and acceleration. No yaw.
+FlatState verticalMove(const Vec3& from, const Vec3& to, double x, double duration_s, bool at_rest) {
+  FlatState out;
+  const Vec3 delta = to - from;
+  double d1 = 0.0;
+  double d2 = 0.0;
+  const double sg = smoothstep7(x, &d1, &d2);
+  out.w_p = from + delta * sg;
+  out.w_v = at_rest ? Vec3::Zero() : Vec3(delta * d1 / duration_s);
+  out.w_a = at_rest ? Vec3::Zero() : Vec3(delta * d2 / (duration_s * duration_s));
+  out.on_ground = at_rest;
+  return out;
+}
+
+}  // namespace
+
 FlatState Trajectory::evaluate(double t_s) const {
   const TrajectoryParams& p = params_;
   const double t = std::clamp(t_s, 0.0, p.duration_s);
@@ -164,16 +183,8 @@ FlatState Trajectory::evaluate(double t_s) const {
   if (t < t1) {
     pattern(0.0, &P, &dP, &ddP);
     const Vec3 ground(P.x(), P.y(), p.ground_z_m);
-    const Vec3 delta = P - ground;
-    double d1 = 0.0;
-    double d2 = 0.0;
-    const double x = (t - t0) / p.takeoff_s;
-    const double sg = smoothstep7(x, &d1, &d2);  // (S1) vertical climb
-    out.w_p = ground + delta * sg;
-    out.w_v = t < t0 ? Vec3::Zero() : Vec3(delta * d1 / p.takeoff_s);
-    out.w_a = t < t0 ? Vec3::Zero() : Vec3(delta * d2 / (p.takeoff_s * p.takeoff_s));
+    out = verticalMove(ground, P, (t - t0) / p.takeoff_s, p.takeoff_s, t < t0);  // (S1) vertical climb
     out.yaw_rad = p.yaw0_rad;
-    out.on_ground = t < t0;
     return out;
   }
   if (t < t2) {
@@ -206,16 +217,8 @@ FlatState Trajectory::evaluate(double t_s) const {
   }
   pattern(s_end_, &P, &dP, &ddP);
   const Vec3 ground(P.x(), P.y(), p.ground_z_m);
-  const Vec3 delta = ground - P;
-  double d1 = 0.0;
-  double d2 = 0.0;
-  const double x = (t - t2) / p.landing_s;
-  const double sg = smoothstep7(x, &d1, &d2);  // (S1) vertical descent
-  out.w_p = P + delta * sg;
-  out.w_v = t >= t3 ? Vec3::Zero() : Vec3(delta * d1 / p.landing_s);
-  out.w_a = t >= t3 ? Vec3::Zero() : Vec3(delta * d2 / (p.landing_s * p.landing_s));
+  out = verticalMove(P, ground, (t - t2) / p.landing_s, p.landing_s, t >= t3);  // (S1) vertical descent
   out.yaw_rad = p.yaw0_rad + yaw_rate * s_end_;
-  out.on_ground = t >= t3;
   return out;
 }
 

@@ -53,26 +53,29 @@ class LineDecoder {
          fmt::format("a '{}' line has {} fields ({}), this one has {}", type, n, layout, n_));
   }
   double real(std::size_t i, const char* name) const {
-    const std::string_view s = fields_[i].text;
-    double v = 0.0;
-    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (s.empty() || ec != std::errc() || ptr != s.data() + s.size())
-      fail(i, name, fmt::format("'{}' is not a number", s));
-    if (!std::isfinite(v)) fail(i, name, fmt::format("'{}' is not finite", s));
+    const double v = whole<double>(i, name, "a number");
+    if (!std::isfinite(v)) fail(i, name, fmt::format("'{}' is not finite", fields_[i].text));
     return v;
   }
   int integer(std::size_t i, const char* name) const {
-    const std::string_view s = fields_[i].text;
-    int v = 0;
-    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (s.empty() || ec != std::errc() || ptr != s.data() + s.size())
-      fail(i, name, fmt::format("'{}' is not an integer anchor id", s));
+    const int v = whole<int>(i, name, "an integer anchor id");
     if (v < 0 || v > kMaxAnchorId)
       fail(i, name, fmt::format("anchor id {} is outside [0, {}] (8-bit Loco Positioning ids)", v, kMaxAnchorId));
     return v;
   }
 
  private:
+  /// Field i read as a whole by std::from_chars; `kind` names what was expected in the message.
+  template <class T>
+  T whole(std::size_t i, const char* name, const char* kind) const {
+    const std::string_view s = fields_[i].text;
+    T v{};
+    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (s.empty() || ec != std::errc() || ptr != s.data() + s.size())
+      fail(i, name, fmt::format("'{}' is not {}", s, kind));
+    return v;
+  }
+
   std::array<Field, 9> fields_{};  // the longest line has 8 fields; one more tells "extra field"
   std::size_t n_ = 0;
   std::size_t line_no_;

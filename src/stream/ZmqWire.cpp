@@ -10,6 +10,18 @@
 namespace uwb {
 namespace {
 constexpr int kPoll_ms = 100;
+
+/// Waits up to kPoll_ms for a message on the socket; false on a timeout or a signal (EINTR), so that the caller
+/// checks its stop flag and deadline again.
+bool readableWithinPoll(zmq::socket_t& sock) {
+  zmq::pollitem_t item{sock.handle(), 0, ZMQ_POLLIN, 0};
+  try {
+    return zmq::poll(&item, 1, std::chrono::milliseconds(kPoll_ms)) != 0;
+  } catch (const zmq::error_t& e) {
+    if (e.num() == EINTR) return false;
+    throw;
+  }
+}
 }  // namespace
 
 ZmqLineSubscriber::ZmqLineSubscriber(zmq::context_t& ctx, const std::string& endpoint, std::string_view topic)
@@ -29,13 +41,7 @@ bool ZmqLineSubscriber::next(std::string& line, const volatile std::sig_atomic_t
       timed_out_ = true;
       return false;
     }
-    zmq::pollitem_t item{sock_.handle(), 0, ZMQ_POLLIN, 0};
-    try {
-      if (zmq::poll(&item, 1, std::chrono::milliseconds(kPoll_ms)) == 0) continue;
-    } catch (const zmq::error_t& e) {
-      if (e.num() == EINTR) continue;
-      throw;
-    }
+    if (!readableWithinPoll(sock_)) continue;
     zmq::message_t topic, body;
     if (!sock_.recv(topic, zmq::recv_flags::dontwait)) continue;
     t_last_message_ = std::chrono::steady_clock::now();
@@ -64,13 +70,7 @@ ZmqLinePublisher::ZmqLinePublisher(zmq::context_t& ctx, const std::string& endpo
 bool ZmqLinePublisher::waitForSubscriber(int timeout_ms, const volatile std::sig_atomic_t* stop) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
   while (std::chrono::steady_clock::now() < deadline && (stop == nullptr || *stop == 0)) {
-    zmq::pollitem_t item{sock_.handle(), 0, ZMQ_POLLIN, 0};
-    try {
-      if (zmq::poll(&item, 1, std::chrono::milliseconds(kPoll_ms)) == 0) continue;
-    } catch (const zmq::error_t& e) {
-      if (e.num() == EINTR) continue;
-      throw;
-    }
+    if (!readableWithinPoll(sock_)) continue;
     zmq::message_t sub;
     if (sock_.recv(sub, zmq::recv_flags::dontwait) && sub.size() > 0 && sub.data<char>()[0] == 1) return true;
   }
