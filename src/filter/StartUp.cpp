@@ -10,6 +10,21 @@
 
 namespace uwb {
 
+StartUpParams StartUpParams::fromEkfParams(const EkfParams& p) {
+  StartUpParams s;
+  s.window_s = p.start_window_s;
+  s.min_samples = static_cast<std::size_t>(p.start_min_samples);
+  s.max_window_s = p.start_max_window_s;
+  s.min_pos_sigma_m = p.start_min_pos_sigma_m;
+  s.max_pos_sigma_m = p.init_pos_sigma_m;
+  s.min_vel_sigma_mps = p.start_min_vel_sigma_mps;
+  s.box_margin_m = p.start_box_margin_m;
+  s.max_rms_residual_m = p.start_max_rms_residual_m;
+  s.floor_refute_height_m = p.floor_refute_height_m;
+  s.floor_refute_residual_ratio = p.floor_refute_residual_ratio;
+  return s;
+}
+
 StartUp::StartUp(const AnchorTable& anchors, const Vec3& b_t_tag, const StartUpParams& params)
     : anchors_(anchors), b_t_tag_(b_t_tag), params_(params) {
   const AnchorBox box = anchorBox(anchors_);  // throws when there are no anchors

@@ -239,7 +239,6 @@ class Estimator {
   std::optional<OnlineAntennaBias> antenna_;  ///< learned antenna pattern (F25), with antenna_bias_degree > 0
   BiasPredictor corrections_;  ///< bias_ plus the learned antenna pattern (F25b); empty without learning
   bool antenna_predicted_ = false;  ///< the last TDoA's correction included the antenna pattern
-  double antenna_var_m2_ = 0.0;     ///< of it, the variance added to the filter's TDoA variance [m²]
   bool imu_mode_;
   DescentBound descent_;  ///< dead-reckoned descent while landing (F26)
   Ekf ekf_;

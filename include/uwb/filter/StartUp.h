@@ -8,6 +8,7 @@
 #include <optional>
 #include <vector>
 
+#include "uwb/filter/EkfParams.h"
 #include "uwb/filter/Multilateration.h"
 #include "uwb/filter/NavState.h"
 
@@ -46,6 +47,10 @@ struct StartUpParams {
   double floor_refute_height_m = 1.2;
   /// … with an RMS residual at most this many times the floor solve's
   double floor_refute_residual_ratio = 1.5;
+
+  /// The estimator's start-up: every field from its EkfParams namesake (start_*, floor_refute_*; the position std at
+  /// most init_pos_sigma_m).
+  static StartUpParams fromEkfParams(const EkfParams& p);
 };
 
 class StartUp {
