@@ -75,6 +75,12 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
   box_max_ = box.max;
   centroid_ = box.centroid;
 
+  configureUpdateOptions();
+  if (params_.pair_bias_tau_s > 0.0) pair_offsets_.resize(kMaxPairId * kMaxPairId);
+  configureBiasCorrections();
+}
+
+void Estimator::configureUpdateOptions() {
   tdoa_model_.b_t_tag = params_.b_t_tag;
   track_opt_.sigma_m = params_.tdoa_sigma_m;
   track_opt_.gate_sigma = params_.gate_sigma;
@@ -93,7 +99,9 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
   tof_opt_.offset_m = params_.tof_offset_m;
   tof_opt_.floor_z_m = params_.floor_z_m;
   tof_opt_.max_range_m = params_.tof_max_range_m;
-  if (params_.pair_bias_tau_s > 0.0) pair_offsets_.resize(kMaxPairId * kMaxPairId);
+}
+
+void Estimator::configureBiasCorrections() {
   if (params_.antenna_bias_degree > 0) {
     // (F25) the learned antenna pattern adds to the (optional) bias model's correction
     antenna_.emplace(AntennaBiasParams{params_.antenna_bias_degree, params_.antenna_bias_sigma_m,
@@ -446,30 +454,7 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
   t_last_event_ = std::isnan(t_last_event_) ? t_s : std::max(t_last_event_, t_s);
   summary_.end_t_s = t_last_event_;
   if (!initialized_) {
-    // (F15) levelling window: mean specific force for the attitude, its spread tells rest from motion
-    if (std::isnan(t_first_imu_)) t_first_imu_ = t_s;
-    init_acc_sum_ += imu.b_acc_mps2;
-    init_gyro_sum_ += imu.b_gyro_radps;
-    init_acc_sq_sum_ += imu.b_acc_mps2.squaredNorm();
-    init_gyro_sq_sum_ += imu.b_gyro_radps.squaredNorm();
-    ++n_init_;
-    last_imu_ = imu;
-    t_last_imu_ = t_s;
-    if (t_s - t_first_imu_ >= params_.level_window_s || n_init_ >= params_.level_max_samples) {
-      const Vec3 mean = init_acc_sum_ / n_init_;
-      const double var = std::max(init_acc_sq_sum_ / n_init_ - mean.squaredNorm(), 0.0);
-      const bool moving = var > params_.level_rest_acc_std_mps2 * params_.level_rest_acc_std_mps2;
-      rest_.reset(imu);
-      // (F18) a still levelling window shows the gyro's own bias: the rest test reads against it too
-      const Vec3 gyro_mean = init_gyro_sum_ / n_init_;
-      if (!moving) rest_.setGyroReference(gyro_mean);
-      // (F18) the window's moments start the rest statistics: a body still from the first sample is on the ground
-      // before the first fix (a motors-off start), whatever its TDoA say of the height
-      const double gyro_ms = init_gyro_sq_sum_ / n_init_;
-      rest_.seed(t_s, var, gyro_ms, std::max(gyro_ms - gyro_mean.squaredNorm(), 0.0));
-      g_ref_ = mean.norm();
-      initialize(t_s, mean, moving);
-    }
+    addLevellingSample(t_s, imu);
     return;
   }
   const double dt_imu = t_s - t_last_imu_;
@@ -496,110 +481,159 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
     if (descent_.running()) descent_.integrate(a_up, dt_imu);
     climb_.integrate(t_s, a_up, dt_imu);  // (F16f)
   }
-  if (params_.ground_phase == GroundPhase::kDetectTakeoff) {
-    bool climbing = false;
-    // (F29b) floor shaking: the high-passed gyro far above the shaking this flight shows in the air
-    const double shake_ms = rest_.gyroHighPassMeanSquare();
-    const bool shaking = mode_.shakingStandsOut(shake_ms);
-    if (on_ground_) {
-      // (F15) take-off detector: leaky integral of the vertical specific-force excess over its level on the ground
-      const double a_up = worldVertical(ekf_.state().w_q_b, imu.b_acc_mps2);
-      v_climb_ = expNegative(dt_imu / params_.takeoff_leak_s) * v_climb_ + dt_imu * (a_up - g_ref_);
-      if (rest_.stillNow() || v_climb_ < 0.05) g_ref_ += (dt_imu / 2.0) * (a_up - g_ref_);
-      // a body that shakes is still touching the floor (touchdown bounces, spin-up): no take-off
-      climbing = v_climb_ > params_.takeoff_climb_mps && !rest_.stillNow() && !shaking;
-    }
-    if (shaking && t_s - t_left_ground_ > params_.contact_rearm_s) {
-      if (t_s - t_last_shake_ >= params_.contact_hold_s) t_shake_since_ = t_s;  // a new shaking episode
-      t_last_shake_ = t_s;
-    }
-    // recent lowest height: on ground contact the estimate can run away upwards (contact force in the thrust
-    // model, floor-biased TDoA) before the shaking shows
-    if (ready_ && t_s - t_low_z_sample_ >= params_.low_z_period_s) {
-      low_z_[i_low_z_] = ekf_.state().w_p_b.z();
-      i_low_z_ = (i_low_z_ + 1) % low_z_.size();
-      n_low_z_ = std::min(n_low_z_ + 1, low_z_.size());
-      t_low_z_sample_ = t_s;
-    }
-    // the lowest estimate of the last n samples (and the current one)
-    const auto lowestRecentZ = [&](std::size_t n) {
-      double z_low = ekf_.state().w_p_b.z();
-      const std::size_t size = low_z_.size();
-      for (std::size_t k = 0; k < std::min(n, n_low_z_); ++k)
-        z_low = std::min(z_low, low_z_[(i_low_z_ + size - 1 - k) % size]);
-      return z_low;
-    };
-    // shaking near the floor, or shaking for long wherever the estimate is (flight shakes only briefly)
-    // (F29b) and not entered from the air while the estimate climbs: shaking in a climb is rotors at thrust, not the
-    // floor (the climb after a take-off of a drone whose gyro shakes in flight)
-    const bool contact = t_s - t_last_shake_ < params_.contact_hold_s &&
-                         (on_ground_ || !ready_ || ekf_.state().w_v_b.z() < params_.rest_max_climb_mps) &&
-                         (!ready_ || t_s - t_shake_since_ >= params_.contact_sustained_s ||
-                          lowestRecentZ(static_cast<std::size_t>(params_.contact_low_z_samples)) - params_.ground_z_m < params_.contact_max_height_m);
-    // rest enters the ground near the floor only: an IMU logged at a low rate or filtered reads as quiet in a still
-    // hover as with the motors off, and a still hover high above the floor is not on the ground (the floor height, the
-    // ZUPT and the ground's TDoA weight would pull it down); the window spans the climb of the estimate after a
-    // touchdown (F26). Once on the ground, rest holds it wherever the estimate is.
-    // Nor does it enter while the estimate climbs or after a climb from the floor: after a take-off a steady climb or
-    // hover reads as quiet as rest too, and the ZUPT would take the climb for accelerometer bias. Only a descent
-    // opens the window (the touchdown: the estimate may climb after it, F26).
-    const NavState& x = ekf_.state();
-    if (ready_ && x.w_v_b.z() < -params_.rest_descent_mps) t_last_descent_ = t_s;
-    // the heights of a landing: those since params_.landing_low_z_lead_s before its last descending sample (the window's span)
-    const auto landingLowZ = [&] {
-      const double span_s = t_s - t_last_descent_ + params_.landing_low_z_lead_s;
-      return lowestRecentZ(std::min(low_z_.size(), static_cast<std::size_t>(span_s / params_.low_z_period_s) + 1));
-    };
-    const bool rest =
-        rest_.atRest() &&
-        (on_ground_ || !ready_ ||
-         (x.w_p_b.z() - params_.ground_z_m < params_.contact_max_height_m && x.w_v_b.z() < params_.rest_max_climb_mps) ||
-         (t_s - t_last_descent_ < params_.landing_window_s && landingLowZ() - params_.ground_z_m < params_.contact_max_height_m));
-    // (F29) the IMU's evidence, weighed with the TDoA's by the flight-mode supervisor
-    const bool settled_in_air = !on_ground_ && ready_ && phase_ == FlightPhase::kTracking &&
-                                t_s - t_left_ground_ > params_.air_shake_settle_s &&
-                                x.w_p_b.z() - params_.ground_z_m > params_.air_shake_min_height_m;
-    mode_.addImu(t_s, dt_imu, ImuModeEvidence{rest, contact, climbing, shake_ms}, settled_in_air);
-    left_rest_mode_ = mode_.mode() == FlightMode::kRest;  // (F16f) the mode the ground is left from
-    mode_.decide(t_s);
-    summary_.floor_doubted_s = mode_.doubtedFloorTime();
-    summary_.floor_doubted_max_height_m = mode_.doubtedFloorMaxHeight();
-    summary_.n_mode_overrules = static_cast<std::size_t>(mode_.tdoaOverrules());
-    summary_.air_shake_rms_radps = std::sqrt(mode_.airShakeLevel());
-    const bool ground_now = mode_.onFloor();
-    // (F29e) floor contact whose TDoA the floor explains worse than the air: the mode is examined by a solve of a
-    // fresh window on the floor against one in the air (F16j), at most every params_.floor_check_period_s
-    if (ground_now && on_ground_ && ready_ && !start_.active() && mode_.mode() == FlightMode::kContact && mode_.tdoaLogOdds() > 0.0 &&
-        t_s - t_floor_check_ >= params_.floor_check_period_s) {
-      t_floor_check_ = t_s;
-      floor_check_ = true;
-      landing_fix_ = false;
-      start_.begin(t_s, ekf_.state(), false, true);
-      ++summary_.n_floor_checks;
-    }
-    if (ground_now && !on_ground_) {
-      predictTo(t_s);
-      propagate(true);
-      enterGround(t_s);
-    } else if (!ground_now && on_ground_) {
-      predictTo(t_s);
-      const bool overruled = (mode_.status() & kTdoaOverrulesImu) != 0;
-      leaveGround(t_s, climbing);
-      if (overruled) {
-        // (F29) the TDoA put the tag in the air against the IMU's floor evidence: the shaking seen now is this
-        // flight's airborne shaking (F29b), and the position held on the floor is found again from the TDoA (F16)
-        if (contact) mode_.learnAirShake(shake_ms);
-        if (ready_ && !start_.active()) startAcquisition(t_s, true);
-        mode_.clearTdoa();
-      }
-    }
-  }
+  if (params_.ground_phase == GroundPhase::kDetectTakeoff) superviseGround(t_s, imu, dt_imu);
 
   if (t_s - t_pred_ >= params_.max_predict_dt_s) {
     predictTo(t_s);
     propagate(false);
   }
   alignHeading(t_s, imu, dt_imu);
+  runPeriodicChecks(t_s);
+}
+
+void Estimator::addLevellingSample(double t_s, const ImuReading& imu) {
+  // (F15) levelling window: mean specific force for the attitude, its spread tells rest from motion
+  if (std::isnan(t_first_imu_)) t_first_imu_ = t_s;
+  init_acc_sum_ += imu.b_acc_mps2;
+  init_gyro_sum_ += imu.b_gyro_radps;
+  init_acc_sq_sum_ += imu.b_acc_mps2.squaredNorm();
+  init_gyro_sq_sum_ += imu.b_gyro_radps.squaredNorm();
+  ++n_init_;
+  last_imu_ = imu;
+  t_last_imu_ = t_s;
+  if (!(t_s - t_first_imu_ >= params_.level_window_s || n_init_ >= params_.level_max_samples)) return;
+  const Vec3 mean = init_acc_sum_ / n_init_;
+  const double var = std::max(init_acc_sq_sum_ / n_init_ - mean.squaredNorm(), 0.0);
+  const bool moving = var > params_.level_rest_acc_std_mps2 * params_.level_rest_acc_std_mps2;
+  rest_.reset(imu);
+  // (F18) a still levelling window shows the gyro's own bias: the rest test reads against it too
+  const Vec3 gyro_mean = init_gyro_sum_ / n_init_;
+  if (!moving) rest_.setGyroReference(gyro_mean);
+  // (F18) the window's moments start the rest statistics: a body still from the first sample is on the ground
+  // before the first fix (a motors-off start), whatever its TDoA say of the height
+  const double gyro_ms = init_gyro_sq_sum_ / n_init_;
+  rest_.seed(t_s, var, gyro_ms, std::max(gyro_ms - gyro_mean.squaredNorm(), 0.0));
+  g_ref_ = mean.norm();
+  initialize(t_s, mean, moving);
+}
+
+void Estimator::superviseGround(double t_s, const ImuReading& imu, double dt_imu) {
+  bool climbing = false;
+  // (F29b) floor shaking: the high-passed gyro far above the shaking this flight shows in the air
+  const double shake_ms = rest_.gyroHighPassMeanSquare();
+  const bool shaking = mode_.shakingStandsOut(shake_ms);
+  if (on_ground_) climbing = updateTakeoffDetector(imu, dt_imu, shaking);
+  if (shaking && t_s - t_left_ground_ > params_.contact_rearm_s) {
+    if (t_s - t_last_shake_ >= params_.contact_hold_s) t_shake_since_ = t_s;  // a new shaking episode
+    t_last_shake_ = t_s;
+  }
+  // recent lowest height: on ground contact the estimate can run away upwards (contact force in the thrust
+  // model, floor-biased TDoA) before the shaking shows
+  if (ready_ && t_s - t_low_z_sample_ >= params_.low_z_period_s) {
+    low_z_[i_low_z_] = ekf_.state().w_p_b.z();
+    i_low_z_ = (i_low_z_ + 1) % low_z_.size();
+    n_low_z_ = std::min(n_low_z_ + 1, low_z_.size());
+    t_low_z_sample_ = t_s;
+  }
+  const bool contact = floorContact(t_s);
+  const bool rest = restNearFloor(t_s);
+  // (F29) the IMU's evidence, weighed with the TDoA's by the flight-mode supervisor
+  const NavState& x = ekf_.state();
+  const bool settled_in_air = !on_ground_ && ready_ && phase_ == FlightPhase::kTracking &&
+                              t_s - t_left_ground_ > params_.air_shake_settle_s &&
+                              x.w_p_b.z() - params_.ground_z_m > params_.air_shake_min_height_m;
+  mode_.addImu(t_s, dt_imu, ImuModeEvidence{rest, contact, climbing, shake_ms}, settled_in_air);
+  left_rest_mode_ = mode_.mode() == FlightMode::kRest;  // (F16f) the mode the ground is left from
+  mode_.decide(t_s);
+  summary_.floor_doubted_s = mode_.doubtedFloorTime();
+  summary_.floor_doubted_max_height_m = mode_.doubtedFloorMaxHeight();
+  summary_.n_mode_overrules = static_cast<std::size_t>(mode_.tdoaOverrules());
+  summary_.air_shake_rms_radps = std::sqrt(mode_.airShakeLevel());
+  followFlightMode(t_s, climbing, contact, shake_ms);
+}
+
+bool Estimator::updateTakeoffDetector(const ImuReading& imu, double dt_imu, bool shaking) {
+  // (F15) take-off detector: leaky integral of the vertical specific-force excess over its level on the ground
+  const double a_up = worldVertical(ekf_.state().w_q_b, imu.b_acc_mps2);
+  v_climb_ = expNegative(dt_imu / params_.takeoff_leak_s) * v_climb_ + dt_imu * (a_up - g_ref_);
+  if (rest_.stillNow() || v_climb_ < 0.05) g_ref_ += (dt_imu / 2.0) * (a_up - g_ref_);
+  // a body that shakes is still touching the floor (touchdown bounces, spin-up): no take-off
+  return v_climb_ > params_.takeoff_climb_mps && !rest_.stillNow() && !shaking;
+}
+
+double Estimator::lowestRecentZ(std::size_t n) const {
+  // the lowest estimate of the last n samples (and the current one)
+  double z_low = ekf_.state().w_p_b.z();
+  const std::size_t size = low_z_.size();
+  for (std::size_t k = 0; k < std::min(n, n_low_z_); ++k)
+    z_low = std::min(z_low, low_z_[(i_low_z_ + size - 1 - k) % size]);
+  return z_low;
+}
+
+bool Estimator::floorContact(double t_s) const {
+  // shaking near the floor, or shaking for long wherever the estimate is (flight shakes only briefly)
+  // (F29b) and not entered from the air while the estimate climbs: shaking in a climb is rotors at thrust, not the
+  // floor (the climb after a take-off of a drone whose gyro shakes in flight)
+  const std::size_t n_low = static_cast<std::size_t>(params_.contact_low_z_samples);
+  return t_s - t_last_shake_ < params_.contact_hold_s &&
+         (on_ground_ || !ready_ || ekf_.state().w_v_b.z() < params_.rest_max_climb_mps) &&
+         (!ready_ || t_s - t_shake_since_ >= params_.contact_sustained_s ||
+          lowestRecentZ(n_low) - params_.ground_z_m < params_.contact_max_height_m);
+}
+
+bool Estimator::restNearFloor(double t_s) {
+  // rest enters the ground near the floor only: an IMU logged at a low rate or filtered reads as quiet in a still
+  // hover as with the motors off, and a still hover high above the floor is not on the ground (the floor height, the
+  // ZUPT and the ground's TDoA weight would pull it down); the window spans the climb of the estimate after a
+  // touchdown (F26). Once on the ground, rest holds it wherever the estimate is.
+  // Nor does it enter while the estimate climbs or after a climb from the floor: after a take-off a steady climb or
+  // hover reads as quiet as rest too, and the ZUPT would take the climb for accelerometer bias. Only a descent
+  // opens the window (the touchdown: the estimate may climb after it, F26).
+  const NavState& x = ekf_.state();
+  if (ready_ && x.w_v_b.z() < -params_.rest_descent_mps) t_last_descent_ = t_s;
+  // the heights of a landing: those since landing_low_z_lead_s before its last descending sample (the window's span)
+  const auto landingLowZ = [&] {
+    const double span_s = t_s - t_last_descent_ + params_.landing_low_z_lead_s;
+    return lowestRecentZ(std::min(low_z_.size(), static_cast<std::size_t>(span_s / params_.low_z_period_s) + 1));
+  };
+  const double floor_m = params_.ground_z_m, max_height_m = params_.contact_max_height_m;
+  return rest_.atRest() &&
+         (on_ground_ || !ready_ ||
+          (x.w_p_b.z() - floor_m < max_height_m && x.w_v_b.z() < params_.rest_max_climb_mps) ||
+          (t_s - t_last_descent_ < params_.landing_window_s && landingLowZ() - floor_m < max_height_m));
+}
+
+void Estimator::followFlightMode(double t_s, bool climbing, bool contact, double shake_ms) {
+  const bool ground_now = mode_.onFloor();
+  // (F29e) floor contact whose TDoA the floor explains worse than the air: the mode is examined by a solve of a
+  // fresh window on the floor against one in the air (F16j), at most every floor_check_period_s
+  if (ground_now && on_ground_ && ready_ && !start_.active() && mode_.mode() == FlightMode::kContact &&
+      mode_.tdoaLogOdds() > 0.0 && t_s - t_floor_check_ >= params_.floor_check_period_s) {
+    t_floor_check_ = t_s;
+    floor_check_ = true;
+    landing_fix_ = false;
+    start_.begin(t_s, ekf_.state(), false, true);
+    ++summary_.n_floor_checks;
+  }
+  if (ground_now && !on_ground_) {
+    predictTo(t_s);
+    propagate(true);
+    enterGround(t_s);
+  } else if (!ground_now && on_ground_) {
+    predictTo(t_s);
+    const bool overruled = (mode_.status() & kTdoaOverrulesImu) != 0;
+    leaveGround(t_s, climbing);
+    if (overruled) {
+      // (F29) the TDoA put the tag in the air against the IMU's floor evidence: the shaking seen now is this
+      // flight's airborne shaking (F29b), and the position held on the floor is found again from the TDoA (F16)
+      if (contact) mode_.learnAirShake(shake_ms);
+      if (ready_ && !start_.active()) startAcquisition(t_s, true);
+      mode_.clearTdoa();
+    }
+  }
+}
+
+void Estimator::runPeriodicChecks(double t_s) {
   if (on_ground_ && t_s - t_last_zupt_ >= params_.zupt_period_s) {
     predictTo(t_s);
     propagate(true);
@@ -688,10 +722,57 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   // (F31) a TDoA longer than its anchor pair's baseline (or not finite) is no range difference: skipped
   if (!checkTdoaRange(z, anchors_, summary_.sensor_range)) return;
   const double t = z.t_s;
+  if (!advanceToTdoa(t)) return;
+  // (F16i) a landing's floor window that finds no fix within landing_fix_max_s ends: the TDoA are used again
+  if (landing_fix_ && t - t_landing_fix_s_ > params_.landing_fix_max_s) endLandingFix();
+  if (start_.active()) {
+    collectStartTdoa(z);
+    return;
+  }
+  if (phase_ == FlightPhase::kAcquisition && t >= t_acq_end_)
+    phase_ = on_ground_ ? (moved_ ? FlightPhase::kLanded : FlightPhase::kGround) : FlightPhase::kTracking;
+  propagate(!imu_mode_);
+  const bool acquiring = phase_ == FlightPhase::kAcquisition;
+  // (F14) TDoA near the floor carry the large floor-level bias: down-weighted on the ground and just above it
+  const bool near_floor = on_ground_ || ekf_.state().w_p_b.z() - params_.ground_z_m < params_.low_flight_m;
+  const TdoaUpdateOptions& opt = acquiring ? acq_opt_ : (near_floor ? rest_opt_ : track_opt_);
+  PairOffset* po = nullptr;
+  const TdoaObservation zc = correctedTdoa(z, acquiring, &po);
+  if (imu_mode_ && ready_ && params_.ground_phase == GroundPhase::kDetectTakeoff) superviseTdoa(t, z);
+  if (antenna_) {
+    antenna_->advance(t);
+    antenna_predicted_ = false;
+  }
+  const BiasPredictor* predictor = antenna_ ? &corrections_ : (bias_ ? &bias_ : nullptr);
+  // (F23c) the residual without the filter's range-bias states, at the prior tag position
+  const bool levels = bias_level_ || raw_level_;
+  const double range_bias_prior_m = levels && ekf_.rangeBias() ? ekf_.rangeBiasDifference(z.id_a, z.id_b) : 0.0;
+  const Vec3 w_p_tag_prior = levels ? Vec3(ekf_.state().w_p_b + ekf_.state().w_q_b * params_.b_t_tag) : Vec3::Zero();
+  const TdoaUpdateResult r = updateTdoa(ekf_, anchors_, zc, opt, predictor);
+  last_tdoa_ = r;
+  learnFromInnovation(t, r, acquiring, near_floor, po);
+  countTdoaOutcome(t, r, acquiring, near_floor);
+  // (F30) in the air only: on and near the floor the TDoA carry the floor-level bias (F14), which their σ there covers
+  const bool gated = r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier;
+  if (!acquiring && !near_floor && gated) checkConsistency(t, r.nis);
+  // in flight only: on and near the floor the TDoA carry the floor-level bias (F14), and a body at rest or in ground
+  // contact (F18: still, or shaking on the legs) is not flying even before the ground phase is entered
+  const bool flying = !acquiring && !near_floor &&
+                      std::min(t - t_acq_end_, t - t_left_ground_) >= params_.rejection_settle_s &&
+                      ekf_.state().w_p_b.z() - params_.ground_z_m > params_.rejection_min_height_m &&
+                      !(imu_mode_ && (rest_.stillNow() || mode_.shakingStandsOut(rest_.gyroHighPassMeanSquare())));
+  last_tdoa_in_flight_ = flying;
+  if (flying && gated) trackRejectionRate(t, r);
+  if (levels) feedBiasLevels(t, z, r, flying, range_bias_prior_m, w_p_tag_prior);
+  notePairInView(t, z, r);
+  superviseTracking(t, acquiring);
+}
+
+bool Estimator::advanceToTdoa(double t) {
   if (!initialized_) {
     if (imu_mode_) {
       ++summary_.n_tdoa_before_imu;
-      return;
+      return false;
     }
     summary_.start_t_s = t;
     t_last_event_ = t;
@@ -700,7 +781,7 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   if (t < t_pred_ - params_.max_gap_s) {
     if (imu_mode_) {
       ++summary_.n_tdoa_out_of_order;  // the IMU clock leads; a backward jump of the IMU re-bases the time (F17)
-      return;
+      return false;
     }
     handleTimeJump(t, t - t_pred_);
   }
@@ -714,49 +795,43 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   summary_.end_t_s = t_last_event_;
   // (F17) the nominal state is brought to the measurement time only when it lags by more than update_predict_dt_s
   if (!imu_mode_ || t - t_pred_ >= params_.update_predict_dt_s) predictTo(t);
+  return true;
+}
 
-  // (F16i) a landing's floor window that finds no fix within params_.landing_fix_max_s ends: the TDoA are used again
-  if (landing_fix_ && t - t_landing_fix_s_ > params_.landing_fix_max_s) endLandingFix();
-  if (start_.active()) {
-    // (F16) collecting the multilateration batch; the displacement comes from the prediction
-    ++summary_.n_tdoa_start;
-    propagate(!imu_mode_);
-    const std::optional<double> floor_z =
-        on_ground_ && params_.floor_constraint ? std::optional<double>(params_.ground_z_m) : std::nullopt;
-    if (replay_.recording()) replay_.recordTdoa(z);
-    // (F16j) floor contact before the first fix may be refuted by the TDoA; rest (motors off) is not
-    // (F29e) and so is floor contact at a floor check
-    const bool floor_refutable = floor_z && ((!ready_ && t_last_rest_ < t_entered_ground_) || floor_check_);
-    if (const std::optional<StartFix> fix = start_.add(z, ekf_.state(), floor_z, floor_refutable)) {
-      propagate(true);
-      if (floor_check_) finishFloorCheck(t, *fix);
-      else if (landing_fix_) finishLandingFix(*fix);
-      else finishStart(t, *fix);
-    } else if (replay_.recording() && start_.referenceTime() != replay_.referenceTime()) {
-      replay_.begin(ekf_, start_.referenceTime());  // (F16b) a failed solve moved the reference to now
-    }
-    return;
-  }
-  if (phase_ == FlightPhase::kAcquisition && t >= t_acq_end_)
-    phase_ = on_ground_ ? (moved_ ? FlightPhase::kLanded : FlightPhase::kGround) : FlightPhase::kTracking;
+void Estimator::collectStartTdoa(const TdoaObservation& z) {
+  // (F16) collecting the multilateration batch; the displacement comes from the prediction
+  const double t = z.t_s;
+  ++summary_.n_tdoa_start;
   propagate(!imu_mode_);
-  const bool acquiring = phase_ == FlightPhase::kAcquisition;
+  const std::optional<double> floor_z =
+      on_ground_ && params_.floor_constraint ? std::optional<double>(params_.ground_z_m) : std::nullopt;
+  if (replay_.recording()) replay_.recordTdoa(z);
+  // (F16j) floor contact before the first fix may be refuted by the TDoA; rest (motors off) is not
+  // (F29e) and so is floor contact at a floor check
+  const bool floor_refutable = floor_z && ((!ready_ && t_last_rest_ < t_entered_ground_) || floor_check_);
+  if (const std::optional<StartFix> fix = start_.add(z, ekf_.state(), floor_z, floor_refutable)) {
+    propagate(true);
+    if (floor_check_) finishFloorCheck(t, *fix);
+    else if (landing_fix_) finishLandingFix(*fix);
+    else finishStart(t, *fix);
+  } else if (replay_.recording() && start_.referenceTime() != replay_.referenceTime()) {
+    replay_.begin(ekf_, start_.referenceTime());  // (F16b) a failed solve moved the reference to now
+  }
+}
+
+TdoaObservation Estimator::correctedTdoa(const TdoaObservation& z, bool acquiring, PairOffset** po) {
   // (F19) optional per-pair offset learned from the innovations while tracking
   TdoaObservation zc = z;
-  PairOffset* po = nullptr;
   if (!pair_offsets_.empty() && z.id_a >= 0 && z.id_b >= 0 && z.id_a < kMaxPairId && z.id_b < kMaxPairId) {
-    po = &pair_offsets_[z.id_a * kMaxPairId + z.id_b];
-    zc.tdoa_m -= po->offset_m;
+    *po = &pair_offsets_[z.id_a * kMaxPairId + z.id_b];
+    zc.tdoa_m -= (*po)->offset_m;
   }
-  // (F14) TDoA near the floor carry the large floor-level bias: down-weighted on the ground and just above it
-  const bool near_floor = on_ground_ || ekf_.state().w_p_b.z() - params_.ground_z_m < params_.low_flight_m;
-  const TdoaUpdateOptions& opt = acquiring ? acq_opt_ : (near_floor ? rest_opt_ : track_opt_);
   // (F16f) on the ground the floor-level anchors are seen with the delays the start on the floor found; after the
   // ground evidence ended without a climb, they fade with the height dead-reckoned from the floor
   if (floor_anchors_.hasDelays() && (on_ground_ || climb_.running())) {
     const double f = on_ground_ ? 1.0 : FloorLevelAnchors::remainingFraction(climb_.height());
     zc.tdoa_m -= f * floor_anchors_.pairDelay(z.id_a, z.id_b);
-  } else if (floor_anchors_.hasDelays() && !acquiring && t - t_last_descent_ < params_.landing_window_s &&
+  } else if (floor_anchors_.hasDelays() && !acquiring && z.t_s - t_last_descent_ < params_.landing_window_s &&
              ekf_.state().w_p_b.z() - params_.ground_z_m < params_.landing_band_m) {
     // (F16h) near the floor after a descent (a landing): the delay or none, whichever the TDoA lies nearer to
     const Moments3* a = anchors_.find(z.id_a);
@@ -767,32 +842,28 @@ void Estimator::addTdoa(const TdoaObservation& z) {
       zc.tdoa_m -= floor_anchors_.nearerPairDelay(z.id_a, z.id_b, r);
     }
   }
-  if (imu_mode_ && ready_ && params_.ground_phase == GroundPhase::kDetectTakeoff) superviseTdoa(t, z);
-  if (antenna_) {
-    antenna_->advance(t);
-    antenna_predicted_ = false;
-  }
-  const BiasPredictor* predictor = antenna_ ? &corrections_ : (bias_ ? &bias_ : nullptr);
-  // (F23c) the residual without the filter's range-bias states, at the prior tag position
-  const bool levels = bias_level_ || raw_level_;
-  const double range_bias_prior_m = levels && ekf_.rangeBias() ? ekf_.rangeBiasDifference(z.id_a, z.id_b) : 0.0;
-  const Vec3 w_p_tag_prior = levels ? Vec3(ekf_.state().w_p_b + ekf_.state().w_q_b * params_.b_t_tag) : Vec3::Zero();
-  const TdoaUpdateResult r = updateTdoa(ekf_, anchors_, zc, opt, predictor);
-  last_tdoa_ = r;
+  return zc;
+}
+
+void Estimator::learnFromInnovation(double t, const TdoaUpdateResult& r, bool acquiring, bool near_floor,
+                                    PairOffset* po) {
   if (antenna_ && antenna_predicted_ && !acquiring && !near_floor && t >= t_fix_settled_ &&
       r.outcome == UpdateOutcome::kApplied) {
     // (F25d) learned while tracking in the air only: near the floor the TDoA carry the ground bias (F14). The
     // robust weight of the update down-weights the same TDoA for the pattern.
     // The TDoA error is correlated in time (F12): the innovations carry far less than one independent sample each
-    antenna_->learn(r.innovation_m,
-                    params_.antenna_bias_noise_scale * r.innovation_var_m2 / r.weight);
+    antenna_->learn(r.innovation_m, params_.antenna_bias_noise_scale * r.innovation_var_m2 / r.weight);
   }
   if (po && !acquiring && r.outcome == UpdateOutcome::kApplied) {
+    // (F19) the pair's offset follows its weighted innovations
     const double dt_pair = std::isnan(po->t_last_s) ? 0.0 : std::min(t - po->t_last_s, 0.2);
     po->offset_m =
         std::clamp(po->offset_m + (dt_pair / params_.pair_bias_tau_s) * r.weight * r.innovation_m, -0.5, 0.5);
     po->t_last_s = t;
   }
+}
+
+void Estimator::countTdoaOutcome(double t, const TdoaUpdateResult& r, bool acquiring, bool near_floor) {
   switch (r.outcome) {
     case UpdateOutcome::kApplied:
       ++summary_.n_tdoa_used;
@@ -808,35 +879,31 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     case UpdateOutcome::kUnknownAnchor: ++summary_.n_tdoa_unknown_anchor; break;
     default: ++summary_.n_tdoa_degenerate; break;
   }
-  // (F30) in the air only: on and near the floor the TDoA carry the floor-level bias (F14), which their σ there covers
-  if (!acquiring && !near_floor &&
-      (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier))
-    checkConsistency(t, r.nis);
-  // in flight only: on and near the floor the TDoA carry the floor-level bias (F14), and a body at rest or in ground
-  // contact (F18: still, or shaking on the legs) is not flying even before the ground phase is entered
-  const bool flying = !acquiring && !near_floor && std::min(t - t_acq_end_, t - t_left_ground_) >= params_.rejection_settle_s &&
-                      ekf_.state().w_p_b.z() - params_.ground_z_m > params_.rejection_min_height_m &&
-                      !(imu_mode_ && (rest_.stillNow() || mode_.shakingStandsOut(rest_.gyroHighPassMeanSquare())));
-  last_tdoa_in_flight_ = flying;
-  if (flying &&
-      (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier)) {
-    // (F16d) rejection rate in flight, exponentially forgotten over params_.rejection_memory_s
-    const double w = std::isnan(t_rejection_) ? 0.0 : std::exp(-std::max(t - t_rejection_, 0.0) / params_.rejection_memory_s);
-    n_rejected_recent_ = w * n_rejected_recent_ + (r.outcome == UpdateOutcome::kRejectedOutlier ? 1.0 : 0.0);
-    n_gated_recent_ = w * n_gated_recent_ + 1.0;
-    t_rejection_ = t;
-    // (F16d) the recent motion while the TDoA agree, to fall back on when a fault is found
-    if (n_rejected_recent_ <= params_.healthy_rejection_rate * n_gated_recent_ && t - t_healthy_sample_ >= params_.healthy_period_s) {
-      healthy_[i_healthy_] = {t, ekf_.state().w_p_b, ekf_.state().w_v_b};
-      i_healthy_ = (i_healthy_ + 1) % healthy_.size();
-      n_healthy_ = std::min(n_healthy_ + 1, healthy_.size());
-      t_healthy_sample_ = t;
-    }
+}
+
+void Estimator::trackRejectionRate(double t, const TdoaUpdateResult& r) {
+  // (F16d) rejection rate in flight, exponentially forgotten over rejection_memory_s
+  const double w =
+      std::isnan(t_rejection_) ? 0.0 : std::exp(-std::max(t - t_rejection_, 0.0) / params_.rejection_memory_s);
+  n_rejected_recent_ = w * n_rejected_recent_ + (r.outcome == UpdateOutcome::kRejectedOutlier ? 1.0 : 0.0);
+  n_gated_recent_ = w * n_gated_recent_ + 1.0;
+  t_rejection_ = t;
+  // (F16d) the recent motion while the TDoA agree, to fall back on when a fault is found
+  if (n_rejected_recent_ <= params_.healthy_rejection_rate * n_gated_recent_ &&
+      t - t_healthy_sample_ >= params_.healthy_period_s) {
+    healthy_[i_healthy_] = {t, ekf_.state().w_p_b, ekf_.state().w_v_b};
+    i_healthy_ = (i_healthy_ + 1) % healthy_.size();
+    n_healthy_ = std::min(n_healthy_ + 1, healthy_.size());
+    t_healthy_sample_ = t;
   }
+}
+
+void Estimator::feedBiasLevels(double t, const TdoaObservation& z, const TdoaUpdateResult& r, bool flying,
+                               double range_bias_prior_m, const Vec3& w_p_tag_prior) {
   // (F23c) a bias level from the TDoA used in flight; elsewhere (the floor-level bias on and near the ground, an
   // acquisition's unsettled state) the open window is dropped. Returns whether a window was counted.
-  const Moments3* anchor_a = levels ? anchors_.find(z.id_a) : nullptr;
-  const Moments3* anchor_b = levels ? anchors_.find(z.id_b) : nullptr;
+  const Moments3* anchor_a = anchors_.find(z.id_a);
+  const Moments3* anchor_b = anchors_.find(z.id_b);
   const auto feed = [&](BiasLevel& level, double residual_m) {
     const int n_before = level.numWindows();
     if (flying && r.outcome == UpdateOutcome::kApplied && anchor_a && anchor_b)
@@ -853,6 +920,9 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   if (mean_level_) feed(*mean_level_, last_model_mean_m_);
   // (F24b) the same statistic on the TDoA before the model's correction (bias_mean_m is what it subtracted)
   if (raw_level_ && feed(*raw_level_, r.innovation_m + range_bias_prior_m + r.bias_mean_m)) updateModelMeanScale();
+}
+
+void Estimator::notePairInView(double t, const TdoaObservation& z, const TdoaUpdateResult& r) {
   if (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier) {
     // anchor pairs in view, for the reported bias floor (F23)
     auto it = std::find_if(recent_pairs_.begin(), recent_pairs_.end(),
@@ -865,16 +935,20 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     bias_floor_ = biasFloor();
     t_bias_floor_s_ = t;
   }
+}
+
+void Estimator::superviseTracking(double t, bool acquiring) {
   // (F16) lost: nothing accepted for max_lost_s → find the position again by multilateration from fresh TDoA
   // (F16d) most TDoA rejected in flight: the stream is faulty or the estimate is off; the few that pass the gate
   // (which widens as P grows) would drag the state away, so the position is found again from fresh TDoA at once
   const bool rejecting = params_.max_rejection_rate < 1.0 && n_gated_recent_ >= params_.rejection_min_samples &&
                          n_rejected_recent_ > params_.max_rejection_rate * n_gated_recent_;
-  const bool nothing_accepted = t - t_last_accept_ > params_.max_lost_s && 
+  const bool nothing_accepted = t - t_last_accept_ > params_.max_lost_s &&
                                 n_rejected_streak_ > static_cast<std::size_t>(params_.lost_min_rejections);
   // (F16k) only TDoA of at least four anchors can fix a position again: with fewer in view (an occluded tag) a
   // re-acquisition would wait for a fix that cannot come, so the filter keeps tracking and its gate takes them back
-  if (!acquiring && (rejecting || nothing_accepted) && anchorsHeard(params_.recent_pair_window_s) >= minFixAnchors(false)) {
+  if (!acquiring && (rejecting || nothing_accepted) &&
+      anchorsHeard(params_.recent_pair_window_s) >= minFixAnchors(false)) {
     if (rejecting) {
       ++summary_.n_rejection_faults;
       revertToHealthyMotion(t);
