@@ -82,23 +82,23 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
 
 void Estimator::configureUpdateOptions() {
   tdoa_model_.b_t_tag = params_.b_t_tag;
-  track_opt_.sigma_m = params_.tdoa_sigma_m;
-  track_opt_.gate_sigma = params_.gate_sigma;
-  track_opt_.loss = params_.robust_loss;
-  track_opt_.robust_k = params_.robust_k;
-  track_opt_.robust_iterations = params_.robust_iterations;
-  track_opt_.b_t_tag = params_.b_t_tag;
-  track_opt_.bias_pose = params_.bias_model_pose;
+  track_opt_ = {.sigma_m = params_.tdoa_sigma_m,
+                .gate_sigma = params_.gate_sigma,
+                .loss = params_.robust_loss,
+                .robust_k = params_.robust_k,
+                .robust_iterations = params_.robust_iterations,
+                .b_t_tag = params_.b_t_tag,
+                .bias_pose = params_.bias_model_pose};
   acq_opt_ = track_opt_;
   acq_opt_.sigma_m = params_.acquisition_tdoa_sigma_m;
   acq_opt_.gate_sigma = 0.0;  // (F16) no gate while acquiring; the robust loss limits outliers
   if (acq_opt_.loss == RobustLoss::kNone) acq_opt_.loss = RobustLoss::kHuber;
   rest_opt_ = track_opt_;
   rest_opt_.sigma_m = params_.rest_tdoa_sigma_m;  // (F14) down-weighted at rest, still gated
-  tof_opt_.sigma_m = params_.tof_sigma_m;
-  tof_opt_.offset_m = params_.tof_offset_m;
-  tof_opt_.floor_z_m = params_.floor_z_m;
-  tof_opt_.max_range_m = params_.tof_max_range_m;
+  tof_opt_ = {.sigma_m = params_.tof_sigma_m,
+              .offset_m = params_.tof_offset_m,
+              .floor_z_m = params_.floor_z_m,
+              .max_range_m = params_.tof_max_range_m};
 }
 
 void Estimator::configureBiasCorrections() {
@@ -206,7 +206,7 @@ void Estimator::finishStart(double t_s, const StartFix& fix) {
   const bool replayed =
       fix.with_velocity && replay_.recording() && replay_.referenceTime() == fix.t_ref_s &&
       replay_.replay(ekf_, fix.w_p0, fix.w_v0, std::sqrt(fix.cov(0, 0)), params_.moving_start_vel_sigma_mps,
-                     params_.cov_period_s, [this](Ekf& f, const TdoaObservation& z) {
+                     params_.cov_period_s, [this](Ekf& f, const TdoaMeasurement& z) {
                        updateTdoa(f, anchors_, z, acq_opt_, bias_ ? &bias_ : nullptr);
                      });
   replay_.stop();
@@ -715,7 +715,7 @@ CooperativeRangeResult Estimator::addNeighbourRange(double t_s, const Moments3& 
   return r;
 }
 
-void Estimator::addTdoa(const TdoaObservation& z) {
+void Estimator::addTdoa(const TdoaMeasurement& z) {
   ++summary_.n_tdoa_total;
   last_tdoa_ = TdoaUpdateResult{};
   last_tdoa_in_flight_ = false;
@@ -737,7 +737,7 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   const bool near_floor = on_ground_ || ekf_.state().w_p_b.z() - params_.ground_z_m < params_.low_flight_m;
   const TdoaUpdateOptions& opt = acquiring ? acq_opt_ : (near_floor ? rest_opt_ : track_opt_);
   PairOffset* po = nullptr;
-  const TdoaObservation zc = correctedTdoa(z, acquiring, &po);
+  const TdoaMeasurement zc = correctedTdoa(z, acquiring, &po);
   if (imu_mode_ && ready_ && params_.ground_phase == GroundPhase::kDetectTakeoff) superviseTdoa(t, z);
   if (antenna_) {
     antenna_->advance(t);
@@ -798,7 +798,7 @@ bool Estimator::advanceToTdoa(double t) {
   return true;
 }
 
-void Estimator::collectStartTdoa(const TdoaObservation& z) {
+void Estimator::collectStartTdoa(const TdoaMeasurement& z) {
   // (F16) collecting the multilateration batch; the displacement comes from the prediction
   const double t = z.t_s;
   ++summary_.n_tdoa_start;
@@ -819,9 +819,9 @@ void Estimator::collectStartTdoa(const TdoaObservation& z) {
   }
 }
 
-TdoaObservation Estimator::correctedTdoa(const TdoaObservation& z, bool acquiring, PairOffset** po) {
+TdoaMeasurement Estimator::correctedTdoa(const TdoaMeasurement& z, bool acquiring, PairOffset** po) {
   // (F19) optional per-pair offset learned from the innovations while tracking
-  TdoaObservation zc = z;
+  TdoaMeasurement zc = z;
   if (!pair_offsets_.empty() && z.id_a >= 0 && z.id_b >= 0 && z.id_a < kMaxPairId && z.id_b < kMaxPairId) {
     *po = &pair_offsets_[z.id_a * kMaxPairId + z.id_b];
     zc.tdoa_m -= (*po)->offset_m;
@@ -898,7 +898,7 @@ void Estimator::trackRejectionRate(double t, const TdoaUpdateResult& r) {
   }
 }
 
-void Estimator::feedBiasLevels(double t, const TdoaObservation& z, const TdoaUpdateResult& r, bool flying,
+void Estimator::feedBiasLevels(double t, const TdoaMeasurement& z, const TdoaUpdateResult& r, bool flying,
                                double range_bias_prior_m, const Vec3& w_p_tag_prior) {
   // (F23c) a bias level from the TDoA used in flight; elsewhere (the floor-level bias on and near the ground, an
   // acquisition's unsettled state) the open window is dropped. Returns whether a window was counted.
@@ -922,7 +922,7 @@ void Estimator::feedBiasLevels(double t, const TdoaObservation& z, const TdoaUpd
   if (raw_level_ && feed(*raw_level_, r.innovation_m + range_bias_prior_m + r.bias_mean_m)) updateModelMeanScale();
 }
 
-void Estimator::notePairInView(double t, const TdoaObservation& z, const TdoaUpdateResult& r) {
+void Estimator::notePairInView(double t, const TdoaMeasurement& z, const TdoaUpdateResult& r) {
   if (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier) {
     // anchor pairs in view, for the reported bias floor (F23)
     auto it = std::find_if(recent_pairs_.begin(), recent_pairs_.end(),
@@ -995,7 +995,7 @@ void Estimator::checkConsistency(double t_s, double nis) {
   }
 }
 
-void Estimator::superviseTdoa(double t_s, const TdoaObservation& z) {
+void Estimator::superviseTdoa(double t_s, const TdoaMeasurement& z) {
   // (F29c) the height at which this TDoA puts the tag: its residual at the estimate over its vertical sensitivity, as
   // a TDoA in the air and as one on the floor (with the floor-level anchors' delays, F16f)
   const Moments3* a = anchors_.find(z.id_a);

@@ -168,7 +168,7 @@ class Estimator {
   Estimator& operator=(const Estimator&) = delete;
 
   void addImu(double t_s, const ImuReading& imu);
-  void addTdoa(const TdoaObservation& z);
+  void addTdoa(const TdoaMeasurement& z);
   void addTof(const TofObservation& tof);
   /// A two-way range at t_s to a neighbouring agent whose tag-position belief (aged to t_s, G22) is `neighbour`
   /// (G20, G21). Ignored (counted) before the position is known.
@@ -226,19 +226,19 @@ class Estimator {
   /// (F17) Initializes a TDoA-only filter, handles time jumps and predicts to t; false when the TDoA is dropped.
   bool advanceToTdoa(double t);
   /// (F16) One TDoA into the start-up's multilateration window; finishes the start, landing fix or floor check.
-  void collectStartTdoa(const TdoaObservation& z);
+  void collectStartTdoa(const TdoaMeasurement& z);
   /// (F19, F16f, F16h) The TDoA with its pair offset and floor-level delays removed; *po: its pair's offset slot.
-  TdoaObservation correctedTdoa(const TdoaObservation& z, bool acquiring, PairOffset** po);
+  TdoaMeasurement correctedTdoa(const TdoaMeasurement& z, bool acquiring, PairOffset** po);
   /// (F25d, F19) The antenna pattern and the pair offset learn from an applied update's innovation.
   void learnFromInnovation(double t, const TdoaUpdateResult& r, bool acquiring, bool near_floor, PairOffset* po);
   void countTdoaOutcome(double t, const TdoaUpdateResult& r, bool acquiring, bool near_floor);
   /// (F16d) The rejection rate in flight, and the recent motion recorded while the TDoA agree.
   void trackRejectionRate(double t, const TdoaUpdateResult& r);
   /// (F23c, F24b, F24c) The flight's bias levels from a TDoA's residual.
-  void feedBiasLevels(double t, const TdoaObservation& z, const TdoaUpdateResult& r, bool flying,
+  void feedBiasLevels(double t, const TdoaMeasurement& z, const TdoaUpdateResult& r, bool flying,
                       double range_bias_prior_m, const Vec3& w_p_tag_prior);
   /// (F23) The anchor pairs in view, and the reported bias term refreshed from them.
-  void notePairInView(double t, const TdoaObservation& z, const TdoaUpdateResult& r);
+  void notePairInView(double t, const TdoaMeasurement& z, const TdoaUpdateResult& r);
   /// (F16, F16d, F16k) Lost or rejecting in flight: re-acquire.
   void superviseTracking(double t, bool acquiring);
   void predictTo(double t_s);
@@ -253,7 +253,7 @@ class Estimator {
   void finishFloorCheck(double t_s, const StartFix& fix);
   /// F16d: position and velocity back to the recent motion recorded before a TDoA fault.
   void revertToHealthyMotion(double t_s);
-  void superviseTdoa(double t_s, const TdoaObservation& z);
+  void superviseTdoa(double t_s, const TdoaMeasurement& z);
   void checkConsistency(double t_s, double nis);
   void applyFloorConstraint(bool on_ground);
   /// F26: the height bounded from above by the IMU's dead-reckoned descent while landing.
