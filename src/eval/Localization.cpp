@@ -17,8 +17,7 @@ SensorLog sensorLogFromFlight(const Flight& flight, MergeReport* report, bool wi
     for (const ImuSample& s : flight.gyro) gyro.push_back({s.t_s, s.b_value});
     log.imu = pairImuStreams(acc, gyro, report);
   }
-  log.tdoa.reserve(flight.tdoa.size());
-  for (const TdoaMeasurement& m : flight.tdoa) log.tdoa.push_back({m.t_s, m.id_a, m.id_b, m.tdoa_m});
+  log.tdoa = flight.tdoa;
   if (with_tof) {
     log.tof.reserve(flight.tof.size());
     for (const ScalarSample& s : flight.tof) log.tof.push_back({s.t_s, s.value});

@@ -29,7 +29,7 @@ void CooperativeAgent::addImu(double t_s, const ImuReading& imu) {
   indep_->addImu(t_s, imu);
 }
 
-void CooperativeAgent::addTdoa(const TdoaObservation& z) {
+void CooperativeAgent::addTdoa(const TdoaMeasurement& z) {
   coop_->addTdoa(z);
   indep_->addTdoa(z);
 }

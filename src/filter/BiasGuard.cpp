@@ -46,7 +46,7 @@ void GuardedEstimator::addTof(const TofObservation& tof) {
   plain_.addTof(tof);
 }
 
-void GuardedEstimator::addTdoa(const TdoaObservation& z) {
+void GuardedEstimator::addTdoa(const TdoaMeasurement& z) {
   corrected_.addTdoa(z);
   plain_.addTdoa(z);
   const TdoaUpdateResult& rc = corrected_.lastTdoaUpdate();

@@ -23,39 +23,12 @@ Quat levelFromGravity(const Vec3& b_acc) {
   return Quat(Eigen::AngleAxisd(pitch, Vec3::UnitY()) * Eigen::AngleAxisd(roll, Vec3::UnitX()));
 }
 
-/// Zero-velocity updates at rest at this period [s] and std [m/s] (F14).
-constexpr double kZuptPeriod_s = 0.01;
-constexpr double kZuptSigma_mps = 0.02;
-/// Levelling window before the first prediction [s] / samples (F15).
-constexpr double kLevelWindow_s = 0.1;
-constexpr int kLevelSamples = 100;
-/// Std of |f| over the levelling window below which the IMU starts at rest [m/s²] (F18).
-constexpr double kLevelRestAccStd_mps2 = 0.15;
-/// Lost (F16): nothing accepted for max_lost_s and at least this many rejections in a row.
-constexpr std::size_t kLostMinRejections = 20;
-/// Memory of the TDoA rejection rate (F16d) [s], ...
-constexpr double kRejectionMemory_s = 0.3;
-/// ... counted this high above the floor only: a touch-down that the estimate has not followed yet rejects the TDoA
-/// of the floor-level bias (F14) for a moment (0425-traj1 and traj3 at 0.25–0.5 m, simulated landings at 0.65 m) [m].
-constexpr double kRejectionMinHeight_m = 0.9;
-/// ... and from this long after an acquisition on: a climb that the estimate lags (simulated take-offs, 0.6 m high at
-/// 1.3 m/s) also rejects most TDoA for a moment, and a re-acquisition during it does worse than the filter [s].
-constexpr double kRejectionSettle_s = 2.0;
-/// ... and over at least this many (forgotten) TDoA.
-constexpr double kRejectionMinSamples = 20.0;
-/// The motion is recorded every kHealthyPeriod_s while at most this fraction is rejected; a fault reverts to the
-/// newest record at least kRevertLead_s and at most kRevertMaxAge_s old (F16d).
-constexpr double kHealthyRejectionRate = 0.3;
-constexpr double kHealthyPeriod_s = 0.05;
-constexpr double kRevertLead_s = 0.6;
-constexpr double kRevertMaxAge_s = 1.2;
 /// Events listed in the summary (re-acquisitions, ground periods): the first this many, reserved at construction so
 /// that no event allocates
 constexpr std::size_t kMaxListedEvents = 100;
-// (F28) the heading alignment acts on a fit whose heading std is below this, when the change exceeds 3σ and this
-constexpr double kMaxAlignedHeadingSigma_rad = 0.35;
-constexpr double kMinHeadingChange_rad = 0.15;
-constexpr double kMinAlignedTiltSigma_rad = 0.01;  ///< floor of the attitude std written with an alignment
+/// Anchor ids below this have a slot in the per-pair offset table (F19).
+constexpr int kMaxPairId = 64;
+
 /// (F16e) The horizontal motion relaxed towards rest over Δt from (p0, v0): v = v0 e^{−Δt/τ},
 /// p = p0 + v0 τ (1 − e^{−Δt/τ}); writes x and y of *p and *v, leaves z.
 void relaxHorizontal(const Vec3& p0, const Vec3& v0, double dt, double tau, Vec3* p, Vec3* v) {
@@ -63,71 +36,6 @@ void relaxHorizontal(const Vec3& p0, const Vec3& v0, double dt, double tau, Vec3
   p->head<2>() = p0.head<2>() + v0.head<2>() * (tau * (1.0 - e));
   v->head<2>() = v0.head<2>() * e;
 }
-
-/// Diverged (F16): the estimate left the anchors' box by this much [m], or moves faster than this [m/s].
-constexpr double kDivergedBoxMargin_m = 3.0;
-constexpr double kDivergedSpeed_mps = 8.0;
-/// A sensor-time gap longer than this is a time jump: the IMU is not integrated across it (F17) [s].
-constexpr double kMaxIntegrationGap_s = 0.25;
-/// Pairs seen within this window enter the reported bias floor (F23) [s].
-constexpr double kRecentPairWindow_s = 0.5;
-/// The bias floor's geometry term is recomputed at most this often [s] (F23).
-constexpr double kBiasFloorPeriod_s = 0.05;
-constexpr int kMaxPairId = 64;
-/// Height std of the body on the floor (F22) [m]: the body origin sits a few cm above the floor.
-constexpr double kGroundHeightSigma_m = 0.1;
-/// Ground contact (F18): shaking within this long counts [s]; only below this estimated height above the floor [m];
-/// after leaving the ground, shaking counts again only after this long [s] (the take-off's own transient).
-constexpr double kContactHold_s = 0.3;
-constexpr double kFromRest_s = 0.05;     // (F16f) the ground was left from rest: at rest this recently
-constexpr double kContactMaxHeight_m = 0.8;
-/// The contact height test uses the lowest estimate of the last 1.5 s, sampled every 50 ms; the rest test that of the
-/// last 3 s (F18).
-constexpr double kLowZPeriod_s = 0.05;
-constexpr std::size_t kContactLowZSamples = 30;  // 1.5 s / kLowZPeriod_s
-constexpr std::size_t kRestLowZSamples = 60;     // 3 s / kLowZPeriod_s: the whole ring (Estimator::low_z_)
-constexpr double kContactRearm_s = 0.5;
-/// Rest enters the ground from the air only while the estimate is near the floor and does not climb faster than
-/// kRestMaxClimb_mps [m/s], or within kLandingWindow_s [s] of a descent faster than kRestDescent_mps [m/s] (a landing:
-/// the estimate may climb after the touchdown, F26) (F18).
-constexpr double kRestMaxClimb_mps = 0.3;
-constexpr double kRestDescent_mps = 0.2;
-constexpr double kLandingWindow_s = 3.0;
-/// … and the low height must have been reached at the descent: only heights from this long before its last descending
-/// sample on count (a touchdown ends a descent; a climb before a hover's dip is no landing) [s] (F18).
-constexpr double kLandingLowZLead_s = 0.5;
-constexpr double kContactSustained_s = 1.5;
-/// (F29b) The airborne shaking level is learned while tracking this long after leaving the ground [s] and this high
-/// above the floor [m] (the take-off's own transient and the floor's shaking excluded).
-constexpr double kAirShakeSettle_s = 2.0;
-constexpr double kAirShakeMinHeight_m = 0.5;
-/// (F29e) A floor check in contact runs at most this often [s].
-constexpr double kFloorCheckPeriod_s = 3.0;
-/// Below this estimated height above the floor TDoA are down-weighted as on the ground (F14) [m].
-constexpr double kLowFlight_m = 0.25;
-/// (F16h) a landing's TDoA are tested against the floor-level delays while the estimate is within this of the floor
-/// [m]: the low-flight band (kLowFlight_m) and the height by which the estimate trails a descent at the touchdown
-/// (0.1–0.3 m on the simulated and real landings)
-constexpr double kLandingBand_m = 0.5;
-/// (F16i) a landing's floor window ends without a fix after this long [s] (StartUp keeps 3 s of history)
-constexpr double kLandingFixMax_s = 3.0;
-/// (F30) The innovation consistency check: the TDoA's NIS averaged over kNisWindow_s (each clipped at kNisClip) and
-/// the share of them beyond kNisFar (2σ; 4.6 % for a consistent Gaussian filter). Inconsistent while that share exceeds
-/// kNisMaxFarFraction (the bulk disagrees, not a few pairs out of line of sight) over at least kNisMinSamples
-/// forgotten TDoA; held for kInconsistentHold_s, the reported position band is widened by the mean's excess over 1, at
-/// most kMaxWidening_m, fading with kWideningFade_s afterwards.
-constexpr double kNisClip = 25.0;
-constexpr double kNisWindow_s = 1.0;
-constexpr double kNisFar = 4.0;
-constexpr double kNisMaxFarFraction = 0.5;
-constexpr double kNisMinSamples = 20.0;
-constexpr double kInconsistentHold_s = 1.0;
-constexpr double kMaxWidening_m = 0.5;
-constexpr double kWideningFade_s = 2.0;
-/// Constant time of the take-off detector's leaky vertical-velocity integrator [s] (F15).
-constexpr double kTakeoffLeak_s = 1.0;
-/// (F25) whether the learned pattern's variance hᵀ P_θ h is added to the filter's TDoA variance.
-constexpr bool kAntennaVarianceInFilter = false;
 
 }  // namespace
 
@@ -148,8 +56,7 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
       imu_mode_(params.process_model == ProcessModel::kImu),
       descent_(DescentBoundParams{params.descent_margin_m}),
       ekf_(params),
-      start_(anchors_, params.b_t_tag,
-             StartUpParams{params.start_window_s, 40, 3.0, 0.2, params.init_pos_sigma_m, 0.15, 1.0}),
+      start_(anchors_, params.b_t_tag, StartUpParams::fromEkfParams(params)),
       replay_(params),
       heading_align_(params.heading_alignment_window_s, InMotionAlignment::kDefaultSamplePeriod_s,
                      InMotionAlignment::kDefaultCorrelation_s, params.rotor_drag_per_s) {
@@ -168,25 +75,33 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
   box_max_ = box.max;
   centroid_ = box.centroid;
 
+  configureUpdateOptions();
+  if (params_.pair_bias_tau_s > 0.0) pair_offsets_.resize(kMaxPairId * kMaxPairId);
+  configureBiasCorrections();
+}
+
+void Estimator::configureUpdateOptions() {
   tdoa_model_.b_t_tag = params_.b_t_tag;
-  track_opt_.sigma_m = params_.tdoa_sigma_m;
-  track_opt_.gate_sigma = params_.gate_sigma;
-  track_opt_.loss = params_.robust_loss;
-  track_opt_.robust_k = params_.robust_k;
-  track_opt_.robust_iterations = params_.robust_iterations;
-  track_opt_.b_t_tag = params_.b_t_tag;
-  track_opt_.bias_pose = params_.bias_model_pose;
+  track_opt_ = {.sigma_m = params_.tdoa_sigma_m,
+                .gate_sigma = params_.gate_sigma,
+                .loss = params_.robust_loss,
+                .robust_k = params_.robust_k,
+                .robust_iterations = params_.robust_iterations,
+                .b_t_tag = params_.b_t_tag,
+                .bias_pose = params_.bias_model_pose};
   acq_opt_ = track_opt_;
   acq_opt_.sigma_m = params_.acquisition_tdoa_sigma_m;
   acq_opt_.gate_sigma = 0.0;  // (F16) no gate while acquiring; the robust loss limits outliers
   if (acq_opt_.loss == RobustLoss::kNone) acq_opt_.loss = RobustLoss::kHuber;
   rest_opt_ = track_opt_;
   rest_opt_.sigma_m = params_.rest_tdoa_sigma_m;  // (F14) down-weighted at rest, still gated
-  tof_opt_.sigma_m = params_.tof_sigma_m;
-  tof_opt_.offset_m = params_.tof_offset_m;
-  tof_opt_.floor_z_m = params_.floor_z_m;
-  tof_opt_.max_range_m = params_.tof_max_range_m;
-  if (params_.pair_bias_tau_s > 0.0) pair_offsets_.resize(kMaxPairId * kMaxPairId);
+  tof_opt_ = {.sigma_m = params_.tof_sigma_m,
+              .offset_m = params_.tof_offset_m,
+              .floor_z_m = params_.floor_z_m,
+              .max_range_m = params_.tof_max_range_m};
+}
+
+void Estimator::configureBiasCorrections() {
   if (params_.antenna_bias_degree > 0) {
     // (F25) the learned antenna pattern adds to the (optional) bias model's correction
     antenna_.emplace(AntennaBiasParams{params_.antenna_bias_degree, params_.antenna_bias_sigma_m,
@@ -200,8 +115,7 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
       if (!antenna_predicted_) return b;
       const BiasPrediction a = antenna_->predict(feature);
       b.mean_m += a.mean_m;
-      antenna_var_m2_ = kAntennaVarianceInFilter ? a.variance_m2 : 0.0;
-      b.variance_m2 += antenna_var_m2_;
+      // (F25b) its variance hᵀ P_θ h is not added to the filter's R: the inflated σ_tdoa stands for it
       return b;
     };
   }
@@ -292,7 +206,7 @@ void Estimator::finishStart(double t_s, const StartFix& fix) {
   const bool replayed =
       fix.with_velocity && replay_.recording() && replay_.referenceTime() == fix.t_ref_s &&
       replay_.replay(ekf_, fix.w_p0, fix.w_v0, std::sqrt(fix.cov(0, 0)), params_.moving_start_vel_sigma_mps,
-                     params_.cov_period_s, [this](Ekf& f, const TdoaObservation& z) {
+                     params_.cov_period_s, [this](Ekf& f, const TdoaMeasurement& z) {
                        updateTdoa(f, anchors_, z, acq_opt_, bias_ ? &bias_ : nullptr);
                      });
   replay_.stop();
@@ -402,7 +316,7 @@ void Estimator::leaveGround(double t_s, bool climbing) {
   // without floor shaking, or lifted by hand): its height is dead-reckoned from there for the fade of the floor-level
   // delays. Leaving floor contact (shaking with the motors running) or with a detected climb, it has already risen.
   const bool from_rest =
-      (t_s - t_last_rest_ < kFromRest_s || left_rest_mode_) && t_s - t_last_shake_ >= kContactHold_s;
+      (t_s - t_last_rest_ < params_.from_rest_s || left_rest_mode_) && t_s - t_last_shake_ >= params_.contact_hold_s;
   if (floor_anchors_.hasDelays() && !climbing && from_rest) climb_.start(t_s);
   t_left_ground_ = t_s;
   if (summary_.ground_left_t_s.size() < summary_.ground_entered_t_s.size()) summary_.ground_left_t_s.push_back(t_s);
@@ -487,12 +401,12 @@ void Estimator::finishLandingFix(const StartFix& fix) {
 
 void Estimator::applyFloorConstraint(bool on_ground) {
   // (F22) z ≥ floor: a one-sided constraint, applied when the estimate violates it; on the ground (F14) the body
-  // sits on the floor: z = floor ± kGroundHeightSigma_m
+  // sits on the floor: z = floor ± params_.ground_height_sigma_m
   if (!params_.floor_constraint || !ready_) return;
   const double z = ekf_.state().w_p_b.z();
   if (on_ground && start_.active()) return;
   if (on_ground) {
-    ekf_.positionUpdate(2, params_.ground_z_m, kGroundHeightSigma_m);
+    ekf_.positionUpdate(2, params_.ground_z_m, params_.ground_height_sigma_m);
     ++summary_.n_floor_updates;
     return;
   }
@@ -525,10 +439,10 @@ void Estimator::applyDescentBound(double t_s) {
 bool Estimator::diverged() const {
   const NavState& x = ekf_.state();
   if (!x.w_p_b.allFinite() || !x.w_v_b.allFinite()) return true;
-  if ((x.w_p_b.array() < box_min_.array() - kDivergedBoxMargin_m).any() ||
-      (x.w_p_b.array() > box_max_.array() + kDivergedBoxMargin_m).any())
+  if ((x.w_p_b.array() < box_min_.array() - params_.diverged_box_margin_m).any() ||
+      (x.w_p_b.array() > box_max_.array() + params_.diverged_box_margin_m).any())
     return true;
-  return x.w_v_b.squaredNorm() > kDivergedSpeed_mps * kDivergedSpeed_mps;
+  return x.w_v_b.squaredNorm() > params_.diverged_speed_mps * params_.diverged_speed_mps;
 }
 
 void Estimator::addImu(double t_s, const ImuReading& imu) {
@@ -540,34 +454,11 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
   t_last_event_ = std::isnan(t_last_event_) ? t_s : std::max(t_last_event_, t_s);
   summary_.end_t_s = t_last_event_;
   if (!initialized_) {
-    // (F15) levelling window: mean specific force for the attitude, its spread tells rest from motion
-    if (std::isnan(t_first_imu_)) t_first_imu_ = t_s;
-    init_acc_sum_ += imu.b_acc_mps2;
-    init_gyro_sum_ += imu.b_gyro_radps;
-    init_acc_sq_sum_ += imu.b_acc_mps2.squaredNorm();
-    init_gyro_sq_sum_ += imu.b_gyro_radps.squaredNorm();
-    ++n_init_;
-    last_imu_ = imu;
-    t_last_imu_ = t_s;
-    if (t_s - t_first_imu_ >= kLevelWindow_s || n_init_ >= kLevelSamples) {
-      const Vec3 mean = init_acc_sum_ / n_init_;
-      const double var = std::max(init_acc_sq_sum_ / n_init_ - mean.squaredNorm(), 0.0);
-      const bool moving = var > kLevelRestAccStd_mps2 * kLevelRestAccStd_mps2;
-      rest_.reset(imu);
-      // (F18) a still levelling window shows the gyro's own bias: the rest test reads against it too
-      const Vec3 gyro_mean = init_gyro_sum_ / n_init_;
-      if (!moving) rest_.setGyroReference(gyro_mean);
-      // (F18) the window's moments start the rest statistics: a body still from the first sample is on the ground
-      // before the first fix (a motors-off start), whatever its TDoA say of the height
-      const double gyro_ms = init_gyro_sq_sum_ / n_init_;
-      rest_.seed(t_s, var, gyro_ms, std::max(gyro_ms - gyro_mean.squaredNorm(), 0.0));
-      g_ref_ = mean.norm();
-      initialize(t_s, mean, moving);
-    }
+    addLevellingSample(t_s, imu);
     return;
   }
   const double dt_imu = t_s - t_last_imu_;
-  if (dt_imu > kMaxIntegrationGap_s || dt_imu < -params_.max_gap_s) {
+  if (dt_imu > params_.max_integration_gap_s || dt_imu < -params_.max_gap_s) {
     handleTimeJump(t_s, dt_imu);
     t_last_imu_ = t_s;
     last_imu_ = imu;
@@ -590,118 +481,167 @@ void Estimator::addImu(double t_s, const ImuReading& imu) {
     if (descent_.running()) descent_.integrate(a_up, dt_imu);
     climb_.integrate(t_s, a_up, dt_imu);  // (F16f)
   }
-  if (params_.ground_phase == GroundPhase::kDetectTakeoff) {
-    bool climbing = false;
-    // (F29b) floor shaking: the high-passed gyro far above the shaking this flight shows in the air
-    const double shake_ms = rest_.gyroHighPassMeanSquare();
-    const bool shaking = mode_.shakingStandsOut(shake_ms);
-    if (on_ground_) {
-      // (F15) take-off detector: leaky integral of the vertical specific-force excess over its level on the ground
-      const double a_up = worldVertical(ekf_.state().w_q_b, imu.b_acc_mps2);
-      v_climb_ = expNegative(dt_imu / kTakeoffLeak_s) * v_climb_ + dt_imu * (a_up - g_ref_);
-      if (rest_.stillNow() || v_climb_ < 0.05) g_ref_ += (dt_imu / 2.0) * (a_up - g_ref_);
-      // a body that shakes is still touching the floor (touchdown bounces, spin-up): no take-off
-      climbing = v_climb_ > params_.takeoff_climb_mps && !rest_.stillNow() && !shaking;
-    }
-    if (shaking && t_s - t_left_ground_ > kContactRearm_s) {
-      if (t_s - t_last_shake_ >= kContactHold_s) t_shake_since_ = t_s;  // a new shaking episode
-      t_last_shake_ = t_s;
-    }
-    // recent lowest height: on ground contact the estimate can run away upwards (contact force in the thrust
-    // model, floor-biased TDoA) before the shaking shows
-    if (ready_ && t_s - t_low_z_sample_ >= kLowZPeriod_s) {
-      low_z_[i_low_z_] = ekf_.state().w_p_b.z();
-      i_low_z_ = (i_low_z_ + 1) % low_z_.size();
-      n_low_z_ = std::min(n_low_z_ + 1, low_z_.size());
-      t_low_z_sample_ = t_s;
-    }
-    // the lowest estimate of the last n samples (and the current one)
-    const auto lowestRecentZ = [&](std::size_t n) {
-      double z_low = ekf_.state().w_p_b.z();
-      const std::size_t size = low_z_.size();
-      for (std::size_t k = 0; k < std::min(n, n_low_z_); ++k)
-        z_low = std::min(z_low, low_z_[(i_low_z_ + size - 1 - k) % size]);
-      return z_low;
-    };
-    // shaking near the floor, or shaking for long wherever the estimate is (flight shakes only briefly)
-    // (F29b) and not entered from the air while the estimate climbs: shaking in a climb is rotors at thrust, not the
-    // floor (the climb after a take-off of a drone whose gyro shakes in flight)
-    const bool contact = t_s - t_last_shake_ < kContactHold_s &&
-                         (on_ground_ || !ready_ || ekf_.state().w_v_b.z() < kRestMaxClimb_mps) &&
-                         (!ready_ || t_s - t_shake_since_ >= kContactSustained_s ||
-                          lowestRecentZ(kContactLowZSamples) - params_.ground_z_m < kContactMaxHeight_m);
-    // rest enters the ground near the floor only: an IMU logged at a low rate or filtered reads as quiet in a still
-    // hover as with the motors off, and a still hover high above the floor is not on the ground (the floor height, the
-    // ZUPT and the ground's TDoA weight would pull it down); the window spans the climb of the estimate after a
-    // touchdown (F26). Once on the ground, rest holds it wherever the estimate is.
-    // Nor does it enter while the estimate climbs or after a climb from the floor: after a take-off a steady climb or
-    // hover reads as quiet as rest too, and the ZUPT would take the climb for accelerometer bias. Only a descent
-    // opens the window (the touchdown: the estimate may climb after it, F26).
-    const NavState& x = ekf_.state();
-    if (ready_ && x.w_v_b.z() < -kRestDescent_mps) t_last_descent_ = t_s;
-    // the heights of a landing: those since kLandingLowZLead_s before its last descending sample (the window's span)
-    const auto landingLowZ = [&] {
-      const double span_s = t_s - t_last_descent_ + kLandingLowZLead_s;
-      return lowestRecentZ(std::min(kRestLowZSamples, static_cast<std::size_t>(span_s / kLowZPeriod_s) + 1));
-    };
-    const bool rest =
-        rest_.atRest() &&
-        (on_ground_ || !ready_ ||
-         (x.w_p_b.z() - params_.ground_z_m < kContactMaxHeight_m && x.w_v_b.z() < kRestMaxClimb_mps) ||
-         (t_s - t_last_descent_ < kLandingWindow_s && landingLowZ() - params_.ground_z_m < kContactMaxHeight_m));
-    // (F29) the IMU's evidence, weighed with the TDoA's by the flight-mode supervisor
-    const bool settled_in_air = !on_ground_ && ready_ && phase_ == FlightPhase::kTracking &&
-                                t_s - t_left_ground_ > kAirShakeSettle_s &&
-                                x.w_p_b.z() - params_.ground_z_m > kAirShakeMinHeight_m;
-    mode_.addImu(t_s, dt_imu, ImuModeEvidence{rest, contact, climbing, shake_ms}, settled_in_air);
-    left_rest_mode_ = mode_.mode() == FlightMode::kRest;  // (F16f) the mode the ground is left from
-    mode_.decide(t_s);
-    summary_.floor_doubted_s = mode_.doubtedFloorTime();
-    summary_.floor_doubted_max_height_m = mode_.doubtedFloorMaxHeight();
-    summary_.n_mode_overrules = static_cast<std::size_t>(mode_.tdoaOverrules());
-    summary_.air_shake_rms_radps = std::sqrt(mode_.airShakeLevel());
-    const bool ground_now = mode_.onFloor();
-    // (F29e) floor contact whose TDoA the floor explains worse than the air: the mode is examined by a solve of a
-    // fresh window on the floor against one in the air (F16j), at most every kFloorCheckPeriod_s
-    if (ground_now && on_ground_ && ready_ && !start_.active() && mode_.mode() == FlightMode::kContact && mode_.tdoaLogOdds() > 0.0 &&
-        t_s - t_floor_check_ >= kFloorCheckPeriod_s) {
-      t_floor_check_ = t_s;
-      floor_check_ = true;
-      landing_fix_ = false;
-      start_.begin(t_s, ekf_.state(), false, true);
-      ++summary_.n_floor_checks;
-    }
-    if (ground_now && !on_ground_) {
-      predictTo(t_s);
-      propagate(true);
-      enterGround(t_s);
-    } else if (!ground_now && on_ground_) {
-      predictTo(t_s);
-      const bool overruled = (mode_.status() & kTdoaOverrulesImu) != 0;
-      leaveGround(t_s, climbing);
-      if (overruled) {
-        // (F29) the TDoA put the tag in the air against the IMU's floor evidence: the shaking seen now is this
-        // flight's airborne shaking (F29b), and the position held on the floor is found again from the TDoA (F16)
-        if (contact) mode_.learnAirShake(shake_ms);
-        if (ready_ && !start_.active()) startAcquisition(t_s, true);
-        mode_.clearTdoa();
-      }
-    }
-  }
+  if (params_.ground_phase == GroundPhase::kDetectTakeoff) superviseGround(t_s, imu, dt_imu);
 
   if (t_s - t_pred_ >= params_.max_predict_dt_s) {
     predictTo(t_s);
     propagate(false);
   }
   alignHeading(t_s, imu, dt_imu);
-  if (on_ground_ && t_s - t_last_zupt_ >= kZuptPeriod_s) {
+  runPeriodicChecks(t_s);
+}
+
+void Estimator::addLevellingSample(double t_s, const ImuReading& imu) {
+  // (F15) levelling window: mean specific force for the attitude, its spread tells rest from motion
+  if (std::isnan(t_first_imu_)) t_first_imu_ = t_s;
+  init_acc_sum_ += imu.b_acc_mps2;
+  init_gyro_sum_ += imu.b_gyro_radps;
+  init_acc_sq_sum_ += imu.b_acc_mps2.squaredNorm();
+  init_gyro_sq_sum_ += imu.b_gyro_radps.squaredNorm();
+  ++n_init_;
+  last_imu_ = imu;
+  t_last_imu_ = t_s;
+  if (!(t_s - t_first_imu_ >= params_.level_window_s || n_init_ >= params_.level_max_samples)) return;
+  const Vec3 mean = init_acc_sum_ / n_init_;
+  const double var = std::max(init_acc_sq_sum_ / n_init_ - mean.squaredNorm(), 0.0);
+  const bool moving = var > params_.level_rest_acc_std_mps2 * params_.level_rest_acc_std_mps2;
+  rest_.reset(imu);
+  // (F18) a still levelling window shows the gyro's own bias: the rest test reads against it too
+  const Vec3 gyro_mean = init_gyro_sum_ / n_init_;
+  if (!moving) rest_.setGyroReference(gyro_mean);
+  // (F18) the window's moments start the rest statistics: a body still from the first sample is on the ground
+  // before the first fix (a motors-off start), whatever its TDoA say of the height
+  const double gyro_ms = init_gyro_sq_sum_ / n_init_;
+  rest_.seed(t_s, var, gyro_ms, std::max(gyro_ms - gyro_mean.squaredNorm(), 0.0));
+  g_ref_ = mean.norm();
+  initialize(t_s, mean, moving);
+}
+
+void Estimator::superviseGround(double t_s, const ImuReading& imu, double dt_imu) {
+  bool climbing = false;
+  // (F29b) floor shaking: the high-passed gyro far above the shaking this flight shows in the air
+  const double shake_ms = rest_.gyroHighPassMeanSquare();
+  const bool shaking = mode_.shakingStandsOut(shake_ms);
+  if (on_ground_) climbing = updateTakeoffDetector(imu, dt_imu, shaking);
+  if (shaking && t_s - t_left_ground_ > params_.contact_rearm_s) {
+    if (t_s - t_last_shake_ >= params_.contact_hold_s) t_shake_since_ = t_s;  // a new shaking episode
+    t_last_shake_ = t_s;
+  }
+  // recent lowest height: on ground contact the estimate can run away upwards (contact force in the thrust
+  // model, floor-biased TDoA) before the shaking shows
+  if (ready_ && t_s - t_low_z_sample_ >= params_.low_z_period_s) {
+    low_z_[i_low_z_] = ekf_.state().w_p_b.z();
+    i_low_z_ = (i_low_z_ + 1) % low_z_.size();
+    n_low_z_ = std::min(n_low_z_ + 1, low_z_.size());
+    t_low_z_sample_ = t_s;
+  }
+  const bool contact = floorContact(t_s);
+  const bool rest = restNearFloor(t_s);
+  // (F29) the IMU's evidence, weighed with the TDoA's by the flight-mode supervisor
+  const NavState& x = ekf_.state();
+  const bool settled_in_air = !on_ground_ && ready_ && phase_ == FlightPhase::kTracking &&
+                              t_s - t_left_ground_ > params_.air_shake_settle_s &&
+                              x.w_p_b.z() - params_.ground_z_m > params_.air_shake_min_height_m;
+  mode_.addImu(t_s, dt_imu, ImuModeEvidence{rest, contact, climbing, shake_ms}, settled_in_air);
+  left_rest_mode_ = mode_.mode() == FlightMode::kRest;  // (F16f) the mode the ground is left from
+  mode_.decide(t_s);
+  summary_.floor_doubted_s = mode_.doubtedFloorTime();
+  summary_.floor_doubted_max_height_m = mode_.doubtedFloorMaxHeight();
+  summary_.n_mode_overrules = static_cast<std::size_t>(mode_.tdoaOverrules());
+  summary_.air_shake_rms_radps = std::sqrt(mode_.airShakeLevel());
+  followFlightMode(t_s, climbing, contact, shake_ms);
+}
+
+bool Estimator::updateTakeoffDetector(const ImuReading& imu, double dt_imu, bool shaking) {
+  // (F15) take-off detector: leaky integral of the vertical specific-force excess over its level on the ground
+  const double a_up = worldVertical(ekf_.state().w_q_b, imu.b_acc_mps2);
+  v_climb_ = expNegative(dt_imu / params_.takeoff_leak_s) * v_climb_ + dt_imu * (a_up - g_ref_);
+  if (rest_.stillNow() || v_climb_ < 0.05) g_ref_ += (dt_imu / 2.0) * (a_up - g_ref_);
+  // a body that shakes is still touching the floor (touchdown bounces, spin-up): no take-off
+  return v_climb_ > params_.takeoff_climb_mps && !rest_.stillNow() && !shaking;
+}
+
+double Estimator::lowestRecentZ(std::size_t n) const {
+  // the lowest estimate of the last n samples (and the current one)
+  double z_low = ekf_.state().w_p_b.z();
+  const std::size_t size = low_z_.size();
+  for (std::size_t k = 0; k < std::min(n, n_low_z_); ++k)
+    z_low = std::min(z_low, low_z_[(i_low_z_ + size - 1 - k) % size]);
+  return z_low;
+}
+
+bool Estimator::floorContact(double t_s) const {
+  // shaking near the floor, or shaking for long wherever the estimate is (flight shakes only briefly)
+  // (F29b) and not entered from the air while the estimate climbs: shaking in a climb is rotors at thrust, not the
+  // floor (the climb after a take-off of a drone whose gyro shakes in flight)
+  const std::size_t n_low = static_cast<std::size_t>(params_.contact_low_z_samples);
+  return t_s - t_last_shake_ < params_.contact_hold_s &&
+         (on_ground_ || !ready_ || ekf_.state().w_v_b.z() < params_.rest_max_climb_mps) &&
+         (!ready_ || t_s - t_shake_since_ >= params_.contact_sustained_s ||
+          lowestRecentZ(n_low) - params_.ground_z_m < params_.contact_max_height_m);
+}
+
+bool Estimator::restNearFloor(double t_s) {
+  // rest enters the ground near the floor only: an IMU logged at a low rate or filtered reads as quiet in a still
+  // hover as with the motors off, and a still hover high above the floor is not on the ground (the floor height, the
+  // ZUPT and the ground's TDoA weight would pull it down); the window spans the climb of the estimate after a
+  // touchdown (F26). Once on the ground, rest holds it wherever the estimate is.
+  // Nor does it enter while the estimate climbs or after a climb from the floor: after a take-off a steady climb or
+  // hover reads as quiet as rest too, and the ZUPT would take the climb for accelerometer bias. Only a descent
+  // opens the window (the touchdown: the estimate may climb after it, F26).
+  const NavState& x = ekf_.state();
+  if (ready_ && x.w_v_b.z() < -params_.rest_descent_mps) t_last_descent_ = t_s;
+  // the heights of a landing: those since landing_low_z_lead_s before its last descending sample (the window's span)
+  const auto landingLowZ = [&] {
+    const double span_s = t_s - t_last_descent_ + params_.landing_low_z_lead_s;
+    return lowestRecentZ(std::min(low_z_.size(), static_cast<std::size_t>(span_s / params_.low_z_period_s) + 1));
+  };
+  const double floor_m = params_.ground_z_m, max_height_m = params_.contact_max_height_m;
+  return rest_.atRest() &&
+         (on_ground_ || !ready_ ||
+          (x.w_p_b.z() - floor_m < max_height_m && x.w_v_b.z() < params_.rest_max_climb_mps) ||
+          (t_s - t_last_descent_ < params_.landing_window_s && landingLowZ() - floor_m < max_height_m));
+}
+
+void Estimator::followFlightMode(double t_s, bool climbing, bool contact, double shake_ms) {
+  const bool ground_now = mode_.onFloor();
+  // (F29e) floor contact whose TDoA the floor explains worse than the air: the mode is examined by a solve of a
+  // fresh window on the floor against one in the air (F16j), at most every floor_check_period_s
+  if (ground_now && on_ground_ && ready_ && !start_.active() && mode_.mode() == FlightMode::kContact &&
+      mode_.tdoaLogOdds() > 0.0 && t_s - t_floor_check_ >= params_.floor_check_period_s) {
+    t_floor_check_ = t_s;
+    floor_check_ = true;
+    landing_fix_ = false;
+    start_.begin(t_s, ekf_.state(), false, true);
+    ++summary_.n_floor_checks;
+  }
+  if (ground_now && !on_ground_) {
     predictTo(t_s);
     propagate(true);
-    ekf_.zeroVelocityUpdate(kZuptSigma_mps);  // (F14)
+    enterGround(t_s);
+  } else if (!ground_now && on_ground_) {
+    predictTo(t_s);
+    const bool overruled = (mode_.status() & kTdoaOverrulesImu) != 0;
+    leaveGround(t_s, climbing);
+    if (overruled) {
+      // (F29) the TDoA put the tag in the air against the IMU's floor evidence: the shaking seen now is this
+      // flight's airborne shaking (F29b), and the position held on the floor is found again from the TDoA (F16)
+      if (contact) mode_.learnAirShake(shake_ms);
+      if (ready_ && !start_.active()) startAcquisition(t_s, true);
+      mode_.clearTdoa();
+    }
+  }
+}
+
+void Estimator::runPeriodicChecks(double t_s) {
+  if (on_ground_ && t_s - t_last_zupt_ >= params_.zupt_period_s) {
+    predictTo(t_s);
+    propagate(true);
+    ekf_.zeroVelocityUpdate(params_.zupt_sigma_mps);  // (F14)
     ++summary_.n_zero_velocity_updates;
     t_last_zupt_ = t_s;
     applyFloorConstraint(true);
-  } else if (t_s - t_last_zupt_ >= kZuptPeriod_s) {
+  } else if (t_s - t_last_zupt_ >= params_.zupt_period_s) {
     t_last_zupt_ = t_s;
     applyFloorConstraint(false);
     applyDescentBound(t_s);
@@ -775,92 +715,29 @@ CooperativeRangeResult Estimator::addNeighbourRange(double t_s, const Moments3& 
   return r;
 }
 
-void Estimator::addTdoa(const TdoaObservation& z) {
+void Estimator::addTdoa(const TdoaMeasurement& z) {
   ++summary_.n_tdoa_total;
   last_tdoa_ = TdoaUpdateResult{};
   last_tdoa_in_flight_ = false;
   // (F31) a TDoA longer than its anchor pair's baseline (or not finite) is no range difference: skipped
   if (!checkTdoaRange(z, anchors_, summary_.sensor_range)) return;
   const double t = z.t_s;
-  if (!initialized_) {
-    if (imu_mode_) {
-      ++summary_.n_tdoa_before_imu;
-      return;
-    }
-    summary_.start_t_s = t;
-    t_last_event_ = t;
-    initialize(t, Vec3(0, 0, kGravity_mps2), false);
-  }
-  if (t < t_pred_ - params_.max_gap_s) {
-    if (imu_mode_) {
-      ++summary_.n_tdoa_out_of_order;  // the IMU clock leads; a backward jump of the IMU re-bases the time (F17)
-      return;
-    }
-    handleTimeJump(t, t - t_pred_);
-  }
-  if (imu_mode_ && t - t_pred_ > kMaxIntegrationGap_s) {
-    // (F17) the IMU stream stopped (dropout or a clock jump seen first here): nothing is integrated across the gap
-    handleTimeJump(t, t - t_pred_);
-    t_last_imu_ = t;
-  }
-  if (!imu_mode_ && t - t_pred_ > kMaxIntegrationGap_s * 4.0) handleTimeJump(t, t - t_pred_);
-  t_last_event_ = std::max(t_last_event_, t);
-  summary_.end_t_s = t_last_event_;
-  // (F17) the nominal state is brought to the measurement time only when it lags by more than update_predict_dt_s
-  if (!imu_mode_ || t - t_pred_ >= params_.update_predict_dt_s) predictTo(t);
-
-  // (F16i) a landing's floor window that finds no fix within kLandingFixMax_s ends: the TDoA are used again
-  if (landing_fix_ && t - t_landing_fix_s_ > kLandingFixMax_s) endLandingFix();
+  if (!advanceToTdoa(t)) return;
+  // (F16i) a landing's floor window that finds no fix within landing_fix_max_s ends: the TDoA are used again
+  if (landing_fix_ && t - t_landing_fix_s_ > params_.landing_fix_max_s) endLandingFix();
   if (start_.active()) {
-    // (F16) collecting the multilateration batch; the displacement comes from the prediction
-    ++summary_.n_tdoa_start;
-    propagate(!imu_mode_);
-    const std::optional<double> floor_z =
-        on_ground_ && params_.floor_constraint ? std::optional<double>(params_.ground_z_m) : std::nullopt;
-    if (replay_.recording()) replay_.recordTdoa(z);
-    // (F16j) floor contact before the first fix may be refuted by the TDoA; rest (motors off) is not
-    // (F29e) and so is floor contact at a floor check
-    const bool floor_refutable = floor_z && ((!ready_ && t_last_rest_ < t_entered_ground_) || floor_check_);
-    if (const std::optional<StartFix> fix = start_.add(z, ekf_.state(), floor_z, floor_refutable)) {
-      propagate(true);
-      if (floor_check_) finishFloorCheck(t, *fix);
-      else if (landing_fix_) finishLandingFix(*fix);
-      else finishStart(t, *fix);
-    } else if (replay_.recording() && start_.referenceTime() != replay_.referenceTime()) {
-      replay_.begin(ekf_, start_.referenceTime());  // (F16b) a failed solve moved the reference to now
-    }
+    collectStartTdoa(z);
     return;
   }
   if (phase_ == FlightPhase::kAcquisition && t >= t_acq_end_)
     phase_ = on_ground_ ? (moved_ ? FlightPhase::kLanded : FlightPhase::kGround) : FlightPhase::kTracking;
   propagate(!imu_mode_);
   const bool acquiring = phase_ == FlightPhase::kAcquisition;
-  // (F19) optional per-pair offset learned from the innovations while tracking
-  TdoaObservation zc = z;
-  PairOffset* po = nullptr;
-  if (!pair_offsets_.empty() && z.id_a >= 0 && z.id_b >= 0 && z.id_a < kMaxPairId && z.id_b < kMaxPairId) {
-    po = &pair_offsets_[z.id_a * kMaxPairId + z.id_b];
-    zc.tdoa_m -= po->offset_m;
-  }
   // (F14) TDoA near the floor carry the large floor-level bias: down-weighted on the ground and just above it
-  const bool near_floor = on_ground_ || ekf_.state().w_p_b.z() - params_.ground_z_m < kLowFlight_m;
+  const bool near_floor = on_ground_ || ekf_.state().w_p_b.z() - params_.ground_z_m < params_.low_flight_m;
   const TdoaUpdateOptions& opt = acquiring ? acq_opt_ : (near_floor ? rest_opt_ : track_opt_);
-  // (F16f) on the ground the floor-level anchors are seen with the delays the start on the floor found; after the
-  // ground evidence ended without a climb, they fade with the height dead-reckoned from the floor
-  if (floor_anchors_.hasDelays() && (on_ground_ || climb_.running())) {
-    const double f = on_ground_ ? 1.0 : FloorLevelAnchors::remainingFraction(climb_.height());
-    zc.tdoa_m -= f * floor_anchors_.pairDelay(z.id_a, z.id_b);
-  } else if (floor_anchors_.hasDelays() && !acquiring && t - t_last_descent_ < kLandingWindow_s &&
-             ekf_.state().w_p_b.z() - params_.ground_z_m < kLandingBand_m) {
-    // (F16h) near the floor after a descent (a landing): the delay or none, whichever the TDoA lies nearer to
-    const Moments3* a = anchors_.find(z.id_a);
-    const Moments3* b = anchors_.find(z.id_b);
-    if (a && b && floor_anchors_.pairDelay(z.id_a, z.id_b) != 0.0) {  // a pair without floor-level anchors: no delay
-      const NavState& x = ekf_.state();
-      const double r = zc.tdoa_m - predictTdoa(x.w_p_b, x.w_q_b, params_.b_t_tag, a->m, b->m);
-      zc.tdoa_m -= floor_anchors_.nearerPairDelay(z.id_a, z.id_b, r);
-    }
-  }
+  PairOffset* po = nullptr;
+  const TdoaMeasurement zc = correctedTdoa(z, acquiring, &po);
   if (imu_mode_ && ready_ && params_.ground_phase == GroundPhase::kDetectTakeoff) superviseTdoa(t, z);
   if (antenna_) {
     antenna_->advance(t);
@@ -873,20 +750,120 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   const Vec3 w_p_tag_prior = levels ? Vec3(ekf_.state().w_p_b + ekf_.state().w_q_b * params_.b_t_tag) : Vec3::Zero();
   const TdoaUpdateResult r = updateTdoa(ekf_, anchors_, zc, opt, predictor);
   last_tdoa_ = r;
+  learnFromInnovation(t, r, acquiring, near_floor, po);
+  countTdoaOutcome(t, r, acquiring, near_floor);
+  // (F30) in the air only: on and near the floor the TDoA carry the floor-level bias (F14), which their σ there covers
+  const bool gated = r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier;
+  if (!acquiring && !near_floor && gated) checkConsistency(t, r.nis);
+  // in flight only: on and near the floor the TDoA carry the floor-level bias (F14), and a body at rest or in ground
+  // contact (F18: still, or shaking on the legs) is not flying even before the ground phase is entered
+  const bool flying = !acquiring && !near_floor &&
+                      std::min(t - t_acq_end_, t - t_left_ground_) >= params_.rejection_settle_s &&
+                      ekf_.state().w_p_b.z() - params_.ground_z_m > params_.rejection_min_height_m &&
+                      !(imu_mode_ && (rest_.stillNow() || mode_.shakingStandsOut(rest_.gyroHighPassMeanSquare())));
+  last_tdoa_in_flight_ = flying;
+  if (flying && gated) trackRejectionRate(t, r);
+  if (levels) feedBiasLevels(t, z, r, flying, range_bias_prior_m, w_p_tag_prior);
+  notePairInView(t, z, r);
+  superviseTracking(t, acquiring);
+}
+
+bool Estimator::advanceToTdoa(double t) {
+  if (!initialized_) {
+    if (imu_mode_) {
+      ++summary_.n_tdoa_before_imu;
+      return false;
+    }
+    summary_.start_t_s = t;
+    t_last_event_ = t;
+    initialize(t, Vec3(0, 0, kGravity_mps2), false);
+  }
+  if (t < t_pred_ - params_.max_gap_s) {
+    if (imu_mode_) {
+      ++summary_.n_tdoa_out_of_order;  // the IMU clock leads; a backward jump of the IMU re-bases the time (F17)
+      return false;
+    }
+    handleTimeJump(t, t - t_pred_);
+  }
+  if (imu_mode_ && t - t_pred_ > params_.max_integration_gap_s) {
+    // (F17) the IMU stream stopped (dropout or a clock jump seen first here): nothing is integrated across the gap
+    handleTimeJump(t, t - t_pred_);
+    t_last_imu_ = t;
+  }
+  if (!imu_mode_ && t - t_pred_ > params_.max_integration_gap_s * 4.0) handleTimeJump(t, t - t_pred_);
+  t_last_event_ = std::max(t_last_event_, t);
+  summary_.end_t_s = t_last_event_;
+  // (F17) the nominal state is brought to the measurement time only when it lags by more than update_predict_dt_s
+  if (!imu_mode_ || t - t_pred_ >= params_.update_predict_dt_s) predictTo(t);
+  return true;
+}
+
+void Estimator::collectStartTdoa(const TdoaMeasurement& z) {
+  // (F16) collecting the multilateration batch; the displacement comes from the prediction
+  const double t = z.t_s;
+  ++summary_.n_tdoa_start;
+  propagate(!imu_mode_);
+  const std::optional<double> floor_z =
+      on_ground_ && params_.floor_constraint ? std::optional<double>(params_.ground_z_m) : std::nullopt;
+  if (replay_.recording()) replay_.recordTdoa(z);
+  // (F16j) floor contact before the first fix may be refuted by the TDoA; rest (motors off) is not
+  // (F29e) and so is floor contact at a floor check
+  const bool floor_refutable = floor_z && ((!ready_ && t_last_rest_ < t_entered_ground_) || floor_check_);
+  if (const std::optional<StartFix> fix = start_.add(z, ekf_.state(), floor_z, floor_refutable)) {
+    propagate(true);
+    if (floor_check_) finishFloorCheck(t, *fix);
+    else if (landing_fix_) finishLandingFix(*fix);
+    else finishStart(t, *fix);
+  } else if (replay_.recording() && start_.referenceTime() != replay_.referenceTime()) {
+    replay_.begin(ekf_, start_.referenceTime());  // (F16b) a failed solve moved the reference to now
+  }
+}
+
+TdoaMeasurement Estimator::correctedTdoa(const TdoaMeasurement& z, bool acquiring, PairOffset** po) {
+  // (F19) optional per-pair offset learned from the innovations while tracking
+  TdoaMeasurement zc = z;
+  if (!pair_offsets_.empty() && z.id_a >= 0 && z.id_b >= 0 && z.id_a < kMaxPairId && z.id_b < kMaxPairId) {
+    *po = &pair_offsets_[z.id_a * kMaxPairId + z.id_b];
+    zc.tdoa_m -= (*po)->offset_m;
+  }
+  // (F16f) on the ground the floor-level anchors are seen with the delays the start on the floor found; after the
+  // ground evidence ended without a climb, they fade with the height dead-reckoned from the floor
+  if (floor_anchors_.hasDelays() && (on_ground_ || climb_.running())) {
+    const double f = on_ground_ ? 1.0 : FloorLevelAnchors::remainingFraction(climb_.height());
+    zc.tdoa_m -= f * floor_anchors_.pairDelay(z.id_a, z.id_b);
+  } else if (floor_anchors_.hasDelays() && !acquiring && z.t_s - t_last_descent_ < params_.landing_window_s &&
+             ekf_.state().w_p_b.z() - params_.ground_z_m < params_.landing_band_m) {
+    // (F16h) near the floor after a descent (a landing): the delay or none, whichever the TDoA lies nearer to
+    const Moments3* a = anchors_.find(z.id_a);
+    const Moments3* b = anchors_.find(z.id_b);
+    if (a && b && floor_anchors_.pairDelay(z.id_a, z.id_b) != 0.0) {  // a pair without floor-level anchors: no delay
+      const NavState& x = ekf_.state();
+      const double r = zc.tdoa_m - predictTdoa(x.w_p_b, x.w_q_b, params_.b_t_tag, a->m, b->m);
+      zc.tdoa_m -= floor_anchors_.nearerPairDelay(z.id_a, z.id_b, r);
+    }
+  }
+  return zc;
+}
+
+void Estimator::learnFromInnovation(double t, const TdoaUpdateResult& r, bool acquiring, bool near_floor,
+                                    PairOffset* po) {
   if (antenna_ && antenna_predicted_ && !acquiring && !near_floor && t >= t_fix_settled_ &&
       r.outcome == UpdateOutcome::kApplied) {
     // (F25d) learned while tracking in the air only: near the floor the TDoA carry the ground bias (F14). The
     // robust weight of the update down-weights the same TDoA for the pattern.
     // The TDoA error is correlated in time (F12): the innovations carry far less than one independent sample each
-    antenna_->learn(r.innovation_m,
-                    params_.antenna_bias_noise_scale * (r.innovation_var_m2 - antenna_var_m2_) / r.weight);
+    antenna_->learn(r.innovation_m, params_.antenna_bias_noise_scale * r.innovation_var_m2 / r.weight);
   }
   if (po && !acquiring && r.outcome == UpdateOutcome::kApplied) {
+    // (F19) the pair's offset follows its weighted innovations
     const double dt_pair = std::isnan(po->t_last_s) ? 0.0 : std::min(t - po->t_last_s, 0.2);
     po->offset_m =
         std::clamp(po->offset_m + (dt_pair / params_.pair_bias_tau_s) * r.weight * r.innovation_m, -0.5, 0.5);
     po->t_last_s = t;
   }
+}
+
+void Estimator::countTdoaOutcome(double t, const TdoaUpdateResult& r, bool acquiring, bool near_floor) {
   switch (r.outcome) {
     case UpdateOutcome::kApplied:
       ++summary_.n_tdoa_used;
@@ -902,35 +879,31 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     case UpdateOutcome::kUnknownAnchor: ++summary_.n_tdoa_unknown_anchor; break;
     default: ++summary_.n_tdoa_degenerate; break;
   }
-  // (F30) in the air only: on and near the floor the TDoA carry the floor-level bias (F14), which their σ there covers
-  if (!acquiring && !near_floor &&
-      (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier))
-    checkConsistency(t, r.nis);
-  // in flight only: on and near the floor the TDoA carry the floor-level bias (F14), and a body at rest or in ground
-  // contact (F18: still, or shaking on the legs) is not flying even before the ground phase is entered
-  const bool flying = !acquiring && !near_floor && std::min(t - t_acq_end_, t - t_left_ground_) >= kRejectionSettle_s &&
-                      ekf_.state().w_p_b.z() - params_.ground_z_m > kRejectionMinHeight_m &&
-                      !(imu_mode_ && (rest_.stillNow() || mode_.shakingStandsOut(rest_.gyroHighPassMeanSquare())));
-  last_tdoa_in_flight_ = flying;
-  if (flying &&
-      (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier)) {
-    // (F16d) rejection rate in flight, exponentially forgotten over kRejectionMemory_s
-    const double w = std::isnan(t_rejection_) ? 0.0 : std::exp(-std::max(t - t_rejection_, 0.0) / kRejectionMemory_s);
-    n_rejected_recent_ = w * n_rejected_recent_ + (r.outcome == UpdateOutcome::kRejectedOutlier ? 1.0 : 0.0);
-    n_gated_recent_ = w * n_gated_recent_ + 1.0;
-    t_rejection_ = t;
-    // (F16d) the recent motion while the TDoA agree, to fall back on when a fault is found
-    if (n_rejected_recent_ <= kHealthyRejectionRate * n_gated_recent_ && t - t_healthy_sample_ >= kHealthyPeriod_s) {
-      healthy_[i_healthy_] = {t, ekf_.state().w_p_b, ekf_.state().w_v_b};
-      i_healthy_ = (i_healthy_ + 1) % healthy_.size();
-      n_healthy_ = std::min(n_healthy_ + 1, healthy_.size());
-      t_healthy_sample_ = t;
-    }
+}
+
+void Estimator::trackRejectionRate(double t, const TdoaUpdateResult& r) {
+  // (F16d) rejection rate in flight, exponentially forgotten over rejection_memory_s
+  const double w =
+      std::isnan(t_rejection_) ? 0.0 : std::exp(-std::max(t - t_rejection_, 0.0) / params_.rejection_memory_s);
+  n_rejected_recent_ = w * n_rejected_recent_ + (r.outcome == UpdateOutcome::kRejectedOutlier ? 1.0 : 0.0);
+  n_gated_recent_ = w * n_gated_recent_ + 1.0;
+  t_rejection_ = t;
+  // (F16d) the recent motion while the TDoA agree, to fall back on when a fault is found
+  if (n_rejected_recent_ <= params_.healthy_rejection_rate * n_gated_recent_ &&
+      t - t_healthy_sample_ >= params_.healthy_period_s) {
+    healthy_[i_healthy_] = {t, ekf_.state().w_p_b, ekf_.state().w_v_b};
+    i_healthy_ = (i_healthy_ + 1) % healthy_.size();
+    n_healthy_ = std::min(n_healthy_ + 1, healthy_.size());
+    t_healthy_sample_ = t;
   }
+}
+
+void Estimator::feedBiasLevels(double t, const TdoaMeasurement& z, const TdoaUpdateResult& r, bool flying,
+                               double range_bias_prior_m, const Vec3& w_p_tag_prior) {
   // (F23c) a bias level from the TDoA used in flight; elsewhere (the floor-level bias on and near the ground, an
   // acquisition's unsettled state) the open window is dropped. Returns whether a window was counted.
-  const Moments3* anchor_a = levels ? anchors_.find(z.id_a) : nullptr;
-  const Moments3* anchor_b = levels ? anchors_.find(z.id_b) : nullptr;
+  const Moments3* anchor_a = anchors_.find(z.id_a);
+  const Moments3* anchor_b = anchors_.find(z.id_b);
   const auto feed = [&](BiasLevel& level, double residual_m) {
     const int n_before = level.numWindows();
     if (flying && r.outcome == UpdateOutcome::kApplied && anchor_a && anchor_b)
@@ -947,6 +920,9 @@ void Estimator::addTdoa(const TdoaObservation& z) {
   if (mean_level_) feed(*mean_level_, last_model_mean_m_);
   // (F24b) the same statistic on the TDoA before the model's correction (bias_mean_m is what it subtracted)
   if (raw_level_ && feed(*raw_level_, r.innovation_m + range_bias_prior_m + r.bias_mean_m)) updateModelMeanScale();
+}
+
+void Estimator::notePairInView(double t, const TdoaMeasurement& z, const TdoaUpdateResult& r) {
   if (r.outcome == UpdateOutcome::kApplied || r.outcome == UpdateOutcome::kRejectedOutlier) {
     // anchor pairs in view, for the reported bias floor (F23)
     auto it = std::find_if(recent_pairs_.begin(), recent_pairs_.end(),
@@ -955,19 +931,24 @@ void Estimator::addTdoa(const TdoaObservation& z) {
     else if (recent_pairs_.size() < recent_pairs_.capacity()) recent_pairs_.push_back({z.id_a, z.id_b, t});
   }
   // (F23) the geometry term changes slowly with the position and the pairs in view: refreshed every 50 ms of TDoA
-  if (!(t - t_bias_floor_s_ < kBiasFloorPeriod_s && t >= t_bias_floor_s_)) {
+  if (!(t - t_bias_floor_s_ < params_.bias_floor_period_s && t >= t_bias_floor_s_)) {
     bias_floor_ = biasFloor();
     t_bias_floor_s_ = t;
   }
+}
+
+void Estimator::superviseTracking(double t, bool acquiring) {
   // (F16) lost: nothing accepted for max_lost_s → find the position again by multilateration from fresh TDoA
   // (F16d) most TDoA rejected in flight: the stream is faulty or the estimate is off; the few that pass the gate
   // (which widens as P grows) would drag the state away, so the position is found again from fresh TDoA at once
-  const bool rejecting = params_.max_rejection_rate < 1.0 && n_gated_recent_ >= kRejectionMinSamples &&
+  const bool rejecting = params_.max_rejection_rate < 1.0 && n_gated_recent_ >= params_.rejection_min_samples &&
                          n_rejected_recent_ > params_.max_rejection_rate * n_gated_recent_;
-  const bool nothing_accepted = t - t_last_accept_ > params_.max_lost_s && n_rejected_streak_ > kLostMinRejections;
+  const bool nothing_accepted = t - t_last_accept_ > params_.max_lost_s &&
+                                n_rejected_streak_ > static_cast<std::size_t>(params_.lost_min_rejections);
   // (F16k) only TDoA of at least four anchors can fix a position again: with fewer in view (an occluded tag) a
   // re-acquisition would wait for a fix that cannot come, so the filter keeps tracking and its gate takes them back
-  if (!acquiring && (rejecting || nothing_accepted) && anchorsHeard(kRecentPairWindow_s) >= minFixAnchors(false)) {
+  if (!acquiring && (rejecting || nothing_accepted) &&
+      anchorsHeard(params_.recent_pair_window_s) >= minFixAnchors(false)) {
     if (rejecting) {
       ++summary_.n_rejection_faults;
       revertToHealthyMotion(t);
@@ -979,42 +960,42 @@ void Estimator::addTdoa(const TdoaObservation& z) {
 }
 
 void Estimator::checkConsistency(double t_s, double nis) {
-  // (F30) the TDoA's normalised innovation squared, clipped and averaged over kNisWindow_s
-  const double w = t_s >= t_nis_ ? expNegative((t_s - t_nis_) / kNisWindow_s) : 1.0;
+  // (F30) the TDoA's normalised innovation squared, clipped and averaged over params_.nis_window_s
+  const double w = t_s >= t_nis_ ? expNegative((t_s - t_nis_) / params_.nis_window_s) : 1.0;
   const double dt = t_s > t_nis_ && t_nis_ > -1e299 ? std::min(t_s - t_nis_, 0.1) : 0.0;
   t_nis_ = std::max(t_nis_, t_s);
-  nis_sum_ = w * nis_sum_ + std::min(std::isfinite(nis) ? nis : kNisClip, kNisClip);
+  nis_sum_ = w * nis_sum_ + std::min(std::isfinite(nis) ? nis : params_.nis_clip, params_.nis_clip);
   nis_n_ = w * nis_n_ + 1.0;
-  nis_far_ = w * nis_far_ + (std::isfinite(nis) && nis <= kNisFar ? 0.0 : 1.0);
+  nis_far_ = w * nis_far_ + (std::isfinite(nis) && nis <= params_.nis_far ? 0.0 : 1.0);
   // the bulk of the TDoA disagrees: not a few pairs out of line of sight (those the gate and the robust loss take)
-  const bool beyond = nis_n_ >= kNisMinSamples && nis_far_ > kNisMaxFarFraction * nis_n_;
-  // (F30) the widening of the reported band fades with kWideningFade_s once the TDoA agree again
-  consistency_var_m2_ *= t_s > t_consistency_var_ ? expNegative((t_s - t_consistency_var_) / kWideningFade_s) : 1.0;
+  const bool beyond = nis_n_ >= params_.nis_min_samples && nis_far_ > params_.nis_max_far_fraction * nis_n_;
+  // (F30) the widening of the reported band fades with params_.widening_fade_s once the TDoA agree again
+  consistency_var_m2_ *= t_s > t_consistency_var_ ? expNegative((t_s - t_consistency_var_) / params_.widening_fade_s) : 1.0;
   t_consistency_var_ = std::max(t_consistency_var_, t_s);
   if (!beyond) {
     t_consistent_ = t_s;
     inconsistent_ = false;
     return;
   }
-  if (t_s - t_consistent_ < kInconsistentHold_s) return;
-  // beyond chance for kInconsistentHold_s: the estimate or its covariance is wrong, whatever the cause
+  if (t_s - t_consistent_ < params_.inconsistent_hold_s) return;
+  // beyond chance for params_.inconsistent_hold_s: the estimate or its covariance is wrong, whatever the cause
   if (!inconsistent_) ++summary_.n_inconsistent_periods;
   inconsistent_ = true;
   summary_.inconsistent_s += dt;
   // the reported band is widened until the TDoA's spread is explained: the excess of the mean NIS over 1 in the
-  // TDoA's variance, at most kMaxWidening_m. The filter's own P is left alone: widening it lets the faulty or
+  // TDoA's variance, at most params_.max_widening_m. The filter's own P is left alone: widening it lets the faulty or
   // non-line-of-sight TDoA in that made the mean large (0426-traj12: 0.262 → 0.494 m) and hides a clock offset
   // from the checks after the run.
   const double excess = std::max(nis_sum_ / nis_n_ - 1.0, 0.0);
-  const double sigma = std::min(std::sqrt(excess) * track_opt_.sigma_m, kMaxWidening_m);
+  const double sigma = std::min(std::sqrt(excess) * track_opt_.sigma_m, params_.max_widening_m);
   if (sigma * sigma > consistency_var_m2_) {
-    if (consistency_var_m2_ == 0.0 || t_s - t_last_widening_ >= kInconsistentHold_s) ++summary_.n_consistency_widenings;
+    if (consistency_var_m2_ == 0.0 || t_s - t_last_widening_ >= params_.inconsistent_hold_s) ++summary_.n_consistency_widenings;
     consistency_var_m2_ = sigma * sigma;
     t_last_widening_ = t_s;
   }
 }
 
-void Estimator::superviseTdoa(double t_s, const TdoaObservation& z) {
+void Estimator::superviseTdoa(double t_s, const TdoaMeasurement& z) {
   // (F29c) the height at which this TDoA puts the tag: its residual at the estimate over its vertical sensitivity, as
   // a TDoA in the air and as one on the floor (with the floor-level anchors' delays, F16f)
   const Moments3* a = anchors_.find(z.id_a);
@@ -1031,12 +1012,12 @@ void Estimator::superviseTdoa(double t_s, const TdoaObservation& z) {
 
 void Estimator::revertToHealthyMotion(double t_s) {
   // (F16d) the TDoA that passed the gate since the fault began pulled the state off (the rate needs ≈ 0.5 s to cross
-  // its threshold): back to the newest motion recorded kRevertLead_s before, carried to now by the relaxed motion
+  // its threshold): back to the newest motion recorded params_.revert_lead_s before, carried to now by the relaxed motion
   // of F16e, with the covariance grown meanwhile plus that motion's own uncertainty
   const PastMotion* best = nullptr;
   for (std::size_t k = 0; k < n_healthy_; ++k) {
     const PastMotion& m = healthy_[k];
-    if (m.t_s <= t_s - kRevertLead_s && t_s - m.t_s <= kRevertMaxAge_s && (!best || m.t_s > best->t_s)) best = &m;
+    if (m.t_s <= t_s - params_.revert_lead_s && t_s - m.t_s <= params_.revert_max_age_s && (!best || m.t_s > best->t_s)) best = &m;
   }
   n_healthy_ = 0;
   if (!best || !(params_.lost_velocity_tau_s > 0.0)) return;
@@ -1072,21 +1053,21 @@ void Estimator::alignHeading(double t_s, const ImuReading& imu, double dt_s) {
   heading_align_.reset();
   if (!r) return;
   const double change = wrapAngle(headingOf(r->w_q_b) - headingOf(x.w_q_b));
-  if (!(r->heading_sigma_rad < kMaxAlignedHeadingSigma_rad)) return;
+  if (!(r->heading_sigma_rad < params_.max_aligned_heading_sigma_rad)) return;
   predictTo(t_s);
   propagate(true);
   // the filter's own heading variance: the heading's row on the body-frame attitude covariance
   const Eigen::RowVector3d row = headingJacobian(ekf_.state().w_q_b);
   const double filter_var = (row * ekf_.covariance().block<3, 3>(kAtt, kAtt) * row.transpose())(0, 0);
   const double sigma = std::sqrt(r->heading_sigma_rad * r->heading_sigma_rad + filter_var);
-  if (std::abs(change) < std::max(3.0 * sigma, kMinHeadingChange_rad)) {
+  if (std::abs(change) < std::max(3.0 * sigma, params_.min_heading_change_rad)) {
     // consistent with the filter: a heading measurement (F28)
     ekf_.headingUpdate(headingOf(r->w_q_b), r->heading_sigma_rad);
     return;
   }
   // the window's evidence contradicts the filter's heading: its attitude, with the fit's uncertainty
-  const double tilt = std::max(r->tilt_sigma_rad, kMinAlignedTiltSigma_rad);
-  const double heading = std::max(r->heading_sigma_rad, kMinAlignedTiltSigma_rad);
+  const double tilt = std::max(r->tilt_sigma_rad, params_.min_aligned_tilt_sigma_rad);
+  const double heading = std::max(r->heading_sigma_rad, params_.min_aligned_tilt_sigma_rad);
   ekf_.resetAttitude(r->w_q_b, Vec3(tilt * tilt, tilt * tilt, heading * heading).asDiagonal());
   ++summary_.n_heading_alignments;
   if (summary_.heading_alignment_t_s.size() < kMaxListedEvents) {
@@ -1115,7 +1096,7 @@ Mat3 Estimator::biasFloor() const {
   const NavState& x = ekf_.state();
   BiasFloorGeometry g(x.w_p_b + x.w_q_b * params_.b_t_tag);
   for (const RecentPair& rp : recent_pairs_) {
-    if (t_last_event_ - rp.t_s > kRecentPairWindow_s) continue;
+    if (t_last_event_ - rp.t_s > params_.recent_pair_window_s) continue;
     const Moments3* a = anchors_.find(rp.id_a);
     const Moments3* b = anchors_.find(rp.id_b);
     if (a && b) g.addPair(rp.id_a, a->m, rp.id_b, b->m);
@@ -1126,7 +1107,7 @@ Mat3 Estimator::biasFloor() const {
     const double s = std::max(params_.rest_tdoa_sigma_m, outputBiasSigma());
     Mat3 C = Mat3::Zero();
     C.topLeftCorner<2, 2>() = g.horizontalCovariance(s);
-    C(2, 2) = kGroundHeightSigma_m * kGroundHeightSigma_m;  // the body's height on the floor, not the repeated updates'
+    C(2, 2) = params_.ground_height_sigma_m * params_.ground_height_sigma_m;  // the body's height on the floor, not the repeated updates'
     return C;
   }
   // (F23d) in flight, the vertical part of the bias-induced position error scaled: C ← S C S, S = diag(1, 1, s)

@@ -176,31 +176,51 @@ std::optional<MultilaterationResult> multilaterateOnFloor(const std::vector<Mult
   return r;
 }
 
+namespace {
+
+bool isFloorLevelAnchor(const std::vector<unsigned char>& floor_level, int id) {
+  return id >= 0 && static_cast<std::size_t>(id) < floor_level.size() && floor_level[id] != 0;
+}
+
+/// (F16f) The unknowns of the floor solve with delays: u = (x, y, g_1 … g_L).
+struct FloorDelayColumns {
+  std::vector<int> column;  ///< by anchor id: the delay's column in u, −1 for none
+  int n_other = 0;          ///< anchors seen that are not floor-level
+  int n_cols = 2;           ///< columns of u
+};
+
+FloorDelayColumns floorDelayColumns(const std::vector<MultilaterationSample>& samples, const AnchorTable& anchors,
+                                    const std::vector<unsigned char>& floor_level) {
+  FloorDelayColumns c;
+  std::vector<unsigned char> other_seen;
+  for (const MultilaterationSample& s : samples) {
+    if (!anchors.find(s.z.id_a) || !anchors.find(s.z.id_b)) continue;
+    for (const int id : {s.z.id_a, s.z.id_b}) {
+      const auto i = static_cast<std::size_t>(id);
+      if (isFloorLevelAnchor(floor_level, id)) {
+        if (c.column.size() <= i) c.column.resize(i + 1, -1);
+        if (c.column[i] < 0) c.column[i] = c.n_cols++;
+      } else {
+        if (other_seen.size() <= i) other_seen.resize(i + 1, 0);
+        if (!other_seen[i]) ++c.n_other;
+        other_seen[i] = 1;
+      }
+    }
+  }
+  return c;
+}
+
+}  // namespace
+
 std::optional<MultilaterationResult> multilaterateOnFloorWithDelays(
     const std::vector<MultilaterationSample>& samples, const AnchorTable& anchors, const Vec3& b_t_tag,
     const std::vector<Vec3>& initial_guesses, double floor_z_m, const std::vector<unsigned char>& floor_level,
     double huber_k_m, int max_iterations) {
   // (F16f) unknowns u = (x, y, g_1 … g_L): one range delay per floor-level anchor seen in the batch
-  const auto isFloorLevel = [&](int id) {
-    return id >= 0 && static_cast<std::size_t>(id) < floor_level.size() && floor_level[id] != 0;
-  };
-  std::vector<int> column;  // by anchor id: the delay's column in u, −1 for none
-  std::vector<unsigned char> other_seen;
-  int n_other = 0, n_cols = 2;
-  for (const MultilaterationSample& s : samples) {
-    if (!anchors.find(s.z.id_a) || !anchors.find(s.z.id_b)) continue;
-    for (const int id : {s.z.id_a, s.z.id_b}) {
-      const auto i = static_cast<std::size_t>(id);
-      if (isFloorLevel(id)) {
-        if (column.size() <= i) column.resize(i + 1, -1);
-        if (column[i] < 0) column[i] = n_cols++;
-      } else {
-        if (other_seen.size() <= i) other_seen.resize(i + 1, 0);
-        if (!other_seen[i]) ++n_other;
-        other_seen[i] = 1;
-      }
-    }
-  }
+  const auto isFloorLevel = [&](int id) { return isFloorLevelAnchor(floor_level, id); };
+  const FloorDelayColumns columns = floorDelayColumns(samples, anchors, floor_level);
+  const std::vector<int>& column = columns.column;
+  const int n_other = columns.n_other, n_cols = columns.n_cols;
   // at most kMaxDelays delays (a fixed-size system: no heap; unused columns are identity rows with a zero step);
   // more floor-level anchors in view than that: the plain solve
   constexpr int kMaxDelays = 8;

@@ -58,9 +58,9 @@ bool imuBad(const TimedImu& s) {
   // 0·x is ±0 for a finite x and NaN for ±∞ or NaN: the sum is zero iff all seven values are finite
   return 0.0 * s.t_s + (0.0 * s.imu.b_acc_mps2 + 0.0 * s.imu.b_gyro_radps).sum() != 0.0;
 }
-bool tdoaBad(const TdoaObservation& z) { return !std::isfinite(z.t_s) || !std::isfinite(z.tdoa_m); }
+bool tdoaBad(const TdoaMeasurement& z) { return !std::isfinite(z.t_s) || !std::isfinite(z.tdoa_m); }
 /// The TDoA duplicate rule: same stamp, pair and value (same stamp, other pair is legal).
-bool tdoaSame(const TdoaObservation& a, const TdoaObservation& b) {
+bool tdoaSame(const TdoaMeasurement& a, const TdoaMeasurement& b) {
   return a.t_s == b.t_s && a.id_a == b.id_a && a.id_b == b.id_b && a.tdoa_m == b.tdoa_m;
 }
 
@@ -165,7 +165,7 @@ MergeReport cleanSensorLog(SensorLog& log, double max_gap_s) {
     std::stable_sort(log.imu.begin(), log.imu.end(), [](const TimedImu& a, const TimedImu& b) { return a.t_s < b.t_s; });
   if (rep.n_tdoa_out_of_order)
     std::stable_sort(log.tdoa.begin(), log.tdoa.end(),
-                     [](const TdoaObservation& a, const TdoaObservation& b) { return a.t_s < b.t_s; });
+                     [](const TdoaMeasurement& a, const TdoaMeasurement& b) { return a.t_s < b.t_s; });
   // duplicates: IMU with the same stamp; TDoA with same stamp, pair and value (same stamp, other pair is legal)
   const std::size_t ni = log.imu.size();
   log.imu.erase(std::unique(log.imu.begin(), log.imu.end(),

@@ -53,7 +53,7 @@ bool checkImuRange(double t_s, const ImuReading& imu, SensorRangeReport& report)
   return false;
 }
 
-bool checkTdoaRange(const TdoaObservation& z, const AnchorTable& anchors, SensorRangeReport& report) {
+bool checkTdoaRange(const TdoaMeasurement& z, const AnchorTable& anchors, SensorRangeReport& report) {
   const Moments3* a = anchors.find(z.id_a);
   const Moments3* b = anchors.find(z.id_b);
   if (!std::isfinite(z.tdoa_m)) {

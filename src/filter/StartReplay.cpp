@@ -39,7 +39,7 @@ void StartReplay::recordPredict(const ImuReading& imu, double dt_s) {
   append(e);
 }
 
-void StartReplay::recordTdoa(const TdoaObservation& z) {
+void StartReplay::recordTdoa(const TdoaMeasurement& z) {
   Entry e;
   e.is_tdoa = true;
   e.z = z;

@@ -10,6 +10,15 @@
 
 namespace uwb {
 
+StartUpParams StartUpParams::fromEkfParams(const EkfParams& p) {
+  return {.window_s = p.start_window_s, .min_samples = static_cast<std::size_t>(p.start_min_samples),
+          .max_window_s = p.start_max_window_s, .min_pos_sigma_m = p.start_min_pos_sigma_m,
+          .max_pos_sigma_m = p.init_pos_sigma_m, .min_vel_sigma_mps = p.start_min_vel_sigma_mps,
+          .box_margin_m = p.start_box_margin_m, .max_rms_residual_m = p.start_max_rms_residual_m,
+          .floor_refute_height_m = p.floor_refute_height_m,
+          .floor_refute_residual_ratio = p.floor_refute_residual_ratio};
+}
+
 StartUp::StartUp(const AnchorTable& anchors, const Vec3& b_t_tag, const StartUpParams& params)
     : anchors_(anchors), b_t_tag_(b_t_tag), params_(params) {
   const AnchorBox box = anchorBox(anchors_);  // throws when there are no anchors
@@ -36,7 +45,7 @@ int StartUp::distinctAnchors() const {
   return anchors.count();
 }
 
-std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x_now, std::optional<double> floor_z_m,
+std::optional<StartFix> StartUp::add(const TdoaMeasurement& z, const NavState& x_now, std::optional<double> floor_z_m,
                                      bool floor_refutable) {
   if (!active_) return std::nullopt;
   // (F16b) displacement since t_ref from the prediction, without the reference velocity (that is v0's part)
@@ -47,9 +56,28 @@ std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x
   if (samples_.size() < samples_.capacity()) samples_.push_back(s);
   if (!(z.t_s - t_try_ >= params_.window_s && samples_.size() >= params_.min_samples)) return std::nullopt;
 
-  bool moving = moving_ && !floor_z_m;
-  bool floor_refuted = false;
-  std::optional<MultilaterationResult> r;
+  const WindowSolve w = solveWindow(z.t_s, floor_z_m, floor_refutable);
+  const std::optional<MultilaterationResult>& r = w.result;
+  const bool inside = r && (!reacquisition_ || r->rms_residual_m <= params_.max_rms_residual_m) &&
+                      (r->w_p0.array() >= box_min_.array() - params_.box_margin_m).all() &&
+                      (r->w_p0.array() <= box_max_.array() + params_.box_margin_m).all() &&
+                      (!w.moving || r->w_v0.norm() < 5.0);
+  if (!inside) {
+    retryLater(z.t_s, x_now);
+    return std::nullopt;
+  }
+  const StartFix fix = fixNow(w, z.t_s, x_now);
+  active_ = false;
+  samples_.clear();
+  return fix;
+}
+
+StartUp::WindowSolve StartUp::solveWindow(double t_now_s, std::optional<double> floor_z_m,
+                                          bool floor_refutable) const {
+  WindowSolve w;
+  w.moving = moving_ && !floor_z_m;
+  w.on_floor = floor_z_m.has_value();
+  std::optional<MultilaterationResult>& r = w.result;
   // (F16k) with fewer anchors in the window than a fix needs, wait for more
   const int n_anchors = distinctAnchors();
   const bool solvable = n_anchors >= minFixAnchors(floor_z_m.has_value());
@@ -63,67 +91,68 @@ std::optional<StartFix> StartUp::add(const TdoaObservation& z, const NavState& x
     // (F16j) at the first start, floor contact (F18) is tested against the TDoA (by a solve in the air: F16k)
     // and at a floor check in floor contact (F29e): the caller says when the floor may be refuted
     if (r && floor_refutable && n_anchors >= minFixAnchors(false)) {
-      if (std::optional<MultilaterationResult> in_air = refuteFloor(*r, *floor_z_m, z.t_s)) {
+      if (std::optional<MultilaterationResult> in_air = refuteFloor(*r, *floor_z_m, t_now_s)) {
         r = in_air;
-        moving = floor_refuted = true;
-        floor_z_m.reset();
+        w.moving = w.floor_refuted = true;
+        w.on_floor = false;
       }
     }
   } else if (solvable) {
-    r = moving ? multilaterateMoving(samples_, anchors_, b_t_tag_, guesses_, t_ref_)
-               : multilaterate(samples_, anchors_, b_t_tag_, guesses_);
+    r = w.moving ? multilaterateMoving(samples_, anchors_, b_t_tag_, guesses_, t_ref_)
+                 : multilaterate(samples_, anchors_, b_t_tag_, guesses_);
   }
-  const bool inside = r && (!reacquisition_ || r->rms_residual_m <= params_.max_rms_residual_m) && (r->w_p0.array() >= box_min_.array() - params_.box_margin_m).all() &&
-                      (r->w_p0.array() <= box_max_.array() + params_.box_margin_m).all() &&
-                      (!moving || r->w_v0.norm() < 5.0);
-  if (!inside) {
-    // keep the most recent part and try again later (the earliest samples are the worst: take-off, faults)
-    const double t_keep = z.t_s - std::min(params_.max_window_s, 0.5 * params_.window_s);
-    std::erase_if(samples_, [&](const MultilaterationSample& m) { return m.z.t_s < t_keep; });
-    t_try_ = z.t_s - 0.5 * params_.window_s;
-    // (F16b) the reference moves to the newest prediction: a displacement predicted over a long failed search
-    // (seconds of IMU dead reckoning) would put p0 and v0 out of bounds however good the fresh TDoA are.
-    // d'_i = p̂(t_i) − p̂_now − (t_i − t_now) v̂_now with p̂(t_i) = d_i + p̂_ref + (t_i − t_ref) v̂_ref.
-    for (MultilaterationSample& m : samples_)
-      m.w_d_b += x_ref_.w_p_b - x_now.w_p_b + (m.z.t_s - t_ref_) * x_ref_.w_v_b - (m.z.t_s - z.t_s) * x_now.w_v_b;
-    x_ref_ = x_now;
-    t_ref_ = z.t_s;
-    return std::nullopt;
-  }
+  return w;
+}
+
+void StartUp::retryLater(double t_now_s, const NavState& x_now) {
+  // keep the most recent part and try again later (the earliest samples are the worst: take-off, faults)
+  const double t_keep = t_now_s - std::min(params_.max_window_s, 0.5 * params_.window_s);
+  std::erase_if(samples_, [&](const MultilaterationSample& m) { return m.z.t_s < t_keep; });
+  t_try_ = t_now_s - 0.5 * params_.window_s;
+  // (F16b) the reference moves to the newest prediction: a displacement predicted over a long failed search
+  // (seconds of IMU dead reckoning) would put p0 and v0 out of bounds however good the fresh TDoA are.
+  // d'_i = p̂(t_i) − p̂_now − (t_i − t_now) v̂_now with p̂(t_i) = d_i + p̂_ref + (t_i − t_ref) v̂_ref.
+  for (MultilaterationSample& m : samples_)
+    m.w_d_b += x_ref_.w_p_b - x_now.w_p_b + (m.z.t_s - t_ref_) * x_ref_.w_v_b - (m.z.t_s - t_now_s) * x_now.w_v_b;
+  x_ref_ = x_now;
+  t_ref_ = t_now_s;
+}
+
+StartFix StartUp::fixNow(const WindowSolve& w, double t_now_s, const NavState& x_now) const {
+  const MultilaterationResult& r = *w.result;
+  const bool moving = w.moving;
   StartFix fix;
   fix.with_velocity = moving;
-  fix.floor_refuted = floor_refuted;
-  fix.w_p0 = r->w_p0;
-  fix.w_v0 = moving ? r->w_v0 : x_ref_.w_v_b;
+  fix.floor_refuted = w.floor_refuted;
+  fix.w_p0 = r.w_p0;
+  fix.w_v0 = moving ? r.w_v0 : x_ref_.w_v_b;
   fix.t_ref_s = t_ref_;
-  fix.rms_residual_m = r->rms_residual_m;
-  fix.anchor_delay_m = r->anchor_delay_m;
-  const double T = z.t_s - t_ref_;
+  fix.rms_residual_m = r.rms_residual_m;
+  fix.anchor_delay_m = r.anchor_delay_m;
+  const double T = t_now_s - t_ref_;
   const Vec3 d_now = x_now.w_p_b - x_ref_.w_p_b - T * x_ref_.w_v_b;
   // (F16b) p_now = p0 + v0 T + d_now, v_now = v0 + (v_pred_now − v_pred_ref)
   Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Identity();
   Eigen::Matrix<double, 6, 6> S = Eigen::Matrix<double, 6, 6>::Zero();
   if (moving) {
-    fix.w_p_b = r->w_p0 + T * r->w_v0 + d_now;
-    fix.w_v_b = r->w_v0 + (x_now.w_v_b - x_ref_.w_v_b);
+    fix.w_p_b = r.w_p0 + T * r.w_v0 + d_now;
+    fix.w_v_b = r.w_v0 + (x_now.w_v_b - x_ref_.w_v_b);
     J.block<3, 3>(0, 3) = T * Mat3::Identity();
-    S = J * r->covariance_pv * J.transpose();
+    S = J * r.covariance_pv * J.transpose();
   } else {
-    fix.w_p_b = r->w_p0 + d_now;
+    fix.w_p_b = r.w_p0 + d_now;
     fix.w_v_b = x_now.w_v_b;
-    S.block<3, 3>(0, 0) = r->covariance;
+    S.block<3, 3>(0, 0) = r.covariance;
   }
   // floors on the stds: the solve's own covariance ignores the correlated TDoA bias
   const double sp = std::clamp(std::sqrt(S.block<3, 3>(0, 0).trace() / 3.0), params_.min_pos_sigma_m,
                                params_.max_pos_sigma_m);
   const double sv = moving ? std::max(std::sqrt(S.block<3, 3>(3, 3).trace() / 3.0), params_.min_vel_sigma_mps)
-                            : params_.min_vel_sigma_mps;
+                           : params_.min_vel_sigma_mps;
   fix.cov.setZero();
   fix.cov.block<3, 3>(0, 0) = sp * sp * Mat3::Identity();
-  if (floor_z_m) fix.cov(2, 2) = 0.1 * 0.1;  // on the floor: the height is known to a few cm (F22)
+  if (w.on_floor) fix.cov(2, 2) = 0.1 * 0.1;  // on the floor: the height is known to a few cm (F22)
   fix.cov.block<3, 3>(3, 3) = sv * sv * Mat3::Identity();
-  active_ = false;
-  samples_.clear();
   return fix;
 }
 

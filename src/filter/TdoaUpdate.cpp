@@ -60,23 +60,6 @@ ScalarLinearMessage<kDim> tdoaMessageOnPositionAttitude(const TdoaNodeMessages& 
   return out;
 }
 
-TdoaNodeMessages tdoaNodeForwardToTag(const TdoaLinearization& lin, const Moments3& x_i, const Moments3& x_j,
-                                      double z_m, double var_m2) {
-  if (!(var_m2 > 0.0) || !std::isfinite(var_m2))
-    throw std::invalid_argument("TDoA node: measurement variance must be finite and > 0");
-  TdoaNodeMessages msg;
-  // (G11) µ3 = N(−B1 m1, B1 Σ1 B1ᵀ), µ4 = N(B2 m2, B2 Σ2 B2ᵀ); B Σ Bᵀ = 0 for an exact (zero-covariance) anchor
-  msg.mu3.m = -lin.B1.dot(x_i.m);
-  msg.mu4.m = lin.B2.dot(x_j.m);
-  // (a covariance with a zero diagonal is zero: |Σ_ij| ≤ √(Σ_ii Σ_jj))
-  if (!x_i.V.diagonal().isZero(0.0)) msg.mu3.V = lin.B1 * x_i.V * lin.B1.transpose();
-  if (!x_j.V.diagonal().isZero(0.0)) msg.mu4.V = lin.B2 * x_j.V * lin.B2.transpose();
-  // (G12) µ7 = N(m6 − m3 − m4 − D, Σ6 + Σ3 + Σ4)
-  msg.mu7 = {z_m - msg.mu3.m - msg.mu4.m - lin.D, var_m2 + msg.mu3.V + msg.mu4.V};
-  msg.B12 = lin.B12();
-  return msg;
-}
-
 namespace {
 
 /// tdoaMessage for anchors already looked up (ids z.id_a, z.id_b; updateTdoa needs them anyway).
@@ -106,7 +89,7 @@ std::optional<ScalarLinearMessage<kDim>> tdoaMessageFromAnchors(const NavState& 
 }  // namespace
 
 std::optional<ScalarLinearMessage<kDim>> tdoaMessage(const NavState& x, const AnchorTable& anchors,
-                                                     const TdoaObservation& z, double z_corrected_m, double var_m2,
+                                                     const TdoaMeasurement& z, double z_corrected_m, double var_m2,
                                                      const Vec3& b_t_tag) {
   const Moments3* anchor_a = anchors.find(z.id_a);
   const Moments3* anchor_b = anchors.find(z.id_b);
@@ -138,56 +121,73 @@ Eigen::Matrix<double, 1, 6> biasPoseJacobian(const BiasPredictor& bias, const Na
   return g;
 }
 
-TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObservation& z,
+namespace {
+
+/// The measurement after the bias model's correction (F12, gp.md P45) and the row of ∂µ/∂δx it carries (P47).
+struct BiasCorrectedTdoa {
+  double z_m = 0.0;
+  double var_m2 = 0.0;
+  double bias_mean_m = 0.0;
+  Eigen::Matrix<double, 1, 6> bias_row = Eigen::Matrix<double, 1, 6>::Zero();  ///< zero unless kJacobian applies
+};
+
+BiasCorrectedTdoa correctBias(const Ekf& ekf, const TdoaMeasurement& z, const Vec3& w_p_anchor_a,
+                              const Vec3& w_p_anchor_b, const TdoaUpdateOptions& options, const BiasPredictor* bias) {
+  const NavState& x = ekf.state();
+  // (F12) bias correction from the predictor, evaluated at the filter's current estimate (paper III-B).
+  BiasCorrectedTdoa c;
+  c.z_m = z.tdoa_m;
+  c.var_m2 = options.sigma_m * options.sigma_m;
+  if (!bias || !*bias) return c;
+  // (P47) before the nominal prediction: a predictor may keep the last prediction's state (F25)
+  const bool bias_pose = options.bias_pose != BiasPoseUncertainty::kNone;
+  if (bias_pose) c.bias_row = biasPoseJacobian(*bias, x, z.id_a, z.id_b, w_p_anchor_a, w_p_anchor_b);
+  const BiasPrediction b = (*bias)(makeTdoaFeature(z.id_a, z.id_b, x.w_p_b, x.w_q_b, w_p_anchor_a, w_p_anchor_b));
+  if (!(std::isfinite(b.mean_m) && std::isfinite(b.variance_m2) && b.variance_m2 >= 0.0 &&
+        std::isfinite(b.noise_scale) && b.noise_scale > 0.0)) {
+    c.bias_row.setZero();
+    return c;
+  }
+  c.z_m -= b.mean_m;
+  c.var_m2 = c.var_m2 * b.noise_scale + b.variance_m2;  // docs/math/gp.md (P45); noise_scale = 1: R + var_f
+  c.bias_mean_m = b.mean_m;
+  if (bias_pose && options.bias_pose == BiasPoseUncertainty::kVariance) {
+    // (P47a) σ_in² = ∇µᵀ P ∇µ over the position and attitude blocks of P
+    const ErrMat& P = ekf.covariance();
+    Eigen::Matrix<double, 6, 6> P6;
+    P6 << P.block<3, 3>(kPos, kPos), P.block<3, 3>(kPos, kAtt), P.block<3, 3>(kAtt, kPos), P.block<3, 3>(kAtt, kAtt);
+    c.var_m2 += (c.bias_row * P6 * c.bias_row.transpose())(0, 0);
+  }
+  return c;
+}
+
+}  // namespace
+
+TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaMeasurement& z,
                             const TdoaUpdateOptions& options, const BiasPredictor* bias) {
   TdoaUpdateResult res;
-  const NavState& x = ekf.state();
   const Moments3* anchor_a = anchors.find(z.id_a);
   const Moments3* anchor_b = anchors.find(z.id_b);
   if (!anchor_a || !anchor_b) {
     res.outcome = UpdateOutcome::kUnknownAnchor;
     return res;
   }
-  // (F12) bias correction from the predictor, evaluated at the filter's current estimate (paper III-B).
-  double z_corr = z.tdoa_m;
-  double var = options.sigma_m * options.sigma_m;
-  // (P47) before the nominal prediction: a predictor may keep the last prediction's state (F25)
-  Eigen::Matrix<double, 1, 6> bias_row = Eigen::Matrix<double, 1, 6>::Zero();
-  const bool bias_pose = options.bias_pose != BiasPoseUncertainty::kNone && bias && *bias;
-  if (bias_pose) bias_row = biasPoseJacobian(*bias, x, z.id_a, z.id_b, anchor_a->m, anchor_b->m);
-  if (bias && *bias) {
-    const BiasPrediction b =
-        (*bias)(makeTdoaFeature(z.id_a, z.id_b, x.w_p_b, x.w_q_b, anchor_a->m, anchor_b->m));
-    if (std::isfinite(b.mean_m) && std::isfinite(b.variance_m2) && b.variance_m2 >= 0.0 &&
-        std::isfinite(b.noise_scale) && b.noise_scale > 0.0) {
-      z_corr -= b.mean_m;
-      var = var * b.noise_scale + b.variance_m2;  // docs/math/gp.md (P45); noise_scale = 1: R + var_f
-      res.bias_mean_m = b.mean_m;
-      if (bias_pose && options.bias_pose == BiasPoseUncertainty::kVariance) {
-        // (P47a) σ_in² = ∇µᵀ P ∇µ over the position and attitude blocks of P
-        const ErrMat& P = ekf.covariance();
-        Eigen::Matrix<double, 6, 6> P6;
-        P6 << P.block<3, 3>(kPos, kPos), P.block<3, 3>(kPos, kAtt), P.block<3, 3>(kAtt, kPos),
-            P.block<3, 3>(kAtt, kAtt);
-        var += (bias_row * P6 * bias_row.transpose())(0, 0);
-      }
-    } else {
-      bias_row.setZero();
-    }
-  }
+  const BiasCorrectedTdoa c = correctBias(ekf, z, anchor_a->m, anchor_b->m, options, bias);
+  res.bias_mean_m = c.bias_mean_m;
+  double z_corr = c.z_m;
   // (F27) the anchors' range biases the filter carries as states: β̂_B − β̂_A
   const bool range_bias = ekf.rangeBias() != nullptr;
   if (range_bias) z_corr -= ekf.rangeBiasDifference(z.id_a, z.id_b);
   std::optional<ScalarLinearMessage<kDim>> msg =
-      tdoaMessageFromAnchors(x, anchor_a, anchor_b, z_corr, var, options.b_t_tag);
+      tdoaMessageFromAnchors(ekf.state(), anchor_a, anchor_b, z_corr, c.var_m2, options.b_t_tag);
   if (!msg) {
     res.outcome = UpdateOutcome::kDegenerate;
     return res;
   }
   // (P47b) z − µ(x̂) − h(x̂) ≈ (∂h/∂δx + ∂µ/∂δx) δx: the corrected measurement's row
-  if (bias_pose && options.bias_pose == BiasPoseUncertainty::kJacobian) {
-    msg->a.segment<3>(kPos) += bias_row.head<3>();
-    msg->a.segment<3>(kAtt) += bias_row.tail<3>();
+  if (options.bias_pose == BiasPoseUncertainty::kJacobian && bias && *bias) {
+    msg->a.segment<3>(kPos) += c.bias_row.head<3>();
+    msg->a.segment<3>(kAtt) += c.bias_row.tail<3>();
   }
   // (F11) χ² gate on the unweighted innovation
   // The message row a = B12 C is non-zero only in the position and attitude blocks, so u = P aᵀ needs only those
@@ -195,7 +195,6 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
   // With range-bias states the row also reaches δβ_A and δβ_B, and S the cross terms (F27c).
   ErrVec P_a = ErrVec::Zero();
   double a_P_a = 0.0;
-  InnovationStats st;
   Ekf::RangeBiasGain gain;
   if (range_bias) {
     gain = ekf.rangeBiasGain(*msg, z.id_a, z.id_b);
@@ -207,28 +206,21 @@ TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObse
     P_a.noalias() += P.middleCols<3>(kAtt) * a_att;
     a_P_a = a_p.dot(P_a.segment<3>(kPos)) + a_att.dot(P_a.segment<3>(kAtt));
   }
-  st.innovation_m = msg->y;  // prior error state is zero
-  st.innovation_var_m2 = (range_bias ? gain.h_u : a_P_a) + msg->var;
-  st.nis = st.innovation_m * st.innovation_m / st.innovation_var_m2;
-  res.innovation_m = st.innovation_m;
-  res.nis = st.nis;
-  res.innovation_var_m2 = st.innovation_var_m2;
-  if (options.gate_sigma > 0.0 && !OutlierGate(options.gate_sigma).accept(st.nis)) {
+  res.innovation_m = msg->y;  // prior error state is zero
+  res.innovation_var_m2 = (range_bias ? gain.h_u : a_P_a) + msg->var;
+  res.nis = res.innovation_m * res.innovation_m / res.innovation_var_m2;
+  if (options.gate_sigma > 0.0 && !OutlierGate(options.gate_sigma).accept(res.nis)) {
     res.outcome = UpdateOutcome::kRejectedOutlier;
     return res;
   }
   // (F13) IRLS weight of the robust loss; the weight inflates the variance of the message (Σ6 / w).
-  const double hph = st.innovation_var_m2 - msg->var;
-  res.weight = robustUpdateWeight(options.loss, options.robust_k, st.innovation_m, hph, msg->var,
+  const double hph = res.innovation_var_m2 - msg->var;
+  res.weight = robustUpdateWeight(options.loss, options.robust_k, res.innovation_m, hph, msg->var,
                                   options.robust_iterations);
   msg->var /= res.weight;
   const bool corrected = range_bias ? ekf.correctWithRangeBias(*msg, gain).has_value()
                                     : ekf.correctPositionAttitude(*msg, P_a, a_P_a).has_value();  // δp, δθ only (G16)
-  if (!corrected) {
-    res.outcome = UpdateOutcome::kDegenerate;
-    return res;
-  }
-  res.outcome = UpdateOutcome::kApplied;
+  res.outcome = corrected ? UpdateOutcome::kApplied : UpdateOutcome::kDegenerate;
   return res;
 }
 

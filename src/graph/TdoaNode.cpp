@@ -17,17 +17,27 @@ void checkVariance(double var_m2) {
 
 }  // namespace
 
-TdoaNodeMessages tdoaNodeForward(const TdoaLinearization& lin, const Moments3& x_i, const Moments3& x_j,
-                                 double z_m, double var_m2) {
+TdoaNodeMessages tdoaNodeForwardToTag(const TdoaLinearization& lin, const Moments3& x_i, const Moments3& x_j,
+                                      double z_m, double var_m2) {
   checkVariance(var_m2);
   TdoaNodeMessages msg;
-  msg.mu3 = {-lin.B1.dot(x_i.m), lin.B1 * x_i.V * lin.B1.transpose()};  // (G11) µ3 = N(−B1 m1, B1 Σ1 B1ᵀ)
-  msg.mu4 = {lin.B2.dot(x_j.m), lin.B2 * x_j.V * lin.B2.transpose()};   // (G11) µ4 = N(B2 m2, B2 Σ2 B2ᵀ)
+  // (G11) µ3 = N(−B1 m1, B1 Σ1 B1ᵀ), µ4 = N(B2 m2, B2 Σ2 B2ᵀ); B Σ Bᵀ = 0 for an exact (zero-covariance) anchor
+  msg.mu3.m = -lin.B1.dot(x_i.m);
+  msg.mu4.m = lin.B2.dot(x_j.m);
+  // (a covariance with a zero diagonal is zero: |Σ_ij| ≤ √(Σ_ii Σ_jj))
+  if (!x_i.V.diagonal().isZero(0.0)) msg.mu3.V = lin.B1 * x_i.V * lin.B1.transpose();
+  if (!x_j.V.diagonal().isZero(0.0)) msg.mu4.V = lin.B2 * x_j.V * lin.B2.transpose();
   // (G12) µ7 = N(m6 − m3 − m4 − D, Σ6 + Σ3 + Σ4)
   msg.mu7 = {z_m - msg.mu3.m - msg.mu4.m - lin.D, var_m2 + msg.mu3.V + msg.mu4.V};
+  msg.B12 = lin.B12();
+  return msg;
+}
+
+TdoaNodeMessages tdoaNodeForward(const TdoaLinearization& lin, const Moments3& x_i, const Moments3& x_j,
+                                 double z_m, double var_m2) {
+  TdoaNodeMessages msg = tdoaNodeForwardToTag(lin, x_i, x_j, z_m, var_m2);  // (G11, G12)
   msg.W7 = 1.0 / msg.mu7.V;  // (G1) W7 = Σ7⁻¹ (Σ7 ≥ Σ6 > 0)
   msg.xi7 = msg.W7 * msg.mu7.m;
-  msg.B12 = lin.B12();
   // (G13) ξ8 = B12ᵀ ξ7, W8 = B12ᵀ W7 B12
   msg.mu8.xi = msg.B12.transpose() * msg.xi7;
   msg.mu8.W = msg.B12.transpose() * msg.W7 * msg.B12;

@@ -128,7 +128,7 @@ std::string formatImuLine(double t_s, const ImuReading& imu) {
   return fmt::format("imu,{},{},{},{},{},{},{}", t_s, a.x(), a.y(), a.z(), g.x(), g.y(), g.z());
 }
 
-std::string formatTdoaLine(const TdoaObservation& z) {
+std::string formatTdoaLine(const TdoaMeasurement& z) {
   return fmt::format("tdoa,{},{},{},{}", z.t_s, z.id_a, z.id_b, z.tdoa_m);
 }
 

@@ -244,7 +244,7 @@ TEST(EventAllocation, AReacquisitionAllocatesNothing) {
   SensorLog log = flight().log;
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> garbage(-10.0, 10.0);
-  for (TdoaObservation& z : log.tdoa)
+  for (TdoaMeasurement& z : log.tdoa)
     if (z.t_s >= 20.0 && z.t_s < 23.0) z.tdoa_m = garbage(rng);
   Estimator est(EkfParams{}, anchorTableFromSurvey(flight().sim.survey));
   // WHEN every event after the first 10 s is pushed

@@ -47,14 +47,14 @@ NavState hoverState() {
 
 /// A filter with range-bias states whose blocks are correlated with δx by the TDoA corrections `warmup` (no gate, no
 /// robust weight), from a random covariance; the TDoA options used are returned in `opt`.
-Ekf correlatedFilter(const EkfParams& params, unsigned seed, std::initializer_list<TdoaObservation> warmup,
+Ekf correlatedFilter(const EkfParams& params, unsigned seed, std::initializer_list<TdoaMeasurement> warmup,
                      TdoaUpdateOptions* opt) {
   Ekf ekf(params);
   ekf.initialize(hoverState(), randomCovariance(seed));
   opt->gate_sigma = 0.0;
   opt->loss = RobustLoss::kNone;
   const AnchorTable anchors = filtertest::arenaAnchors();
-  for (const TdoaObservation& z : warmup) updateTdoa(ekf, anchors, z, *opt);
+  for (const TdoaMeasurement& z : warmup) updateTdoa(ekf, anchors, z, *opt);
   return ekf;
 }
 
@@ -104,7 +104,7 @@ TEST(EkfRangeBias, TdoaCorrectionIsTheKalmanUpdateOfTheAugmentedState) {
   const BiasVec beta0 = ekf.rangeBias()->means();
   const NavState x0 = ekf.state();
   // WHEN one more TDoA of pair (1, 2) is applied
-  const TdoaObservation z{0.0, 1, 2, -0.75};
+  const TdoaMeasurement z{0.0, 1, 2, -0.75};
   const TdoaUpdateResult r = updateTdoa(ekf, anchors, z, opt);
   ASSERT_EQ(r.outcome, UpdateOutcome::kApplied);
   // THEN it equals the dense Kalman update on [δx, δβ] with the row [∂h/∂δx, −e_A + e_B] (F27c)

@@ -192,7 +192,7 @@ TEST(Estimator, WithoutTdoaInFlightTheHorizontalMotionRelaxesInsteadOfDrifting) 
   // GIVEN the circle log without TDoA for 4 s, and an IMU whose horizontal acceleration is off by 1 m/s² meanwhile
   // (a tilt error of 6°: what the thrust model's horizontal channel rests on)
   SensorLog log = circleLog(0.0, 16.0, 8);
-  std::erase_if(log.tdoa, [](const TdoaObservation& z) { return z.t_s > 6.0 && z.t_s < 10.0; });
+  std::erase_if(log.tdoa, [](const TdoaMeasurement& z) { return z.t_s > 6.0 && z.t_s < 10.0; });
   for (auto& s : log.imu)
     if (s.t_s > 6.0 && s.t_s < 10.0) s.imu.b_acc_mps2.x() += 1.0;
   // WHEN localizing with the relaxation (F16e) and without it

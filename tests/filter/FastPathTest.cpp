@@ -213,7 +213,7 @@ TEST(TdoaFastPath, MessageAttitudeRowEqualsJacobianProduct) {
   x.w_q_b = Quat(Eigen::AngleAxisd(0.5, Vec3(0.3, 0.2, 1.0).normalized()));
   // WHEN building the filter's TDoA message and the reference from the node and J_tag_att = −R[b_t]× (G16, M4)
   const std::optional<ScalarLinearMessage<kDim>> msg =
-      tdoaMessage(x, anchors, TdoaObservation{0.0, 0, 1, 1.3}, 1.3, 0.1, kUtilTagOffset_b);
+      tdoaMessage(x, anchors, TdoaMeasurement{0.0, 0, 1, 1.3}, 1.3, 0.1, kUtilTagOffset_b);
   const Vec3 w_p_tag = tagPosition(x.w_p_b, x.w_q_b, kUtilTagOffset_b);
   const TdoaLinearization lin = *linearizeTdoa(w_p_tag, anchors.find(1)->m, anchors.find(0)->m);
   const ScalarLinearMessage<kDim> ref = tdoaMessageOnPositionAttitude(

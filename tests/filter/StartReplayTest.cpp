@@ -36,7 +36,7 @@ void windowEvents(Apply&& apply) {
     apply(imu, 0.001, nullptr);
     if (k % 3 == 0) {
       const int a = (k / 3) % 8, b = (k / 3 + 1) % 8;
-      const TdoaObservation z{k * 0.001, a, b, 0.8 * std::sin(0.1 * k) + 0.1 * n(rng)};
+      const TdoaMeasurement z{k * 0.001, a, b, 0.8 * std::sin(0.1 * k) + 0.1 * n(rng)};
       apply(imu, 0.0, &z);
     }
   }
@@ -55,7 +55,7 @@ TEST(StartReplay, ReplayIsTheFilterRunFromTheRestartedState) {
   replay.begin(at_ref, 2.0);
   EXPECT_TRUE(replay.recording());
   EXPECT_DOUBLE_EQ(replay.referenceTime(), 2.0);
-  windowEvents([&](const ImuReading& imu, double dt, const TdoaObservation* z) {
+  windowEvents([&](const ImuReading& imu, double dt, const TdoaMeasurement* z) {
     if (z) replay.recordTdoa(*z);
     else replay.recordPredict(imu, dt);
   });
@@ -63,14 +63,14 @@ TEST(StartReplay, ReplayIsTheFilterRunFromTheRestartedState) {
   const Vec3 p0(0.7, -0.1, 1.0), v0(0.2, 0.1, -0.1);
   const double sp = 0.3, sv = 1.0, period = params.cov_period_s;
   Ekf replayed(params);
-  const auto update = [&](Ekf& f, const TdoaObservation& z) { updateTdoa(f, anchors, z, opt); };
+  const auto update = [&](Ekf& f, const TdoaMeasurement& z) { updateTdoa(f, anchors, z, opt); };
   ASSERT_TRUE(replay.replay(replayed, p0, v0, sp, sv, period, update));
   Ekf by_hand = at_ref;
   by_hand.propagateCovariance();
   Eigen::Matrix<double, 6, 6> cov = Eigen::Matrix<double, 6, 6>::Zero();
   cov.diagonal() << sp * sp, sp * sp, sp * sp, sv * sv, sv * sv, sv * sv;
   by_hand.resetPositionVelocity(p0, v0, cov);
-  windowEvents([&](const ImuReading& imu, double dt, const TdoaObservation* z) {
+  windowEvents([&](const ImuReading& imu, double dt, const TdoaMeasurement* z) {
     if (!z) {
       by_hand.predict(imu, dt);
       return;
@@ -94,7 +94,7 @@ TEST(StartReplay, AStoppedOrOverflowedRecordIsNotReplayed) {
   EkfParams params;
   Ekf f(params);
   f.initialize(movingState(), initialCovariance(params));
-  const auto no_update = [](Ekf&, const TdoaObservation&) {};
+  const auto no_update = [](Ekf&, const TdoaMeasurement&) {};
   Ekf target(params);
   target.initialize(NavState{}, initialCovariance(params));
   // stopped

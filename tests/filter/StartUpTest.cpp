@@ -28,7 +28,7 @@ std::optional<StartFix> runStart(StartUp& start, const AnchorTable& anchors, con
                                  std::optional<double> floor_z_m, bool refutable = true, int n_pairs = 8) {
   const NavState held;  // the prediction on the ground: zero velocity, the displacements vanish
   for (int k = 0; k < 2000; ++k) {
-    TdoaObservation z;
+    TdoaMeasurement z;
     z.t_s = 0.0025 * k;
     z.id_a = k % n_pairs;
     z.id_b = (z.id_a + 1) % 8;

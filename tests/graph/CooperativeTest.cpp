@@ -47,8 +47,7 @@ TEST(Cooperative, SingleMeasurementIsExactForTheLinearizedModel) {
     VecX mt = T * m;
     mt(3) += lin.D;
     const Moments brute = condition(mt, T * V * T.transpose(), 3, VecX::Constant(1, z));
-    EXPECT_LT(maxAbs(post[which].m - brute.m), 1e-9);
-    EXPECT_LT(maxAbs(post[which].V - brute.V), 1e-9);
+    EXPECT_LT(maxAbsDifference(post[which], brute), 1e-9);
   }
   EXPECT_LT(maxAbs(post[2].m - priors[2].m), 1e-15);
   EXPECT_LT(maxAbs(post[2].V), 1e-15);

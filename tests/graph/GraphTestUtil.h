@@ -4,6 +4,8 @@
  */
 #pragma once
 
+#include <algorithm>
+
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <random>
@@ -53,5 +55,11 @@ inline Moments condition(const VecX& m, const MatX& V, Eigen::Index n1, const Ve
 }
 
 inline double maxAbs(const MatX& A) { return A.size() == 0 ? 0.0 : A.cwiseAbs().maxCoeff(); }
+
+/// Largest absolute difference between two moment-form messages (Moments, Moments3, …), over means and covariances.
+template <class MomentsA, class MomentsB>
+double maxAbsDifference(const MomentsA& a, const MomentsB& b) {
+  return std::max(maxAbs(a.m - b.m), maxAbs(a.V - b.V));
+}
 
 }  // namespace uwb::graphtest

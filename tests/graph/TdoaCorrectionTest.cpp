@@ -124,10 +124,8 @@ TEST(TdoaCorrection, FastPathEqualsGenericMessagePassing) {
     const auto generic = correctTdoaByMessages(Moments{s.m, s.P}, C, p_tag, msg);
     ASSERT_TRUE(fast && dyn && generic);
     // THEN all agree
-    EXPECT_LT(maxAbs(fast->posterior.m - generic->m), 1e-9);
-    EXPECT_LT(maxAbs(fast->posterior.V - generic->V), 1e-9);
-    EXPECT_LT(maxAbs(fast->posterior.m - dyn->posterior.m), 1e-12);
-    EXPECT_LT(maxAbs(fast->posterior.V - dyn->posterior.V), 1e-12);
+    EXPECT_LT(maxAbsDifference(fast->posterior, *generic), 1e-9);
+    EXPECT_LT(maxAbsDifference(fast->posterior, dyn->posterior), 1e-12);
   }
 }
 

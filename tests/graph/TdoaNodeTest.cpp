@@ -115,12 +115,9 @@ TEST(TdoaNode, PosteriorOfTagAndAnchorsMatchesDenseJoint) {
     ASSERT_TRUE(post_k && post_i && post_j);
     // THEN each equals the brute-force conditional of the dense joint given z (exact for the linear model)
     const Moments bk = bruteForcePosterior(s, 0), bi = bruteForcePosterior(s, 1), bj = bruteForcePosterior(s, 2);
-    EXPECT_LT(maxAbs(post_k->m - bk.m), kTol);
-    EXPECT_LT(maxAbs(post_k->V - bk.V), kTol);
-    EXPECT_LT(maxAbs(post_i->m - bi.m), kTol);
-    EXPECT_LT(maxAbs(post_i->V - bi.V), kTol);
-    EXPECT_LT(maxAbs(post_j->m - bj.m), kTol);
-    EXPECT_LT(maxAbs(post_j->V - bj.V), kTol);
+    EXPECT_LT(maxAbsDifference(*post_k, bk), kTol);
+    EXPECT_LT(maxAbsDifference(*post_i, bi), kTol);
+    EXPECT_LT(maxAbsDifference(*post_j, bj), kTol);
   }
 }
 

@@ -17,7 +17,7 @@ TEST(LineProtocol, EveryEventTypeReadsBackBitForBit) {
   ImuReading imu;
   imu.b_acc_mps2 = Vec3(0.1 + 0.2, -9.81 / 3.0, 1e-300);
   imu.b_gyro_radps = Vec3(1.0 / 7.0, -2.0 / 3.0, 123456.789e10);
-  const TdoaObservation z{12.000000000000002, 3, 7, -1.0 / 3.0};
+  const TdoaMeasurement z{12.000000000000002, 3, 7, -1.0 / 3.0};
   const TofObservation tof{12.5, 0.1 + 0.7};
   // WHEN written and read back
   const StreamEvent e_imu = parseEventLine(formatImuLine(0.1 * 3.0, imu), 1);

@@ -51,7 +51,7 @@ class CooperativeAgent {
   CooperativeAgent(int id, const EkfParams& params, const AnchorTable& anchors, const CooperativeAgentOptions& options);
 
   void addImu(double t_s, const ImuReading& imu);
-  void addTdoa(const TdoaObservation& z);
+  void addTdoa(const TdoaMeasurement& z);
   /// Keeps the newest belief of each other agent (own and older ones ignored).
   void addBelief(const NeighbourBelief& belief);
   /// A TWR to agent `peer`: applied to the cooperative estimator with the peer's latest belief aged to t_s (G22);

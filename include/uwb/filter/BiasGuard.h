@@ -40,7 +40,7 @@ class GuardedEstimator {
   GuardedEstimator& operator=(const GuardedEstimator&) = delete;
 
   void addImu(double t_s, const ImuReading& imu);
-  void addTdoa(const TdoaObservation& z);
+  void addTdoa(const TdoaMeasurement& z);
   void addTof(const TofObservation& tof);
 
   bool ready() const { return corrected_.ready() && plain_.ready(); }

@@ -168,7 +168,7 @@ class Estimator {
   Estimator& operator=(const Estimator&) = delete;
 
   void addImu(double t_s, const ImuReading& imu);
-  void addTdoa(const TdoaObservation& z);
+  void addTdoa(const TdoaMeasurement& z);
   void addTof(const TofObservation& tof);
   /// A two-way range at t_s to a neighbouring agent whose tag-position belief (aged to t_s, G22) is `neighbour`
   /// (G20, G21). Ignored (counted) before the position is known.
@@ -201,7 +201,46 @@ class Estimator {
   const OnlineAntennaBias* antennaBias() const { return antenna_ ? &*antenna_ : nullptr; }
 
  private:
+  struct PairOffset;
+  /// The TDoA update's options while tracking, acquiring and at rest, and the ToF update's (F11–F14, F16, F21).
+  void configureUpdateOptions();
+  /// (F24b, F24c, F25) The bias model's mean scaling and the learned antenna pattern wrapped around the bias model.
+  void configureBiasCorrections();
   void initialize(double t_s, const Vec3& acc_mean_b, bool moving);
+  /// (F15) One IMU sample into the levelling window; initializes the filter when the window is complete.
+  void addLevellingSample(double t_s, const ImuReading& imu);
+  /// (F18, F29) The IMU's ground evidence of one sample (rest, contact, climb) into the flight-mode supervisor.
+  void superviseGround(double t_s, const ImuReading& imu, double dt_imu);
+  /// (F15) The take-off detector's leaky vertical velocity on the ground; true when it shows a climb.
+  bool updateTakeoffDetector(const ImuReading& imu, double dt_imu, bool shaking);
+  /// (F18) The lowest height estimate of the last n samples of the recent-height ring and the current one [m].
+  double lowestRecentZ(std::size_t n) const;
+  /// (F18, F29b) Floor contact: recent shaking near the floor, or sustained shaking.
+  bool floorContact(double t_s) const;
+  /// (F18) Rest that may enter the ground: near the floor, not climbing, or within a landing's window.
+  bool restNearFloor(double t_s);
+  /// (F29, F29e) Floor checks, and entering or leaving the ground as the flight mode decided.
+  void followFlightMode(double t_s, bool climbing, bool contact, double shake_ms);
+  /// (F14, F16, F22, F26) The zero-velocity update on the ground; in flight the floor, descent and divergence checks.
+  void runPeriodicChecks(double t_s);
+  /// (F17) Initializes a TDoA-only filter, handles time jumps and predicts to t; false when the TDoA is dropped.
+  bool advanceToTdoa(double t);
+  /// (F16) One TDoA into the start-up's multilateration window; finishes the start, landing fix or floor check.
+  void collectStartTdoa(const TdoaMeasurement& z);
+  /// (F19, F16f, F16h) The TDoA with its pair offset and floor-level delays removed; *po: its pair's offset slot.
+  TdoaMeasurement correctedTdoa(const TdoaMeasurement& z, bool acquiring, PairOffset** po);
+  /// (F25d, F19) The antenna pattern and the pair offset learn from an applied update's innovation.
+  void learnFromInnovation(double t, const TdoaUpdateResult& r, bool acquiring, bool near_floor, PairOffset* po);
+  void countTdoaOutcome(double t, const TdoaUpdateResult& r, bool acquiring, bool near_floor);
+  /// (F16d) The rejection rate in flight, and the recent motion recorded while the TDoA agree.
+  void trackRejectionRate(double t, const TdoaUpdateResult& r);
+  /// (F23c, F24b, F24c) The flight's bias levels from a TDoA's residual.
+  void feedBiasLevels(double t, const TdoaMeasurement& z, const TdoaUpdateResult& r, bool flying,
+                      double range_bias_prior_m, const Vec3& w_p_tag_prior);
+  /// (F23) The anchor pairs in view, and the reported bias term refreshed from them.
+  void notePairInView(double t, const TdoaMeasurement& z, const TdoaUpdateResult& r);
+  /// (F16, F16d, F16k) Lost or rejecting in flight: re-acquire.
+  void superviseTracking(double t, bool acquiring);
   void predictTo(double t_s);
   void propagate(bool force);
   void handleTimeJump(double t_s, double gap_s);
@@ -214,7 +253,7 @@ class Estimator {
   void finishFloorCheck(double t_s, const StartFix& fix);
   /// F16d: position and velocity back to the recent motion recorded before a TDoA fault.
   void revertToHealthyMotion(double t_s);
-  void superviseTdoa(double t_s, const TdoaObservation& z);
+  void superviseTdoa(double t_s, const TdoaMeasurement& z);
   void checkConsistency(double t_s, double nis);
   void applyFloorConstraint(bool on_ground);
   /// F26: the height bounded from above by the IMU's dead-reckoned descent while landing.
@@ -239,7 +278,6 @@ class Estimator {
   std::optional<OnlineAntennaBias> antenna_;  ///< learned antenna pattern (F25), with antenna_bias_degree > 0
   BiasPredictor corrections_;  ///< bias_ plus the learned antenna pattern (F25b); empty without learning
   bool antenna_predicted_ = false;  ///< the last TDoA's correction included the antenna pattern
-  double antenna_var_m2_ = 0.0;     ///< of it, the variance added to the filter's TDoA variance [m²]
   bool imu_mode_;
   DescentBound descent_;  ///< dead-reckoned descent while landing (F26)
   Ekf ekf_;

@@ -15,7 +15,7 @@ namespace uwb {
 /// One measurement of the batch: the TDoA and the body displacement d_i since the reference instant, so the body
 /// was at p0 + d_i when it was taken (d_i from IMU integration; zero for a static body).
 struct MultilaterationSample {
-  TdoaObservation z;
+  TdoaMeasurement z;
   Vec3 w_d_b = Vec3::Zero();
   Quat w_q_b = Quat::Identity();  ///< attitude when measured (lever arm)
 };

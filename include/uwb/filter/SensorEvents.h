@@ -31,7 +31,7 @@ struct TimedImu {
 /// Sensor streams as the filter consumes them.
 struct SensorLog {
   std::vector<TimedImu> imu;
-  std::vector<TdoaObservation> tdoa;
+  std::vector<TdoaMeasurement> tdoa;
   std::vector<TofObservation> tof;  ///< optional downward range (F21); empty unless ToF fusion is wanted
 };
 
@@ -115,7 +115,7 @@ class SensorEventCursor {
     t_next_other_ = t_tdoa <= t_tof ? t_tdoa : t_tof;
   }
   const TimedImu* imu_;
-  const TdoaObservation* tdoa_;
+  const TdoaMeasurement* tdoa_;
   const TofObservation* tof_;
   std::size_t n_imu_, n_tdoa_, n_tof_;
   std::size_t i_imu_ = 0, i_tdoa_ = 0, i_tof_ = 0;

@@ -62,7 +62,7 @@ bool checkImuRange(double t_s, const ImuReading& imu, SensorRangeReport& report)
 /// (F31) The TDoA is inside its physical range: finite and |z| ≤ ‖a_B − a_A‖ + margin (a range difference cannot
 /// exceed the distance between the two anchors, triangle inequality). A TDoA naming an anchor outside `anchors`
 /// passes (the update counts it as unknown). When not, it is counted in `report` and false is returned.
-bool checkTdoaRange(const TdoaObservation& z, const AnchorTable& anchors, SensorRangeReport& report);
+bool checkTdoaRange(const TdoaMeasurement& z, const AnchorTable& anchors, SensorRangeReport& report);
 
 /// One warning per sensor with samples skipped: the count, the bound, the first stamp and the worst value, e.g.
 /// "skipped 1 gyro sample outside the sensor's physical range (‖ω‖ ≤ 70 rad/s, max_gyro_radps, filter.md F31): first

@@ -39,7 +39,7 @@ class StartReplay {
   /// One prediction step of the filter, as it was made (Ekf::predict(imu, dt)).
   void recordPredict(const ImuReading& imu, double dt_s);
   /// One TDoA, in its place among the predictions.
-  void recordTdoa(const TdoaObservation& z);
+  void recordTdoa(const TdoaMeasurement& z);
 
   /// Restarts `filter` from the recorded one with position p0 and velocity v0 under the std pos_sigma_m and
   /// vel_sigma_mps (no correlation with the other states) and runs the record again: every TDoA through
@@ -59,7 +59,7 @@ class StartReplay {
     bool is_tdoa = false;
     union {
       Prediction predict;
-      TdoaObservation z;
+      TdoaMeasurement z;
     };
     Entry() : predict{} {}
   };

@@ -8,6 +8,7 @@
 #include <optional>
 #include <vector>
 
+#include "uwb/filter/EkfParams.h"
 #include "uwb/filter/Multilateration.h"
 #include "uwb/filter/NavState.h"
 
@@ -46,6 +47,10 @@ struct StartUpParams {
   double floor_refute_height_m = 1.2;
   /// … with an RMS residual at most this many times the floor solve's
   double floor_refute_residual_ratio = 1.5;
+
+  /// The estimator's start-up: every field from its EkfParams namesake (start_*, floor_refute_*; the position std at
+  /// most init_pos_sigma_m).
+  static StartUpParams fromEkfParams(const EkfParams& p);
 };
 
 class StartUp {
@@ -65,10 +70,22 @@ class StartUp {
   /// collection then ends). floor_z_m: the body sits on the floor now (ground evidence, F18) at this height of its
   /// origin, so the solve is over x and y (F16c). floor_refutable: that evidence may be refuted by the TDoA (F16j: floor
   /// contact before the first fix, not rest).
-  std::optional<StartFix> add(const TdoaObservation& z, const NavState& x_now,
+  std::optional<StartFix> add(const TdoaMeasurement& z, const NavState& x_now,
                               std::optional<double> floor_z_m = std::nullopt, bool floor_refutable = false);
 
  private:
+  /// The window's solve: on the floor (with the floor-level delays, F16f), refuted (F16j), moving or at rest.
+  struct WindowSolve {
+    std::optional<MultilaterationResult> result;
+    bool moving = false;         ///< position and velocity solved (F16b)
+    bool floor_refuted = false;  ///< (F16j)
+    bool on_floor = false;       ///< solved on the floor at a known height (F16c)
+  };
+  WindowSolve solveWindow(double t_now_s, std::optional<double> floor_z_m, bool floor_refutable) const;
+  /// (F16b) A failed solve: the window keeps its newest part and the reference moves to now.
+  void retryLater(double t_now_s, const NavState& x_now);
+  /// (F16b) The solve brought to now, with floors on its stds.
+  StartFix fixNow(const WindowSolve& w, double t_now_s, const NavState& x_now) const;
   /// Distinct anchors among the window's TDoA (F16k).
   int distinctAnchors() const;
   /// (F16j) The solve in motion of the window when its TDoA put the body in the air rather than on the floor at

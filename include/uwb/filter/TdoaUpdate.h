@@ -8,6 +8,7 @@
 #include <optional>
 #include <vector>
 
+#include "uwb/core/Tdoa.h"
 #include "uwb/filter/Ekf.h"
 #include "uwb/filter/OutlierGate.h"
 #include "uwb/graph/GaussianMessage.h"
@@ -40,14 +41,6 @@ struct AnchorBox {
 /// Throws std::invalid_argument when the table is empty.
 AnchorBox anchorBox(const AnchorTable& anchors);
 
-/// One TDoA as the filter sees it: tdoa_m = |p_tag − a_B| − |p_tag − a_A| (UTIL convention).
-struct TdoaObservation {
-  double t_s = 0.0;
-  int id_a = 0;
-  int id_b = 0;
-  double tdoa_m = 0.0;
-};
-
 struct TdoaUpdateOptions {
   double sigma_m = 0.35;       ///< measurement std before bias-model variance [m]
   double gate_sigma = 4.0;     ///< χ² gate on √NIS; ≤ 0 disables the gate
@@ -78,7 +71,7 @@ struct TdoaUpdateResult {
 /// The TDoA message on the error state from the graph's TDoA node (G11–G16), without applying it.
 /// nullopt when an anchor is unknown or the geometry is degenerate (tag on an anchor).
 std::optional<ScalarLinearMessage<kDim>> tdoaMessage(const NavState& x, const AnchorTable& anchors,
-                                                     const TdoaObservation& z, double z_corrected_m, double var_m2,
+                                                     const TdoaMeasurement& z, double z_corrected_m, double var_m2,
                                                      const Vec3& b_t_tag);
 
 /// (G16) The TDoA node's message on the error state through x_k = x̃_k + C δx for the tag Jacobian
@@ -87,17 +80,9 @@ std::optional<ScalarLinearMessage<kDim>> tdoaMessage(const NavState& x, const An
 ScalarLinearMessage<kDim> tdoaMessageOnPositionAttitude(const TdoaNodeMessages& node, const Mat3& J_tag_att,
                                                         const Vec3& w_p_tag);
 
-/// The part of the TDoA node's forward pass (tdoaNodeForward, G11–G13) that the filter's message on δx (G16) uses:
-/// µ3, µ4, µ7 and B12, with the same values; W7, ξ7 and µ8 are left at zero. The anchor terms B Σ Bᵀ of Σ7 are
-/// skipped for anchors with zero covariance (surveyed anchors, EkfParams::anchor_sigma_m = 0), where they are 0;
-/// the anchors' Σ must be covariances (symmetric positive semi-definite), so that a zero diagonal means Σ = 0.
-/// Throws std::invalid_argument if var_m2 is not finite and > 0.
-TdoaNodeMessages tdoaNodeForwardToTag(const TdoaLinearization& lin, const Moments3& x_i, const Moments3& x_j,
-                                      double z_m, double var_m2);
-
 /// Full TDoA update of `ekf` (F10–F13). The covariance should be propagated (Ekf::propagateCovariance) by the
 /// caller according to its schedule. `bias` may be null (no bias correction).
-TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaObservation& z,
+TdoaUpdateResult updateTdoa(Ekf& ekf, const AnchorTable& anchors, const TdoaMeasurement& z,
                             const TdoaUpdateOptions& options, const BiasPredictor* bias = nullptr);
 
 }  // namespace uwb

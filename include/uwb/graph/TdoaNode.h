@@ -38,7 +38,15 @@ struct TdoaNodeMessages {
   Information3 mu8;             ///< message on x_k: ξ8 = B12ᵀ ξ7, W8 = B12ᵀ W7 B12 (rank one)
 };
 
-/// Forward pass of the TDoA node (G11–G13). z_m = m6 is the measured TDoA, already bias-corrected by the
+/// The forward pass up to the message on B12 x_k (G11–G12): µ3, µ4, µ7 and B12; W7, ξ7 and µ8 are left at zero. The
+/// message on the tag's error state (the filter's G16) needs no more. The anchor terms B Σ Bᵀ of Σ7 are skipped for
+/// anchors with zero covariance (surveyed anchors), where they are 0; the anchors' Σ must be covariances (symmetric
+/// positive semi-definite), so that a zero diagonal means Σ = 0. Throws std::invalid_argument if var_m2 is not
+/// finite and > 0.
+TdoaNodeMessages tdoaNodeForwardToTag(const TdoaLinearization& lin, const Moments3& x_i, const Moments3& x_j,
+                                      double z_m, double var_m2);
+
+/// Forward pass of the TDoA node (G11–G13): tdoaNodeForwardToTag and the message on x_k (G13). z_m = m6 is the measured TDoA, already bias-corrected by the
 /// caller; var_m2 = Σ6 is its variance (possibly inflated by the caller, e.g. GP variance or robust weight).
 /// x_i, x_j: beliefs of the two anchors (or agents) in the paper's order (UTIL: x_i = anchor B, x_j = anchor A).
 /// Throws std::invalid_argument if var_m2 is not finite and > 0.

@@ -13,17 +13,10 @@
 #include <string>
 #include <vector>
 
+#include "uwb/core/Tdoa.h"
 #include "uwb/core/Types.h"
 
 namespace uwb {
-
-/// One TDoA measurement: tdoa_m = |p − a_idB| − |p − a_idA| + noise [m].
-struct TdoaMeasurement {
-  double t_s = 0.0;
-  int id_a = 0;
-  int id_b = 0;
-  double tdoa_m = 0.0;
-};
 
 /// One TWR range measurement to one anchor [m].
 struct TwrMeasurement {

@@ -26,7 +26,7 @@ struct StreamEvent {
   Kind kind = Kind::kNone;
   double t_s = 0.0;
   ImuReading imu;        ///< kImu
-  TdoaObservation tdoa;  ///< kTdoa (its t_s equals t_s)
+  TdoaMeasurement tdoa;  ///< kTdoa (its t_s equals t_s)
   TofObservation tof;    ///< kTof (its t_s equals t_s)
 };
 
@@ -43,7 +43,7 @@ void checkEventAnchors(const StreamEvent& ev, const AnchorTable& anchors, std::s
 
 /// The line of one event (no newline).
 std::string formatImuLine(double t_s, const ImuReading& imu);
-std::string formatTdoaLine(const TdoaObservation& z);
+std::string formatTdoaLine(const TdoaMeasurement& z);
 std::string formatTofLine(const TofObservation& z);
 /// The line of event `ev` of a merged log (SensorEventCursor over `log`).
 std::string formatEventLine(const SensorLog& log, const SensorEvent& ev);
