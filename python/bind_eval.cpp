@@ -266,31 +266,42 @@ EkfParams ekfParamsFromPython(const std::string& preset, const py::dict& overrid
   return ekfParams(preset, overrides);
 }
 
-void bindEval(py::module_& m) {
-  // ------------------------------------------------------------------------------------- training data
+namespace {
+
+// ------------------------------------------------------------------------------------- training data
+py::dict datasetArrays(const BiasDataset& d) {
+  std::vector<const TdoaFeature*> fs;
+  fs.reserve(d.samples.size());
+  const auto n = static_cast<Eigen::Index>(d.samples.size());
+  RowMat x(n, 2);
+  auto flight = newIntArray(n);
+  auto mf = flight.mutable_unchecked<1>();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    fs.push_back(&d.samples[i].feature);
+    x.row(i) << d.samples[i].t_s, d.samples[i].error_m;
+    mf(i) = d.samples[i].flight;
+  }
+  py::dict out = featuresToDict(fs);
+  out["t"] = toNumpy(x.col(0), true), out["error"] = toNumpy(x.col(1), true), out["flight"] = flight;
+  return out;
+}
+
+BiasDataset buildDataset(const std::vector<const Flight*>& flights, const AnchorSurvey& survey, const py::kwargs& kw) {
+  const BiasDatasetParams params = datasetParams(kw);
+  std::vector<Flight> copies;
+  copies.reserve(flights.size());
+  for (const Flight* f : flights) copies.push_back(*f);
+  py::gil_scoped_release release;
+  return buildBiasDataset(copies, survey, params);
+}
+
+void bindBiasDataset(py::module_& m) {
   py::class_<BiasDataset>(m, "BiasDataset",
                           "GP training data from flights with ground truth: features from the interpolated\n"
                           "ground-truth pose and the TDoA error ε (paper eq. 6), after explicit exclusion rules.")
       .def("__len__", [](const BiasDataset& d) { return d.samples.size(); })
-      .def(
-          "arrays",
-          [](const BiasDataset& d) {
-            std::vector<const TdoaFeature*> fs;
-            fs.reserve(d.samples.size());
-            const auto n = static_cast<Eigen::Index>(d.samples.size());
-            RowMat x(n, 2);
-            auto flight = newIntArray(n);
-            auto mf = flight.mutable_unchecked<1>();
-            for (Eigen::Index i = 0; i < n; ++i) {
-              fs.push_back(&d.samples[i].feature);
-              x.row(i) << d.samples[i].t_s, d.samples[i].error_m;
-              mf(i) = d.samples[i].flight;
-            }
-            py::dict out = featuresToDict(fs);
-            out["t"] = toNumpy(x.col(0), true), out["error"] = toNumpy(x.col(1), true), out["flight"] = flight;
-            return out;
-          },
-          "{t, flight (index), error [m] (ε, the GP target), id_a, id_b, yaw_a, yaw_b, b_p_a, b_p_b, w_p_b}")
+      .def("arrays", &datasetArrays,
+           "{t, flight (index), error [m] (ε, the GP target), id_a, id_b, yaw_a, yaw_b, b_p_a, b_p_b, w_p_b}")
       .def_property_readonly("flights",
                              [](const BiasDataset& d) {
                                py::list l;
@@ -300,22 +311,12 @@ void bindEval(py::module_& m) {
                              "per-flight exclusion counts")
       .def("report_text", &BiasDataset::reportText, "Text summary: samples per flight and pair, and what was excluded.");
 
-  m.def(
-      "build_bias_dataset",
-      [](const std::vector<const Flight*>& flights, const AnchorSurvey& survey, const py::kwargs& kw) {
-        const BiasDatasetParams params = datasetParams(kw);
-        std::vector<Flight> copies;
-        copies.reserve(flights.size());
-        for (const Flight* f : flights) copies.push_back(*f);
-        py::gil_scoped_release release;
-        return buildBiasDataset(copies, survey, params);
-      },
-      py::arg("flights"), py::arg("survey"),
-      "Training data from flights with a ground-truth pose (position-only without IMU: world-frame features).\n"
-      "Keyword arguments override\n"
-      "BiasDatasetParams (min_z_m, glitch_margin_s, max_abs_error_m, neighbour_pairs_only, b_t_tag, "
-      "inputs='estimate'|'truth': GP inputs from the uncorrected filter (the default, as the CLI's train) or from the "
-      "ground truth).");
+  m.def("build_bias_dataset", &buildDataset, py::arg("flights"), py::arg("survey"),
+        "Training data from flights with a ground-truth pose (position-only without IMU: world-frame features).\n"
+        "Keyword arguments override\n"
+        "BiasDatasetParams (min_z_m, glitch_margin_s, max_abs_error_m, neighbour_pairs_only, b_t_tag, "
+        "inputs='estimate'|'truth': GP inputs from the uncorrected filter (the default, as the CLI's train) or from the "
+        "ground truth).");
 
   m.def("bias_preset_names", &BiasPreset::names, "Bias-model presets: z1, z2, tdoa (paper) and extras.");
   m.def(
@@ -328,8 +329,35 @@ void bindEval(py::module_& m) {
       "GP input rows (N, D) of a feature dict for a feature map ('yaw_angles' → [yaw_a, yaw_b], 'body_positions' →\n"
       "[b_p_a, b_p_b], 'world_position' → [w_p_b], 'body_positions_anchors' → [b_p_a, b_p_b, w_p_anchor_a,\n"
       "w_p_anchor_b], 'body_positions_world' → [b_p_a, b_p_b, w_p_b]).");
+}
 
-  // ---------------------------------------------------------------------------------------- bias model
+// ---------------------------------------------------------------------------------------- bias model
+py::list modelEntries(const BiasModel& b) {
+  py::list l;
+  for (const auto& e : b.entries()) {
+    py::dict d;
+    d["id_a"] = e.id_a, d["id_b"] = e.id_b, d["gp"] = e.gp;
+    l.append(d);
+  }
+  return l;
+}
+
+py::dict predictBias(const BiasModel& b, const py::dict& features) {
+  const std::vector<TdoaFeature> fs = featuresFromDict(features, b.features());
+  Eigen::VectorXd mean(static_cast<Eigen::Index>(fs.size())), var(mean.size());
+  {
+    py::gil_scoped_release release;
+    for (std::size_t i = 0; i < fs.size(); ++i) {
+      const BiasPrediction p = b.predict(fs[i]);
+      mean(i) = p.mean_m, var(i) = p.variance_m2;
+    }
+  }
+  py::dict d;
+  d["mean"] = toNumpy(mean, true), d["var"] = toNumpy(var, true);
+  return d;
+}
+
+void bindBiasModel(py::module_& m) {
   py::class_<BiasModel>(m, "BiasModel",
                         "A trained TDoA bias model (SVGP(s) + feature mapping); the filter's bias predictor.")
       .def(py::init([](const gp::Svgp& svgp, const std::string& feature_map, const std::string& preset) {
@@ -340,35 +368,9 @@ void bindEval(py::module_& m) {
       .def_property_readonly("preset", &BiasModel::preset, "name of the training preset the model was made with")
       .def_property_readonly("feature_map", [](const BiasModel& b) { return toString(b.features()); },
                              "the feature map of its inputs (feature_matrix names)")
-      .def_property_readonly("entries",
-                             [](const BiasModel& b) {
-                               py::list l;
-                               for (const auto& e : b.entries()) {
-                                 py::dict d;
-                                 d["id_a"] = e.id_a, d["id_b"] = e.id_b, d["gp"] = e.gp;
-                                 l.append(d);
-                               }
-                               return l;
-                             },
-                             "[{id_a, id_b (-1: all pairs), gp: Svgp}]")
-      .def(
-          "predict",
-          [](const BiasModel& b, const py::dict& features) {
-            const std::vector<TdoaFeature> fs = featuresFromDict(features, b.features());
-            Eigen::VectorXd mean(static_cast<Eigen::Index>(fs.size())), var(mean.size());
-            {
-              py::gil_scoped_release release;
-              for (std::size_t i = 0; i < fs.size(); ++i) {
-                const BiasPrediction p = b.predict(fs[i]);
-                mean(i) = p.mean_m, var(i) = p.variance_m2;
-              }
-            }
-            py::dict d;
-            d["mean"] = toNumpy(mean, true), d["var"] = toNumpy(var, true);
-            return d;
-          },
-          py::arg("features"),
-          "Predicted bias of every row of a feature dict: {mean [m], var [m²] (latent)}; 0, 0 for uncovered pairs.")
+      .def_property_readonly("entries", &modelEntries, "[{id_a, id_b (-1: all pairs), gp: Svgp}]")
+      .def("predict", &predictBias, py::arg("features"),
+           "Predicted bias of every row of a feature dict: {mean [m], var [m²] (latent)}; 0, 0 for uncovered pairs.")
       .def_property("training_bias_level_m", &BiasModel::trainingBiasLevel, &BiasModel::setTrainingBiasLevel,
                     "TDoA bias level of the training flights [m] (filter.md F24b; 0 unknown: the mean is not scaled)")
       .def_property("training_mean_level_m", &BiasModel::trainingMeanLevel, &BiasModel::setTrainingMeanLevel,
@@ -387,174 +389,199 @@ void bindEval(py::module_& m) {
         return "<BiasModel preset=" + b.preset() + " features=" + toString(b.features()) + " models=" +
                std::to_string(b.entries().size()) + ">";
       });
+}
 
-  m.def(
-      "train_bias_model",
-      [](const BiasDataset& data, const std::string& preset, int num_inducing, double holdout_fraction,
-         double holdout_block_s, const py::object& progress, const py::kwargs& kw) {
-        BiasTrainParams p;
-        p.preset = preset;
-        p.num_inducing = num_inducing;
-        p.holdout_fraction = holdout_fraction;
-        p.holdout_block_s = holdout_block_s;
-        // SVGP training parameters (same names as train_svgp)
-        for (const auto& [key, value] : kw) {
-          const std::string n = py::str(key);
-          if (n == "epochs") p.svgp.epochs = py::cast<int>(value);
-          else if (n == "batch_size") p.svgp.batch_size = py::cast<int>(value);
-          else if (n == "seed") p.svgp.seed = py::cast<std::uint64_t>(value);
-          else if (n == "lr") p.svgp.lr = py::cast<double>(value);
-          else if (n == "lr_inducing") p.svgp.lr_inducing = py::cast<double>(value);
-          else if (n == "natgrad_step") p.svgp.natgrad_step = py::cast<double>(value);
-          else if (n == "train_inducing") p.svgp.train_inducing = py::cast<bool>(value);
-          else if (n == "num_threads") p.svgp.num_threads = py::cast<int>(value);
-          else if (n == "mean_scale") p.mean_scale = py::cast<double>(value);
-          else if (n == "full_variance") p.full_variance = py::cast<bool>(value);
-          else if (n == "predictive_dof") p.predictive_shape.dof = py::cast<double>(value);
-          else if (n == "predictive_scale") p.predictive_shape.scale = py::cast<double>(value);
-          else if (n == "min_samples_per_inducing") p.min_samples_per_inducing = py::cast<int>(value);
-          else
-            throw std::invalid_argument("unknown training parameter '" + n +
-                                        "' (known: epochs, batch_size, seed, lr, lr_inducing, natgrad_step, "
-                                        "train_inducing, num_threads, mean_scale, full_variance, predictive_dof, predictive_scale, "
-                                        "min_samples_per_inducing)");
-        }
-        p.validate();
-        BiasTrainProgress cb;
-        if (!progress.is_none()) {
-          cb = [&progress](int model, int models, const gp::EpochReport& r) {
-            py::gil_scoped_acquire acquire;
-            py::dict d;
-            d["model"] = model, d["models"] = models, d["epoch"] = r.epoch, d["epochs"] = r.epochs;
-            d["elbo"] = r.elbo, d["val_rmse"] = r.val_rmse, d["elapsed_s"] = r.elapsed_s;
-            progress(d);
-          };
-        }
-        BiasTrainReport report;
-        BiasModel model;
-        {
-          py::gil_scoped_release release;
-          model = trainBiasModel(data, p, &report, cb);
-        }
-        return py::make_tuple(std::move(model), trainReportDict(report));
-      },
-      py::arg("dataset"), py::arg("preset") = std::string(kDefaultTrainPreset),
-      py::arg("num_inducing") = BiasTrainParams{}.num_inducing, py::arg("holdout_fraction") = 0.2,
-      py::arg("holdout_block_s") = 5.0, py::arg("progress") = py::none(),
-      "Trains the preset's GP(s) on the dataset (time blocks held out). Keyword arguments: SVGP training\n"
-      "parameters (epochs, batch_size, seed, lr, ...). Returns (BiasModel, report {n_train, n_holdout,\n"
-      "bias_rmse_before_m, bias_rmse_after_m, mean_predicted_std_m, mean_predictive_std_m, holdout_coverage_1sigma, "
-      "holdout_coverage_2sigma, holdout_nlpd, train_seconds, num_models}).");
+// ------------------------------------------------------------------------------------------ training
+/// The SVGP training parameters among train_bias_model's keyword arguments (same names as train_svgp).
+void applyTrainKwargs(BiasTrainParams& p, const py::kwargs& kw) {
+  for (const auto& [key, value] : kw) {
+    const std::string n = py::str(key);
+    if (n == "epochs") p.svgp.epochs = py::cast<int>(value);
+    else if (n == "batch_size") p.svgp.batch_size = py::cast<int>(value);
+    else if (n == "seed") p.svgp.seed = py::cast<std::uint64_t>(value);
+    else if (n == "lr") p.svgp.lr = py::cast<double>(value);
+    else if (n == "lr_inducing") p.svgp.lr_inducing = py::cast<double>(value);
+    else if (n == "natgrad_step") p.svgp.natgrad_step = py::cast<double>(value);
+    else if (n == "train_inducing") p.svgp.train_inducing = py::cast<bool>(value);
+    else if (n == "num_threads") p.svgp.num_threads = py::cast<int>(value);
+    else if (n == "mean_scale") p.mean_scale = py::cast<double>(value);
+    else if (n == "full_variance") p.full_variance = py::cast<bool>(value);
+    else if (n == "predictive_dof") p.predictive_shape.dof = py::cast<double>(value);
+    else if (n == "predictive_scale") p.predictive_shape.scale = py::cast<double>(value);
+    else if (n == "min_samples_per_inducing") p.min_samples_per_inducing = py::cast<int>(value);
+    else
+      throw std::invalid_argument("unknown training parameter '" + n +
+                                  "' (known: epochs, batch_size, seed, lr, lr_inducing, natgrad_step, "
+                                  "train_inducing, num_threads, mean_scale, full_variance, predictive_dof, predictive_scale, "
+                                  "min_samples_per_inducing)");
+  }
+}
 
-  m.def(
-      "bias_calibration",
-      [](const BiasDataset& data, const BiasModel& model) {
-        BiasCalibration c;
-        {
-          py::gil_scoped_release release;
-          c = biasCalibration(data, model);
-        }
-        return jsonToPython(toJson(c));
-      },
-      py::arg("dataset"), py::arg("model"),
-      "Calibration of the model's predicted bias on a dataset (docs/math/gp.md P43, P43b, P43c): r = ε − µ against\n"
-      "σ² = var_f + σ_n² + the variance the sample's flight shows beyond the model's training flights (from the\n"
-      "levels its filter run measured; none for ground-truth inputs) and the central intervals of the model's\n"
-      "predictive shape (Student-t or Gaussian).\n"
-      "Returns {n, n_uncovered, coverage_1sigma, coverage_2sigma, nlpd [nats], rmse_m, mean_std_m, levels,\n"
-      "coverage (at levels), predictive_dof, predictive_scale}.");
+py::tuple trainModel(const BiasDataset& data, const std::string& preset, int num_inducing, double holdout_fraction,
+                     double holdout_block_s, const py::object& progress, const py::kwargs& kw) {
+  BiasTrainParams p;
+  p.preset = preset;
+  p.num_inducing = num_inducing;
+  p.holdout_fraction = holdout_fraction;
+  p.holdout_block_s = holdout_block_s;
+  applyTrainKwargs(p, kw);
+  p.validate();
+  BiasTrainProgress cb;
+  if (!progress.is_none()) {
+    cb = [&progress](int model, int models, const gp::EpochReport& r) {
+      py::gil_scoped_acquire acquire;
+      py::dict d;
+      d["model"] = model, d["models"] = models, d["epoch"] = r.epoch, d["epochs"] = r.epochs;
+      d["elbo"] = r.elbo, d["val_rmse"] = r.val_rmse, d["elapsed_s"] = r.elapsed_s;
+      progress(d);
+    };
+  }
+  BiasTrainReport report;
+  BiasModel model;
+  {
+    py::gil_scoped_release release;
+    model = trainBiasModel(data, p, &report, cb);
+  }
+  return py::make_tuple(std::move(model), trainReportDict(report));
+}
 
-  // -------------------------------------------------------------------------------------- localization
-  m.def(
-      "localize_flight",
-      [](const Flight& flight, const AnchorSurvey& survey, const BiasModel* bias_model, const std::string& preset,
-         const py::dict& params, double output_period_s, bool tdoa_only, double airborne_min_z_m) {
-        LocalizationOptions options;
-        options.params = ekfParams(preset, params);
-        options.output_period_s = output_period_s;
-        options.tdoa_only = tdoa_only;
-        options.metrics.airborne_min_z_m = airborne_min_z_m;
-        if (bias_model) applyBiasModelLevel(*bias_model, &options.params);  // (F24b)
-        LocalizationRun run;
-        {
-          py::gil_scoped_release release;
-          run = localizeFlight(flight, survey, options, bias_model ? bias_model->predictor() : BiasPredictor{});
-        }
-        py::dict d;
-        d["trajectory"] = trajectoryToDict(run.trajectory);
-        d["summary"] = summaryDict(run.summary, options.params);
-        d["metrics"] = run.metrics ? py::object(metricsDict(*run.metrics)) : py::object(py::none());
-        d["duration_s"] = run.duration_s, d["n_truth_glitches"] = run.n_truth_glitches;
-        return d;
-      },
-      py::arg("flight"), py::arg("survey"), py::arg("bias_model") = nullptr, py::arg("preset") = "defaults",
-      py::arg("params") = py::dict(), py::arg("output_period_s") = 0.01, py::arg("tdoa_only") = false,
-      py::arg("airborne_min_z_m") = kAirborneMinZ_m,
-      "Runs the localization filter on a flight, with the GP correction when bias_model is given (paper III-B:\n"
-      "z − mean, variance added). preset: 'defaults' | 'crazyflie' | 'tdoa-only'; params: EkfParams overrides\n"
-      "(field names of uwb/filter/EkfParams.h, enums as strings). Returns {trajectory {t, p, q, sigma_p, v, acc_bias,\n"
-      "gyro_bias (NaN without IMU)},\n"
-      "summary {...}, metrics (None without ground truth) {whole, airborne: {n, rmse_m, rmse_axis_m, mean_m,\n"
-      "p50_m, p90_m, p99_m, max_m}, samples {t, p_true, p_est, error, error_norm, airborne}}, duration_s}.");
-  m.def(
-      "run_evaluation",
-      [](const py::handle& train, const py::handle& test, const AnchorSurvey& survey,
-         const std::vector<std::string>& kernels, const std::vector<int>& inducing, int repeats, int epochs,
-         int threads, const py::object& out, const std::string& command, bool render, const py::object& progress) {
-        EvaluationParams params;
-        params.kernels = kernels;
-        params.inducing = inducing;
-        params.repeats = repeats;
-        if (epochs > 0) params.train.svgp.epochs = epochs;
-        params.threads = threads;
-        params.validate();
-        const std::vector<NamedFlight> tr = namedFlights(train, "train"), te = namedFlights(test, "test");
-        EvaluationProgress cb;
-        if (!progress.is_none()) {
-          cb = [&progress](const std::string& line) {
-            py::gil_scoped_acquire acquire;
-            progress(line);
-          };
-        }
-        EvaluationResult result;
-        {
-          py::gil_scoped_release release;
-          result = runEvaluation(tr, te, survey, params, cb);
-        }
-        py::dict d;
-        d["rows"] = jsonToPython(toJson(result.rows));
-        d["runs"] = jsonToPython(runsToJson(result.runs));  // with the bias calibration per run (P43)
-        d["best_kernel"] = result.best_kernel, d["best_inducing"] = result.best_inducing;
-        d["n_train_samples"] = result.n_train_samples, d["seconds"] = result.seconds;
-        d["dataset_report"] = result.dataset_report;
-        d["markdown"] = toMarkdown(result.rows);
-        if (!out.is_none()) {
-          const std::string dir = py::str(out);
-          writeEvaluation(result, survey, dir, command);
-          if (render) {
-            // Same figures as the CLI's report (one implementation: uwbtdoa.plots), then the report names them.
-            const py::list written = py::module_::import("uwbtdoa.plots").attr("render_report")(dir);
-            std::vector<std::string> names;
-            for (const auto& p : written) {
-              const std::string path = py::str(p);
-              names.push_back(path.substr(path.find_last_of('/') + 1));
-            }
-            writeEvaluation(result, survey, dir, command, names);
-            d["figures"] = names;
-          }
-        }
-        return d;
-      },
-      py::arg("train"), py::arg("test"), py::arg("survey"),
-      py::arg("kernels") = std::vector<std::string>{"z1", "z2", "tdoa"},
-      py::arg("inducing") = std::vector<int>{10, 30, 50, 100, 170}, py::arg("repeats") = 3, py::arg("epochs") = 0,
-      py::arg("threads") = 2, py::arg("out") = py::none(), py::arg("command") = "", py::arg("render") = true,
-      py::arg("progress") = py::none(),
-      "The paper's evaluation (uwbtdoa evaluate): train every (kernel, M, repeat), localize every test flight\n"
-      "without and with correction. train/test: {name: Flight} or a list of Flights (named after their file).\n"
-      "Returns {rows (results.json objects), runs (per configuration, repeat and test flight, with change_pct and the\n"
-      "bias calibration coverage_1sigma, coverage_2sigma, nlpd), best_kernel, best_inducing, n_train_samples, seconds,\n"
-      "dataset_report, markdown}. With out=DIR, writes the CLI's report files there and renders the figures.");
+py::object calibration(const BiasDataset& data, const BiasModel& model) {
+  BiasCalibration c;
+  {
+    py::gil_scoped_release release;
+    c = biasCalibration(data, model);
+  }
+  return jsonToPython(toJson(c));
+}
+
+void bindBiasTraining(py::module_& m) {
+  m.def("train_bias_model", &trainModel, py::arg("dataset"), py::arg("preset") = std::string(kDefaultTrainPreset),
+        py::arg("num_inducing") = BiasTrainParams{}.num_inducing, py::arg("holdout_fraction") = 0.2,
+        py::arg("holdout_block_s") = 5.0, py::arg("progress") = py::none(),
+        "Trains the preset's GP(s) on the dataset (time blocks held out). Keyword arguments: SVGP training\n"
+        "parameters (epochs, batch_size, seed, lr, ...). Returns (BiasModel, report {n_train, n_holdout,\n"
+        "bias_rmse_before_m, bias_rmse_after_m, mean_predicted_std_m, mean_predictive_std_m, holdout_coverage_1sigma, "
+        "holdout_coverage_2sigma, holdout_nlpd, train_seconds, num_models}).");
+
+  m.def("bias_calibration", &calibration, py::arg("dataset"), py::arg("model"),
+        "Calibration of the model's predicted bias on a dataset (docs/math/gp.md P43, P43b, P43c): r = ε − µ against\n"
+        "σ² = var_f + σ_n² + the variance the sample's flight shows beyond the model's training flights (from the\n"
+        "levels its filter run measured; none for ground-truth inputs) and the central intervals of the model's\n"
+        "predictive shape (Student-t or Gaussian).\n"
+        "Returns {n, n_uncovered, coverage_1sigma, coverage_2sigma, nlpd [nats], rmse_m, mean_std_m, levels,\n"
+        "coverage (at levels), predictive_dof, predictive_scale}.");
+}
+
+// -------------------------------------------------------------------------------------- localization
+py::dict localize(const Flight& flight, const AnchorSurvey& survey, const BiasModel* bias_model,
+                  const std::string& preset, const py::dict& params, double output_period_s, bool tdoa_only,
+                  double airborne_min_z_m) {
+  LocalizationOptions options;
+  options.params = ekfParams(preset, params);
+  options.output_period_s = output_period_s;
+  options.tdoa_only = tdoa_only;
+  options.metrics.airborne_min_z_m = airborne_min_z_m;
+  if (bias_model) applyBiasModelLevel(*bias_model, &options.params);  // (F24b)
+  LocalizationRun run;
+  {
+    py::gil_scoped_release release;
+    run = localizeFlight(flight, survey, options, bias_model ? bias_model->predictor() : BiasPredictor{});
+  }
+  py::dict d;
+  d["trajectory"] = trajectoryToDict(run.trajectory);
+  d["summary"] = summaryDict(run.summary, options.params);
+  d["metrics"] = run.metrics ? py::object(metricsDict(*run.metrics)) : py::object(py::none());
+  d["duration_s"] = run.duration_s, d["n_truth_glitches"] = run.n_truth_glitches;
+  return d;
+}
+
+/// With out=DIR: the CLI's report files there, and (render) the figures, which the report then names.
+void writeEvaluationReport(const EvaluationResult& result, const AnchorSurvey& survey, const std::string& dir,
+                           const std::string& command, bool render, py::dict& d) {
+  writeEvaluation(result, survey, dir, command);
+  if (!render) return;
+  // Same figures as the CLI's report (one implementation: uwbtdoa.plots), then the report names them.
+  const py::list written = py::module_::import("uwbtdoa.plots").attr("render_report")(dir);
+  std::vector<std::string> names;
+  for (const auto& p : written) {
+    const std::string path = py::str(p);
+    names.push_back(path.substr(path.find_last_of('/') + 1));
+  }
+  writeEvaluation(result, survey, dir, command, names);
+  d["figures"] = names;
+}
+
+py::dict evaluate(const py::handle& train, const py::handle& test, const AnchorSurvey& survey,
+                  const std::vector<std::string>& kernels, const std::vector<int>& inducing, int repeats, int epochs,
+                  int threads, const py::object& out, const std::string& command, bool render,
+                  const py::object& progress) {
+  EvaluationParams params;
+  params.kernels = kernels;
+  params.inducing = inducing;
+  params.repeats = repeats;
+  if (epochs > 0) params.train.svgp.epochs = epochs;
+  params.threads = threads;
+  params.validate();
+  const std::vector<NamedFlight> tr = namedFlights(train, "train"), te = namedFlights(test, "test");
+  EvaluationProgress cb;
+  if (!progress.is_none()) {
+    cb = [&progress](const std::string& line) {
+      py::gil_scoped_acquire acquire;
+      progress(line);
+    };
+  }
+  EvaluationResult result;
+  {
+    py::gil_scoped_release release;
+    result = runEvaluation(tr, te, survey, params, cb);
+  }
+  py::dict d;
+  d["rows"] = jsonToPython(toJson(result.rows));
+  d["runs"] = jsonToPython(runsToJson(result.runs));  // with the bias calibration per run (P43)
+  d["best_kernel"] = result.best_kernel, d["best_inducing"] = result.best_inducing;
+  d["n_train_samples"] = result.n_train_samples, d["seconds"] = result.seconds;
+  d["dataset_report"] = result.dataset_report;
+  d["markdown"] = toMarkdown(result.rows);
+  if (!out.is_none()) writeEvaluationReport(result, survey, py::str(out), command, render, d);
+  return d;
+}
+
+py::dict trajectoryMetrics(const py::dict& trajectory, const py::object& truth, double airborne_min_z_m,
+                           double max_interp_gap_s) {
+  TrajectoryMetricsParams p;
+  p.airborne_min_z_m = airborne_min_z_m;
+  p.max_interp_gap_s = max_interp_gap_s;
+  p.validate();
+  std::vector<PoseSample> gt;
+  if (py::isinstance<Flight>(truth)) {
+    gt = PoseTrack(py::cast<const Flight&>(truth)).samples();
+  } else {
+    const Trajectory t = trajectoryFromDict(py::cast<py::dict>(truth));
+    for (const auto& s : t) gt.push_back({s.t_s, s.w_p_b, s.w_q_b});
+  }
+  return metricsDict(computeTrajectoryMetrics(trajectoryFromDict(trajectory), gt, p));
+}
+
+void bindLocalization(py::module_& m) {
+  m.def("localize_flight", &localize, py::arg("flight"), py::arg("survey"), py::arg("bias_model") = nullptr,
+        py::arg("preset") = "defaults", py::arg("params") = py::dict(), py::arg("output_period_s") = 0.01,
+        py::arg("tdoa_only") = false, py::arg("airborne_min_z_m") = kAirborneMinZ_m,
+        "Runs the localization filter on a flight, with the GP correction when bias_model is given (paper III-B:\n"
+        "z − mean, variance added). preset: 'defaults' | 'crazyflie' | 'tdoa-only'; params: EkfParams overrides\n"
+        "(field names of uwb/filter/EkfParams.h, enums as strings). Returns {trajectory {t, p, q, sigma_p, v, acc_bias,\n"
+        "gyro_bias (NaN without IMU)},\n"
+        "summary {...}, metrics (None without ground truth) {whole, airborne: {n, rmse_m, rmse_axis_m, mean_m,\n"
+        "p50_m, p90_m, p99_m, max_m}, samples {t, p_true, p_est, error, error_norm, airborne}}, duration_s}.");
+  m.def("run_evaluation", &evaluate, py::arg("train"), py::arg("test"), py::arg("survey"),
+        py::arg("kernels") = std::vector<std::string>{"z1", "z2", "tdoa"},
+        py::arg("inducing") = std::vector<int>{10, 30, 50, 100, 170}, py::arg("repeats") = 3, py::arg("epochs") = 0,
+        py::arg("threads") = 2, py::arg("out") = py::none(), py::arg("command") = "", py::arg("render") = true,
+        py::arg("progress") = py::none(),
+        "The paper's evaluation (uwbtdoa evaluate): train every (kernel, M, repeat), localize every test flight\n"
+        "without and with correction. train/test: {name: Flight} or a list of Flights (named after their file).\n"
+        "Returns {rows (results.json objects), runs (per configuration, repeat and test flight, with change_pct and the\n"
+        "bias calibration coverage_1sigma, coverage_2sigma, nlpd), best_kernel, best_inducing, n_train_samples, seconds,\n"
+        "dataset_report, markdown}. With out=DIR, writes the CLI's report files there and renders the figures.");
   m.def("filter_param_names",
         [] {
           std::vector<std::string> names;
@@ -562,25 +589,19 @@ void bindEval(py::module_& m) {
           return names;
         },
         "Names accepted by localize_flight(params=...).");
-  m.def(
-      "compute_trajectory_metrics",
-      [](const py::dict& trajectory, const py::object& truth, double airborne_min_z_m, double max_interp_gap_s) {
-        TrajectoryMetricsParams p;
-        p.airborne_min_z_m = airborne_min_z_m;
-        p.max_interp_gap_s = max_interp_gap_s;
-        p.validate();
-        std::vector<PoseSample> gt;
-        if (py::isinstance<Flight>(truth)) {
-          gt = PoseTrack(py::cast<const Flight&>(truth)).samples();
-        } else {
-          const Trajectory t = trajectoryFromDict(py::cast<py::dict>(truth));
-          for (const auto& s : t) gt.push_back({s.t_s, s.w_p_b, s.w_q_b});
-        }
-        return metricsDict(computeTrajectoryMetrics(trajectoryFromDict(trajectory), gt, p));
-      },
-      py::arg("trajectory"), py::arg("truth"), py::arg("airborne_min_z_m") = 0.3, py::arg("max_interp_gap_s") = 0.1,
-      "Position error of an estimated trajectory {t, p, ...} against ground truth (a Flight: its glitch-free pose\n"
-      "track; or a dict {t, p[, q]}): {whole, airborne, samples, n_truth_not_covered} as in localize_flight.");
+  m.def("compute_trajectory_metrics", &trajectoryMetrics, py::arg("trajectory"), py::arg("truth"),
+        py::arg("airborne_min_z_m") = 0.3, py::arg("max_interp_gap_s") = 0.1,
+        "Position error of an estimated trajectory {t, p, ...} against ground truth (a Flight: its glitch-free pose\n"
+        "track; or a dict {t, p[, q]}): {whole, airborne, samples, n_truth_not_covered} as in localize_flight.");
+}
+
+}  // namespace
+
+void bindEval(py::module_& m) {
+  bindBiasDataset(m);
+  bindBiasModel(m);
+  bindBiasTraining(m);
+  bindLocalization(m);
 }
 
 }  // namespace uwb::python

@@ -117,9 +117,7 @@ void writeText(const std::string& text, const std::string& path) {
   if (!out) throw FileError("error writing model file '" + path + "'");
 }
 
-}  // namespace
-
-void bindGp(py::module_& m) {
+void bindKernel(py::module_& m) {
   py::class_<Kernel>(m, "Kernel",
                      "Composite GP kernel: a sum of products of parts, each reading its own input columns.\n"
                      "Build with Kernel.preset('z1'|'z2'|'tdoa') or compose periodic(), matern52(), rbf(),\n"
@@ -160,7 +158,10 @@ void bindGp(py::module_& m) {
       .def("__add__", &combineSum, py::is_operator())
       .def("__mul__", &combineProduct, py::is_operator())
       .def("__repr__", [](const Kernel& k) { return "<Kernel " + k.name() + ">"; });
+}
 
+/// The kernel parts, each as a one-part Kernel: periodic(), matern52(), rbf(), ledergerber().
+void bindKernelParts(py::module_& m) {
   const auto l_default = py::float_(1.0);
   m.def(
       "periodic",
@@ -189,7 +190,29 @@ void bindGp(py::module_& m) {
       },
       py::arg("dims"), py::arg("t0") = 1.0, py::arg("t1") = 1.0, py::arg("t2") = 1.0,
       "Ledergerber–D'Andrea part θ0 exp(−(1 − cos∠(x,x'))/θ1 − (‖x‖−‖x'‖)²/θ2) on 3 columns (paper k_L, eq. 9).");
+}
 
+py::dict svgpElbo(const Svgp& g, const py::handle& X, const py::handle& y, double num_data) {
+  const MatX Xm = toMatX(X, "X");
+  const VecX yv = toVecX(y, "y");
+  if (yv.size() != Xm.rows()) throw std::invalid_argument("y: length differs from the rows of X");
+  const gp::ElboTerms t = g.elbo(Xm, yv, num_data < 0 ? static_cast<double>(Xm.rows()) : num_data);
+  py::dict d;
+  d["elbo"] = t.elbo, d["kl"] = t.kl, d["exp_log_lik"] = t.exp_log_lik, d["exp_log_lik_sum"] = t.exp_log_lik_sum;
+  return d;
+}
+
+py::dict svgpPredict(const Svgp& g, const py::handle& X, int threads) {
+  const MatX Xm = toMatX(X, "X", g.inputDim());
+  gp::SvgpPrediction p;
+  {
+    py::gil_scoped_release release;
+    p = g.predictor().predict(Xm, threads);
+  }
+  return predictionDict(p);
+}
+
+void bindSvgp(py::module_& m) {
   py::class_<Svgp>(m, "Svgp",
                    "Whitened sparse variational GP with a Gaussian likelihood and a constant mean (Hensman 2013).")
       .def(py::init([](const Kernel& k, const py::handle& Z, double jitter) {
@@ -228,33 +251,11 @@ void bindGp(py::module_& m) {
       .def("params", [](const Svgp& g) { return paramsDict(g.params()); }, "{name: (value, trainable)}")
       .def("set_param", &Svgp::setParam, py::arg("name"), py::arg("value"), "Sets one named parameter (see params()).")
       .def("kl", &Svgp::kl, "KL(q(u) ‖ p(u)) [nats], the ELBO's regularizer.")
-      .def(
-          "elbo",
-          [](const Svgp& g, const py::handle& X, const py::handle& y, double num_data) {
-            const MatX Xm = toMatX(X, "X");
-            const VecX yv = toVecX(y, "y");
-            if (yv.size() != Xm.rows()) throw std::invalid_argument("y: length differs from the rows of X");
-            const gp::ElboTerms t = g.elbo(Xm, yv, num_data < 0 ? static_cast<double>(Xm.rows()) : num_data);
-            py::dict d;
-            d["elbo"] = t.elbo, d["kl"] = t.kl, d["exp_log_lik"] = t.exp_log_lik, d["exp_log_lik_sum"] = t.exp_log_lik_sum;
-            return d;
-          },
-          py::arg("X"), py::arg("y"), py::arg("num_data") = -1.0,
-          "Minibatch ELBO per datum (num_data defaults to len(y)): {elbo, kl, exp_log_lik, exp_log_lik_sum}")
-      .def(
-          "predict",
-          [](const Svgp& g, const py::handle& X, int threads) {
-            const MatX Xm = toMatX(X, "X", g.inputDim());
-            gp::SvgpPrediction p;
-            {
-              py::gil_scoped_release release;
-              p = g.predictor().predict(Xm, threads);
-            }
-            return predictionDict(p);
-          },
-          py::arg("X"), py::arg("threads") = 1,
-          "Predictions at raw inputs X (N, D): {mean, var_f (latent), var_y (= var_f + noise)}. threads > 1 splits "
-          "the rows over that many threads (0: one per core); the result does not depend on it.")
+      .def("elbo", &svgpElbo, py::arg("X"), py::arg("y"), py::arg("num_data") = -1.0,
+           "Minibatch ELBO per datum (num_data defaults to len(y)): {elbo, kl, exp_log_lik, exp_log_lik_sum}")
+      .def("predict", &svgpPredict, py::arg("X"), py::arg("threads") = 1,
+           "Predictions at raw inputs X (N, D): {mean, var_f (latent), var_y (= var_f + noise)}. threads > 1 splits "
+           "the rows over that many threads (0: one per core); the result does not depend on it.")
       .def("to_json", [](const Svgp& g) { return g.toJson().dump(); }, "The model as JSON text (Svgp::toJson).")
       .def_static("from_json", [](const std::string& s) { return Svgp::fromJson(parseJson(s, "SVGP JSON")); },
                   py::arg("text"), "A model from the JSON text of to_json().")
@@ -267,6 +268,14 @@ void bindGp(py::module_& m) {
         return "<Svgp M=" + std::to_string(g.numInducing()) + " D=" + std::to_string(g.inputDim()) + " kernel " +
                g.kernel().name() + ">";
       });
+}
+
+}  // namespace
+
+void bindGp(py::module_& m) {
+  bindKernel(m);
+  bindKernelParts(m);
+  bindSvgp(m);
 }
 
 }  // namespace uwb::python

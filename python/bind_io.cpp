@@ -373,38 +373,42 @@ RowMat anchorPositions(const AnchorSurvey& survey, const Eigen::VectorXi& ids) {
   return out;
 }
 
-void bindIo(py::module_& m) {
+namespace {
+
+// ------------------------------------------------------------------------------------------ surveys
+py::array_t<int> surveyIds(const AnchorSurvey& s) {
+  auto out = newIntArray(static_cast<Eigen::Index>(s.anchors.size()));
+  auto o = out.mutable_unchecked<1>();
+  for (std::size_t i = 0; i < s.anchors.size(); ++i) o(i) = s.anchors[i].id;
+  return out;
+}
+
+py::array_t<double> surveyPositions(const AnchorSurvey& s) {
+  RowMat p(static_cast<Eigen::Index>(s.anchors.size()), 3);
+  for (std::size_t i = 0; i < s.anchors.size(); ++i) p.row(i) = s.anchors[i].w_p;
+  return toNumpy(p);
+}
+
+py::array_t<double> surveyQuaternions(const AnchorSurvey& s) {
+  RowMat q(static_cast<Eigen::Index>(s.anchors.size()), 4);
+  for (std::size_t i = 0; i < s.anchors.size(); ++i) {
+    const Quat& w_q = s.anchors[i].w_q;
+    q.row(i) << w_q.x(), w_q.y(), w_q.z(), w_q.w();
+  }
+  return toNumpy(q);
+}
+
+void bindAnchorSurvey(py::module_& m) {
   py::class_<AnchorSurvey>(m, "AnchorSurvey",
                            "Surveyed UWB anchors: ids, world positions [m] and orientations (x, y, z, w).")
       .def(py::init([](const py::handle& ids, const py::handle& positions, const py::object& quaternions,
                        const std::string& source) { return surveyFromArrays(ids, positions, quaternions, source); }),
            py::arg("ids"), py::arg("positions"), py::arg("quaternions") = py::none(), py::arg("source") = "",
            "Builds a survey from ids (N,), positions (N, 3) [m] and optional quaternions (N, 4) (x, y, z, w).")
-      .def_property_readonly("ids",
-                             [](const AnchorSurvey& s) {
-                               auto out = newIntArray(static_cast<Eigen::Index>(s.anchors.size()));
-                               auto o = out.mutable_unchecked<1>();
-                               for (std::size_t i = 0; i < s.anchors.size(); ++i) o(i) = s.anchors[i].id;
-                               return out;
-                             },
-                             "(N,) anchor ids, ascending")
-      .def_property_readonly("positions",
-                             [](const AnchorSurvey& s) {
-                               RowMat p(static_cast<Eigen::Index>(s.anchors.size()), 3);
-                               for (std::size_t i = 0; i < s.anchors.size(); ++i) p.row(i) = s.anchors[i].w_p;
-                               return toNumpy(p);
-                             },
+      .def_property_readonly("ids", &surveyIds, "(N,) anchor ids, ascending")
+      .def_property_readonly("positions", &surveyPositions,
                              "(N, 3) anchor positions in the world frame [m], in the order of ids")
-      .def_property_readonly("quaternions",
-                             [](const AnchorSurvey& s) {
-                               RowMat q(static_cast<Eigen::Index>(s.anchors.size()), 4);
-                               for (std::size_t i = 0; i < s.anchors.size(); ++i) {
-                                 const Quat& w_q = s.anchors[i].w_q;
-                                 q.row(i) << w_q.x(), w_q.y(), w_q.z(), w_q.w();
-                               }
-                               return toNumpy(q);
-                             },
-                             "(N, 4) anchor orientations (x, y, z, w)")
+      .def_property_readonly("quaternions", &surveyQuaternions, "(N, 4) anchor orientations (x, y, z, w)")
       .def_readwrite("source", &AnchorSurvey::source, "the file it was read from (named in messages)")
       .def("position", [](const AnchorSurvey& s, int id) { return toNumpy(s.position(id), true); }, py::arg("id"),
            "World position [m] of one anchor; KeyError when the id is absent.")
@@ -418,40 +422,61 @@ void bindIo(py::module_& m) {
       .def("__repr__", [](const AnchorSurvey& s) {
         return "<AnchorSurvey " + std::to_string(s.anchors.size()) + " anchors from '" + s.source + "'>";
       });
+}
 
-  py::class_<Flight>(m, "Flight",
-                     "A flight: every sensor stream as a dict of numpy arrays in SI units (see docs/python.md).\n"
-                     "Reading a stream property converts the whole stream at once; assigning a dict replaces it.")
-      .def(py::init([](const py::kwargs& streams) {
-             Flight f;
-             for (const auto& [key, value] : streams) setStream(f, py::str(key), py::cast<py::dict>(value));
-             return f;
-           }),
-           "Flight(tdoa={...}, acc={...}, ...): builds a flight from stream dicts.")
-      .def_property("tdoa", [](const Flight& f) { return tdoaDict(f.tdoa); },
-                    [](Flight& f, const py::dict& d) { setStream(f, "tdoa", d); },
-                    "dict: t [s], id_a, id_b (int32), tdoa [m] = |p_tag − a_idB| − |p_tag − a_idA|")
-      .def_property("twr", [](const Flight& f) { return twrDict(f.twr); },
-                    [](Flight& f, const py::dict& d) { setStream(f, "twr", d); }, "dict: t [s], anchor_id, range [m]")
-      .def_property("acc", [](const Flight& f) { return imuDict(f.acc); },
-                    [](Flight& f, const py::dict& d) { setStream(f, "acc", d); },
-                    "dict: t [s], value (N, 3) specific force [m/s², body]")
-      .def_property("gyro", [](const Flight& f) { return imuDict(f.gyro); },
-                    [](Flight& f, const py::dict& d) { setStream(f, "gyro", d); },
-                    "dict: t [s], value (N, 3) angular rate [rad/s, body]")
-      .def_property("tof", [](const Flight& f) { return scalarDict(f.tof); },
-                    [](Flight& f, const py::dict& d) { setStream(f, "tof", d); }, "dict: t [s], value [m]")
-      .def_property("flow", [](const Flight& f) { return flowDict(f.flow); },
-                    [](Flight& f, const py::dict& d) { setStream(f, "flow", d); },
-                    "dict: t [s], delta_x, delta_y [counts]")
-      .def_property("baro", [](const Flight& f) { return scalarDict(f.baro); },
-                    [](Flight& f, const py::dict& d) { setStream(f, "baro", d); },
-                    "dict: t [s], value [m above sea level]")
-      .def_property("pose", [](const Flight& f) { return poseDict(f.pose); },
-                    [](Flight& f, const py::dict& d) { setStream(f, "pose", d); },
-                    "dict: t [s], p (N, 3) [m, world], q (N, 4) body→world (x, y, z, w)")
-      .def_readwrite("pose_has_orientation", &Flight::pose_has_orientation,
-                     "the pose stream carries a quaternion (False: position only)")
+// ------------------------------------------------------------------------------------------ flights
+/// A stream of the flight as a read/write property: reading converts the whole stream to a dict (to_dict),
+/// assigning a dict replaces it (setStream).
+template <class Sample>
+void defStream(py::class_<Flight>& c, const char* name, std::vector<Sample> Flight::*stream,
+               py::dict (*to_dict)(const std::vector<Sample>&), const char* doc) {
+  c.def_property(
+      name, [stream, to_dict](const Flight& f) { return to_dict(f.*stream); },
+      [name](Flight& f, const py::dict& d) { setStream(f, name, d); }, doc);
+}
+
+std::string flightRepr(const Flight& f) {
+  std::string r = "<Flight '" + f.source + "'";
+  for (const auto& s : kStreams) {
+    if (!f.has(s.stream)) continue;
+    std::size_t n = 0;
+    switch (s.stream) {
+      case Stream::kTdoa: n = f.tdoa.size(); break;
+      case Stream::kTwr: n = f.twr.size(); break;
+      case Stream::kAcc: n = f.acc.size(); break;
+      case Stream::kGyro: n = f.gyro.size(); break;
+      case Stream::kTof: n = f.tof.size(); break;
+      case Stream::kFlow: n = f.flow.size(); break;
+      case Stream::kBaro: n = f.baro.size(); break;
+      case Stream::kPose: n = f.pose.size(); break;
+    }
+    r += std::string(" ") + s.name + "=" + std::to_string(n);
+  }
+  const auto [t0, t1] = f.timeSpan();
+  return r + " t=[" + std::to_string(t0) + ", " + std::to_string(t1) + "] s>";
+}
+
+void bindFlight(py::module_& m) {
+  py::class_<Flight> c(m, "Flight",
+                       "A flight: every sensor stream as a dict of numpy arrays in SI units (see docs/python.md).\n"
+                       "Reading a stream property converts the whole stream at once; assigning a dict replaces it.");
+  c.def(py::init([](const py::kwargs& streams) {
+          Flight f;
+          for (const auto& [key, value] : streams) setStream(f, py::str(key), py::cast<py::dict>(value));
+          return f;
+        }),
+        "Flight(tdoa={...}, acc={...}, ...): builds a flight from stream dicts.");
+  defStream(c, "tdoa", &Flight::tdoa, &tdoaDict,
+            "dict: t [s], id_a, id_b (int32), tdoa [m] = |p_tag − a_idB| − |p_tag − a_idA|");
+  defStream(c, "twr", &Flight::twr, &twrDict, "dict: t [s], anchor_id, range [m]");
+  defStream(c, "acc", &Flight::acc, &imuDict, "dict: t [s], value (N, 3) specific force [m/s², body]");
+  defStream(c, "gyro", &Flight::gyro, &imuDict, "dict: t [s], value (N, 3) angular rate [rad/s, body]");
+  defStream(c, "tof", &Flight::tof, &scalarDict, "dict: t [s], value [m]");
+  defStream(c, "flow", &Flight::flow, &flowDict, "dict: t [s], delta_x, delta_y [counts]");
+  defStream(c, "baro", &Flight::baro, &scalarDict, "dict: t [s], value [m above sea level]");
+  defStream(c, "pose", &Flight::pose, &poseDict, "dict: t [s], p (N, 3) [m, world], q (N, 4) body→world (x, y, z, w)");
+  c.def_readwrite("pose_has_orientation", &Flight::pose_has_orientation,
+                  "the pose stream carries a quaternion (False: position only)")
       .def_readwrite("columns", &Flight::columns, "header columns of the source file (the writer reproduces them)")
       .def_readwrite("source", &Flight::source, "the file it was read from (named in messages)")
       .def("streams", &allStreams, "All non-empty streams: {name: stream dict}.")
@@ -470,27 +495,48 @@ void bindIo(py::module_& m) {
           py::arg("t0"), py::arg("t1"),
           "The flight between the stamps t0 and t1 [s], every stream cut there (stamps kept): the log as a recording "
           "started at t0, e.g. in the air, and stopped at t1 would hold it (`uwbtdoa localize --window`).")
-      .def("__repr__", [](const Flight& f) {
-        std::string r = "<Flight '" + f.source + "'";
-        for (const auto& s : kStreams) {
-          if (!f.has(s.stream)) continue;
-          std::size_t n = 0;
-          switch (s.stream) {
-            case Stream::kTdoa: n = f.tdoa.size(); break;
-            case Stream::kTwr: n = f.twr.size(); break;
-            case Stream::kAcc: n = f.acc.size(); break;
-            case Stream::kGyro: n = f.gyro.size(); break;
-            case Stream::kTof: n = f.tof.size(); break;
-            case Stream::kFlow: n = f.flow.size(); break;
-            case Stream::kBaro: n = f.baro.size(); break;
-            case Stream::kPose: n = f.pose.size(); break;
-          }
-          r += std::string(" ") + s.name + "=" + std::to_string(n);
-        }
-        const auto [t0, t1] = f.timeSpan();
-        return r + " t=[" + std::to_string(t0) + ", " + std::to_string(t1) + "] s>";
-      });
+      .def("__repr__", &flightRepr);
+}
 
+// ------------------------------------------------------------------------------------- ground truth
+py::dict interpolateTrack(const PoseTrack& track, const py::handle& t) {
+  const RowMat ts = toMatrix(t, 0, "t");
+  const Eigen::Index n = ts.rows();
+  RowMat p = RowMat::Constant(n, 3, std::numeric_limits<double>::quiet_NaN());
+  RowMat q = RowMat::Constant(n, 4, std::numeric_limits<double>::quiet_NaN());
+  py::array_t<bool> valid(static_cast<py::ssize_t>(n));
+  auto mv = valid.mutable_unchecked<1>();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto s = track.interpolate(ts(i, 0));
+    mv(i) = s.has_value();
+    if (!s) continue;
+    p.row(i) = s->w_p_b.transpose();
+    q.row(i) << s->w_q_b.x(), s->w_q_b.y(), s->w_q_b.z(), s->w_q_b.w();
+  }
+  py::dict d;
+  d["t"] = toNumpy(ts.col(0), true), d["p"] = toNumpy(p), d["q"] = toNumpy(q), d["valid"] = valid;
+  return d;
+}
+
+py::dict trackGlitches(const PoseTrack& t) {
+  const auto& g = t.glitches();
+  const auto n = static_cast<Eigen::Index>(g.size());
+  py::array_t<std::int64_t> index(static_cast<py::ssize_t>(n));
+  std::vector<std::string> kind;
+  RowMat x(n, 2);
+  auto mi = index.mutable_unchecked<1>();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    mi(i) = static_cast<std::int64_t>(g[i].index);
+    x.row(i) << g[i].t_s, g[i].magnitude;
+    kind.push_back(g[i].kind == PoseGlitchKind::kAttitude ? "attitude" : "position");
+  }
+  py::dict d;
+  d["index"] = index, d["t"] = toNumpy(x.col(0), true);
+  d["magnitude"] = toNumpy(x.col(1), true), d["kind"] = kind;
+  return d;
+}
+
+void bindPoseTrack(py::module_& m) {
   py::class_<PoseTrack>(m, "PoseTrack",
                         "Ground truth as a function of time: the flight's pose samples minus detected glitches;\n"
                         "linear position / slerp attitude interpolation.")
@@ -498,102 +544,102 @@ void bindIo(py::module_& m) {
            py::arg("flight"), py::arg("params") = py::dict(),
            "params: overrides of PoseTrackParams (max_gap_s, max_attitude_jump_rad, max_angular_rate_radps,\n"
            "max_glitch_run_s, max_position_jump_m).")
-      .def(
-          "interpolate",
-          [](const PoseTrack& track, const py::handle& t) {
-            const RowMat ts = toMatrix(t, 0, "t");
-            const Eigen::Index n = ts.rows();
-            RowMat p = RowMat::Constant(n, 3, std::numeric_limits<double>::quiet_NaN());
-            RowMat q = RowMat::Constant(n, 4, std::numeric_limits<double>::quiet_NaN());
-            py::array_t<bool> valid(static_cast<py::ssize_t>(n));
-            auto mv = valid.mutable_unchecked<1>();
-            for (Eigen::Index i = 0; i < n; ++i) {
-              const auto s = track.interpolate(ts(i, 0));
-              mv(i) = s.has_value();
-              if (!s) continue;
-              p.row(i) = s->w_p_b.transpose();
-              q.row(i) << s->w_q_b.x(), s->w_q_b.y(), s->w_q_b.z(), s->w_q_b.w();
-            }
-            py::dict d;
-            d["t"] = toNumpy(ts.col(0), true), d["p"] = toNumpy(p), d["q"] = toNumpy(q), d["valid"] = valid;
-            return d;
-          },
-          py::arg("t"),
-          "Pose at times t (N,): {t, p (N, 3), q (N, 4), valid (N,) bool}; NaN where there is no ground truth.")
+      .def("interpolate", &interpolateTrack, py::arg("t"),
+           "Pose at times t (N,): {t, p (N, 3), q (N, 4), valid (N,) bool}; NaN where there is no ground truth.")
       .def_property_readonly("samples", [](const PoseTrack& t) { return poseDict(t.samples()); },
                              "accepted samples {t, p, q}")
-      .def_property_readonly("glitches",
-                             [](const PoseTrack& t) {
-                               const auto& g = t.glitches();
-                               const auto n = static_cast<Eigen::Index>(g.size());
-                               py::array_t<std::int64_t> index(static_cast<py::ssize_t>(n));
-                               std::vector<std::string> kind;
-                               RowMat x(n, 2);
-                               auto mi = index.mutable_unchecked<1>();
-                               for (Eigen::Index i = 0; i < n; ++i) {
-                                 mi(i) = static_cast<std::int64_t>(g[i].index);
-                                 x.row(i) << g[i].t_s, g[i].magnitude;
-                                 kind.push_back(g[i].kind == PoseGlitchKind::kAttitude ? "attitude" : "position");
-                               }
-                               py::dict d;
-                               d["index"] = index, d["t"] = toNumpy(x.col(0), true);
-                               d["magnitude"] = toNumpy(x.col(1), true), d["kind"] = kind;
-                               return d;
-                             },
+      .def_property_readonly("glitches", &trackGlitches,
                              "rejected samples {index, t, kind ('attitude'|'position'), magnitude}")
       .def_property_readonly("start_time", &PoseTrack::startTime, "first pose time [s]")
       .def_property_readonly("end_time", &PoseTrack::endTime, "last pose time [s]")
       .def_property_readonly("has_orientation", &PoseTrack::hasOrientation, "the track carries attitudes")
       .def("__len__", [](const PoseTrack& t) { return t.samples().size(); });
+}
 
-  m.def(
-      "tdoa_residuals",
-      [](const Flight& flight, const AnchorSurvey& survey, const PoseTrack* track, const py::object& b_t_tag,
-         double airborne_min_z_m) {
-        TdoaResidualParams params;
-        if (!b_t_tag.is_none()) params.b_t_tag = row3(toMatrix(b_t_tag, 3, "b_t_tag"), 0);
-        params.airborne_min_z_m = airborne_min_z_m;
-        TdoaResidualReport report;
-        std::vector<TdoaResidual> r;
-        {
-          py::gil_scoped_release release;
-          const PoseTrack own = track ? PoseTrack() : PoseTrack(flight);
-          r = tdoaResiduals(flight, survey, track ? *track : own, params, &report);
+py::dict residuals(const Flight& flight, const AnchorSurvey& survey, const PoseTrack* track, const py::object& b_t_tag,
+                   double airborne_min_z_m) {
+  TdoaResidualParams params;
+  if (!b_t_tag.is_none()) params.b_t_tag = row3(toMatrix(b_t_tag, 3, "b_t_tag"), 0);
+  params.airborne_min_z_m = airborne_min_z_m;
+  TdoaResidualReport report;
+  std::vector<TdoaResidual> r;
+  {
+    py::gil_scoped_release release;
+    const PoseTrack own = track ? PoseTrack() : PoseTrack(flight);
+    r = tdoaResiduals(flight, survey, track ? *track : own, params, &report);
+  }
+  py::dict d = residualArrays(r);
+  py::dict rep;
+  rep["n_measurements"] = report.n_measurements, rep["n_residuals"] = report.n_residuals;
+  rep["n_no_ground_truth"] = report.n_no_ground_truth, rep["n_unknown_anchor"] = report.n_unknown_anchor;
+  d["report"] = rep;
+  return d;
+}
+
+std::vector<std::string> surveyWarnings(const AnchorSurvey& survey, const Flight* flight, const py::object& positions) {
+  std::vector<Vec3> p;
+  if (!positions.is_none()) {
+    const RowMat rows = toMatrix(positions, 3, "positions");
+    for (Eigen::Index i = 0; i < rows.rows(); ++i) p.push_back(rows.row(i).transpose());
+  } else if (flight) {
+    for (const PoseSample& s : flight->pose) p.push_back(s.w_p_b);
+  }
+  const std::vector<InputIssue> issues =
+      checkSurvey(survey, flight, p, !positions.is_none() ? "positions" : flight ? flight->source : "");
+  throwOnError(issues);
+  std::vector<std::string> out;
+  for (const InputIssue& i : issues) out.push_back(i.text());
+  return out;
+}
+
+void bindChecks(py::module_& m) {
+  m.def("tdoa_residuals", &residuals, py::arg("flight"), py::arg("survey"), py::arg("track") = nullptr,
+        py::arg("b_t_tag") = py::none(), py::arg("airborne_min_z_m") = 0.3,
+        "TDoA residual r = measured − h(p_gt) of every measurement with ground truth (paper eq. 6, the GP target).\n"
+        "track defaults to PoseTrack(flight). Returns arrays {index (into flight.tdoa), t, id_a, id_b, measured,\n"
+        "predicted, residual, w_p_b (N, 3), w_q_b (N, 4), airborne} and report {n_measurements, n_residuals,\n"
+        "n_no_ground_truth, n_unknown_anchor}.");
+}
+
+// --------------------------------------------------------------------------------------------- files
+py::object readFlight(const std::string& path, const std::vector<std::string>& required, const AnchorSurvey* survey,
+                      bool with_report) {
+  FlightReadOptions options;
+  for (const auto& name : required) options.required.push_back(streamFromName(name));
+  options.survey = survey;
+  return flightWithReport<ReadReport>(
+      with_report, [&](ReadReport& report) { return readFlightCsv(path, options, &report); },
+      [](const ReadReport& report) {
+        py::dict r;
+        r["n_rows"] = report.n_rows, r["n_bytes"] = report.n_bytes, r["notes"] = report.notes;
+        return r;
+      });
+}
+
+py::object importUsd(const std::string& path, bool salvage, bool with_report) {
+  UsdReadOptions options;
+  options.salvage = salvage;
+  return flightWithReport<UsdImportReport>(
+      with_report, [&](UsdImportReport& report) { return importUsdLog(path, options, &report); },
+      [](const UsdImportReport& report) {
+        py::list sources;
+        for (const auto& s : report.sources) {
+          py::dict d;
+          d["stream"] = streamName(s.stream), d["event"] = s.event, d["fields"] = s.fields, d["count"] = s.count;
+          sources.append(d);
         }
-        py::dict d = residualArrays(r);
-        py::dict rep;
-        rep["n_measurements"] = report.n_measurements, rep["n_residuals"] = report.n_residuals;
-        rep["n_no_ground_truth"] = report.n_no_ground_truth, rep["n_unknown_anchor"] = report.n_unknown_anchor;
-        d["report"] = rep;
-        return d;
-      },
-      py::arg("flight"), py::arg("survey"), py::arg("track") = nullptr, py::arg("b_t_tag") = py::none(),
-      py::arg("airborne_min_z_m") = 0.3,
-      "TDoA residual r = measured − h(p_gt) of every measurement with ground truth (paper eq. 6, the GP target).\n"
-      "track defaults to PoseTrack(flight). Returns arrays {index (into flight.tdoa), t, id_a, id_b, measured,\n"
-      "predicted, residual, w_p_b (N, 3), w_q_b (N, 4), airborne} and report {n_measurements, n_residuals,\n"
-      "n_no_ground_truth, n_unknown_anchor}.");
+        py::dict r;
+        r["sources"] = sources, r["notes"] = report.notes, r["t0_us"] = report.t0_us;
+        return r;
+      });
+}
 
-  m.def(
-      "read_flight_csv",
-      [](const std::string& path, const std::vector<std::string>& required, const AnchorSurvey* survey,
-         bool with_report) -> py::object {
-        FlightReadOptions options;
-        for (const auto& name : required) options.required.push_back(streamFromName(name));
-        options.survey = survey;
-        return flightWithReport<ReadReport>(
-            with_report, [&](ReadReport& report) { return readFlightCsv(path, options, &report); },
-            [](const ReadReport& report) {
-              py::dict r;
-              r["n_rows"] = report.n_rows, r["n_bytes"] = report.n_bytes, r["notes"] = report.notes;
-              return r;
-            });
-      },
-      py::arg("path"), py::arg("required") = std::vector<std::string>{}, py::arg("survey") = nullptr,
-      py::arg("with_report") = false,
-      "Reads a UTIL flight CSV (SI units in memory). required: stream names that must be present; survey: every\n"
-      "anchor id must be surveyed. with_report=True returns (flight, {n_rows, n_bytes, notes}).\n"
-      "ValueError 'file:line:column (field): ...' on bad data, OSError when the file cannot be read.");
+void bindFlightFiles(py::module_& m) {
+  m.def("read_flight_csv", &readFlight, py::arg("path"), py::arg("required") = std::vector<std::string>{},
+        py::arg("survey") = nullptr, py::arg("with_report") = false,
+        "Reads a UTIL flight CSV (SI units in memory). required: stream names that must be present; survey: every\n"
+        "anchor id must be surveyed. with_report=True returns (flight, {n_rows, n_bytes, notes}).\n"
+        "ValueError 'file:line:column (field): ...' on bad data, OSError when the file cannot be read.");
   m.def(
       "write_flight_csv",
       [](const Flight& f, const std::string& path) {
@@ -601,30 +647,11 @@ void bindIo(py::module_& m) {
         writeFlightCsv(f, path);
       },
       py::arg("flight"), py::arg("path"), "Writes a flight in the UTIL layout (read_flight_csv reads it back exactly).");
-  m.def(
-      "import_usd_log",
-      [](const std::string& path, bool salvage, bool with_report) -> py::object {
-        UsdReadOptions options;
-        options.salvage = salvage;
-        return flightWithReport<UsdImportReport>(
-            with_report, [&](UsdImportReport& report) { return importUsdLog(path, options, &report); },
-            [](const UsdImportReport& report) {
-              py::list sources;
-              for (const auto& s : report.sources) {
-                py::dict d;
-                d["stream"] = streamName(s.stream), d["event"] = s.event, d["fields"] = s.fields, d["count"] = s.count;
-                sources.append(d);
-              }
-              py::dict r;
-              r["sources"] = sources, r["notes"] = report.notes, r["t0_us"] = report.t0_us;
-              return r;
-            });
-      },
-      py::arg("path"), py::arg("salvage") = false, py::arg("with_report") = false,
-      "Imports a Crazyflie uSD-card event log (cfusdlog, versions 1 and 2) as a flight, with UTIL's event-type\n"
-      "mapping and units (docs/io.md section 6). salvage=True reads a log whose writing was cut (no valid CRC).\n"
-      "with_report=True returns (flight, {sources: [{stream, event, fields, count}], notes, t0_us}).\n"
-      "ValueError 'file: byte B, event K (type.field): ...' on bad data, OSError when the file cannot be read.");
+  m.def("import_usd_log", &importUsd, py::arg("path"), py::arg("salvage") = false, py::arg("with_report") = false,
+        "Imports a Crazyflie uSD-card event log (cfusdlog, versions 1 and 2) as a flight, with UTIL's event-type\n"
+        "mapping and units (docs/io.md section 6). salvage=True reads a log whose writing was cut (no valid CRC).\n"
+        "with_report=True returns (flight, {sources: [{stream, event, fields, count}], notes, t0_us}).\n"
+        "ValueError 'file: byte B, event K (type.field): ...' on bad data, OSError when the file cannot be read.");
   m.def(
       "write_usd_log",
       [](const Flight& f, const std::string& path) {
@@ -634,6 +661,9 @@ void bindIo(py::module_& m) {
       py::arg("flight"), py::arg("path"),
       "Writes a flight as the events UTIL recorded (cfusdlog version 2, float32 values in the file units);\n"
       "import_usd_log reads it back within float32 precision.");
+}
+
+void bindTrajectoryFiles(py::module_& m) {
   m.def(
       "read_trajectory_csv", [](const std::string& path) { return trajectoryToDict(readTrajectoryCsv(path)); },
       py::arg("path"),
@@ -650,34 +680,33 @@ void bindIo(py::module_& m) {
       py::arg("trajectory"), py::arg("path"),
       "Writes the poses of a trajectory dict {t, p, q} as TUM text (timestamp tx ty tz qx qy qz qw, space-\n"
       "separated, shortest round-trip numbers): the format evo and the SLAM trajectory tools read.");
+}
+
+void bindSurveyFiles(py::module_& m) {
   m.def(
       "read_cfclient_anchors", &readCfclientAnchors, py::arg("path"),
       "Reads the anchor positions the Crazyflie client's Loco Positioning tab saves (YAML: one {x, y, z} per\n"
       "anchor id) as an AnchorSurvey (`uwbtdoa survey`, docs/crazyflie.md).");
-  m.def(
-      "check_survey",
-      [](const AnchorSurvey& survey, const Flight* flight, const py::object& positions) {
-        std::vector<Vec3> p;
-        if (!positions.is_none()) {
-          const RowMat rows = toMatrix(positions, 3, "positions");
-          for (Eigen::Index i = 0; i < rows.rows(); ++i) p.push_back(rows.row(i).transpose());
-        } else if (flight) {
-          for (const PoseSample& s : flight->pose) p.push_back(s.w_p_b);
-        }
-        const std::vector<InputIssue> issues =
-            checkSurvey(survey, flight, p, !positions.is_none() ? "positions" : flight ? flight->source : "");
-        throwOnError(issues);
-        std::vector<std::string> out;
-        for (const InputIssue& i : issues) out.push_back(i.text());
-        return out;
-      },
-      py::arg("survey"), py::arg("flight") = nullptr, py::arg("positions") = py::none(),
-      "The checks of `uwbtdoa survey` as a list of warnings with their numbers: colocated anchors, anchors in one\n"
-      "plane, ids of the flight's TDoA missing from the survey, positions (N, 3) (default: the flight's motion\n"
-      "capture) outside the anchors' box. ValueError for a survey no position can be computed from.");
+  m.def("check_survey", &surveyWarnings, py::arg("survey"), py::arg("flight") = nullptr,
+        py::arg("positions") = py::none(),
+        "The checks of `uwbtdoa survey` as a list of warnings with their numbers: colocated anchors, anchors in one\n"
+        "plane, ids of the flight's TDoA missing from the survey, positions (N, 3) (default: the flight's motion\n"
+        "capture) outside the anchors' box. ValueError for a survey no position can be computed from.");
   m.def("read_anchor_survey", &readAnchorSurvey, py::arg("path"), "Reads a UTIL anchor survey text file.");
   m.def("write_anchor_survey", &writeAnchorSurvey, py::arg("survey"), py::arg("path"),
         "Writes a survey that read_anchor_survey reads back exactly.");
+}
+
+}  // namespace
+
+void bindIo(py::module_& m) {
+  bindAnchorSurvey(m);
+  bindFlight(m);
+  bindPoseTrack(m);
+  bindChecks(m);
+  bindFlightFiles(m);
+  bindTrajectoryFiles(m);
+  bindSurveyFiles(m);
 }
 
 }  // namespace uwb::python

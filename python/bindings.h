@@ -32,16 +32,24 @@ using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowM
 using DArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using IArray = py::array_t<int, py::array::c_style | py::array::forcecast>;
 
+/// obj as an Array (array_t, converted from any array-like); std::invalid_argument "NAME: expected WHAT" when it
+/// cannot be converted.
+template <class Array>
+Array ensureArray(const py::handle& obj, const char* name, const char* what) {
+  Array a;
+  try {
+    a = Array::ensure(obj);
+  } catch (const py::error_already_set&) {
+    throw std::invalid_argument(std::string(name) + ": expected " + what);
+  }
+  if (!a) throw std::invalid_argument(std::string(name) + ": expected " + what);
+  return a;
+}
+
 /// Converts any array-like to float64 and checks its shape: (N, cols), or (cols,) which is read as one row
 /// (when allow_row is true). cols == 0 means a 1-D array (N,). Throws std::invalid_argument (→ ValueError).
 inline RowMat toMatrix(const py::handle& obj, py::ssize_t cols, const char* name, bool allow_row = true) {
-  DArray a;
-  try {
-    a = DArray::ensure(obj);
-  } catch (const py::error_already_set&) {
-    throw std::invalid_argument(std::string(name) + ": expected a numeric array");
-  }
-  if (!a) throw std::invalid_argument(std::string(name) + ": expected a numeric array");
+  const DArray a = ensureArray<DArray>(obj, name, "a numeric array");
   if (cols == 0) {
     if (a.ndim() == 0) {
       RowMat m(1, 1);
@@ -67,13 +75,7 @@ inline RowMat toMatrix(const py::handle& obj, py::ssize_t cols, const char* name
 
 /// 1-D int array.
 inline Eigen::VectorXi toIntVector(const py::handle& obj, const char* name) {
-  IArray a;
-  try {
-    a = IArray::ensure(obj);
-  } catch (const py::error_already_set&) {
-    throw std::invalid_argument(std::string(name) + ": expected an integer array");
-  }
-  if (!a) throw std::invalid_argument(std::string(name) + ": expected an integer array");
+  const IArray a = ensureArray<IArray>(obj, name, "an integer array");
   if (a.ndim() == 0) return Eigen::VectorXi::Constant(1, *a.data());
   if (a.ndim() != 1) throw std::invalid_argument(std::string(name) + ": expected a 1-D integer array");
   return Eigen::Map<const Eigen::VectorXi>(a.data(), a.shape(0));

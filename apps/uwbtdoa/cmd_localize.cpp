@@ -110,78 +110,112 @@ void requireFiniteEstimates(const uwb::Trajectory& trajectory, const std::string
 /// Largest --output-period [s]: one sample a minute still draws a trajectory.
 constexpr double kMaxOutputPeriod_s = 60.0;
 
-void runLocalize(const LocalizeArgs& a) {
-  uwb::app::Warnings warnings;
-  // Outputs first: a run of minutes must not end in "cannot write".
+/// What the run reads: the filter parameters and bias model, the survey and the flight (windowed).
+struct LocalizeInputs {
+  uwb::EkfParams params;
+  bool process_model_given = false, start_flag = false;
+  uwb::BiasPredictor bias;
+  uwb::AnchorSurvey survey;
+  uwb::ReadReport read_report;
+  uwb::Flight flight;
+  bool use_imu = false;  ///< the IMU process model was asked for (or is the default) and --tdoa-only is off
+};
+
+/// Outputs first: a run of minutes must not end in "cannot write".
+void checkOutputs(const LocalizeArgs& a) {
   const std::vector<std::string> inputs{a.flight, a.anchors, a.filter.config, a.filter.bias_model};
   if (!a.out.empty()) uwb::checkOutputFile(a.out, "trajectory file", inputs);
   if (!a.plot.empty()) uwb::checkOutputFile(a.plot, "plot file", inputs);
   uwb::app::checkPeriod(a.output_period, "--output-period", kMaxOutputPeriod_s);
-  uwb::app::FilterSetup setup = uwb::app::buildFilterParams(a.filter);
-  uwb::EkfParams& params = setup.params;
-  const bool process_model_given = setup.process_model_given, start_flag = setup.start_flag;
-  if (a.no_ground_detect) params.ground_phase = uwb::GroundPhase::kNone;
-  params.validate();
-  const uwb::BiasPredictor bias = uwb::app::loadBiasPredictor(a.filter, &params);
+}
 
-  const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(a.anchors);
-  warnings.addIssues(uwb::checkSurveyGeometry(survey));
-  if (params.has_start_position)
-    uwb::app::checkNearAnchors(params.start_w_p_b, survey, start_flag ? "--start" : a.filter.config + " (start_w_p_b)");
+/// Stream-rate issues of the flight; an IMU that the run ignores only warrants a warning.
+void checkRates(const uwb::Flight& flight, bool use_imu, uwb::app::Warnings& warnings) {
+  std::vector<uwb::InputIssue> issues = uwb::checkStreamRates(flight);
+  for (uwb::InputIssue& i : issues) {
+    const bool imu_field = i.where.field == "t_acc" || i.where.field == "t_gyro";
+    if (imu_field && !use_imu) i.severity = uwb::IssueSeverity::kWarning;
+  }
+  warnings.addIssues(issues);
+}
+
+LocalizeInputs loadInputs(const LocalizeArgs& a, uwb::app::Warnings& warnings) {
+  LocalizeInputs in;
+  uwb::app::FilterSetup setup = uwb::app::buildFilterParams(a.filter);
+  in.params = setup.params;
+  in.process_model_given = setup.process_model_given;
+  in.start_flag = setup.start_flag;
+  if (a.no_ground_detect) in.params.ground_phase = uwb::GroundPhase::kNone;
+  in.params.validate();
+  in.bias = uwb::app::loadBiasPredictor(a.filter, &in.params);
+
+  in.survey = uwb::readAnchorSurvey(a.anchors);
+  warnings.addIssues(uwb::checkSurveyGeometry(in.survey));
+  if (in.params.has_start_position)
+    uwb::app::checkNearAnchors(in.params.start_w_p_b, in.survey,
+                               in.start_flag ? "--start" : a.filter.config + " (start_w_p_b)");
   uwb::FlightReadOptions read_opt;
   read_opt.required = {uwb::Stream::kTdoa};
-  read_opt.survey = &survey;
-  uwb::ReadReport read_report;
-  const uwb::Flight flight = windowed(uwb::readFlightCsv(a.flight, read_opt, &read_report), a.window, a.flight);
-  const bool use_imu = params.process_model == uwb::ProcessModel::kImu && !a.tdoa_only;
-  if (use_imu && process_model_given && !flight.hasImu()) {
+  read_opt.survey = &in.survey;
+  in.flight = windowed(uwb::readFlightCsv(a.flight, read_opt, &in.read_report), a.window, a.flight);
+  in.use_imu = in.params.process_model == uwb::ProcessModel::kImu && !a.tdoa_only;
+  if (in.use_imu && in.process_model_given && !in.flight.hasImu()) {
     throw uwb::InputError(uwb::SourceLocation{a.flight, 1, 0, "t_acc"},
                           "process model 'imu' was asked for but the flight has no IMU streams (acc and gyro); use "
                           "--process-model cv or ca, or leave it out for the TDoA-only default");
   }
-  {
-    std::vector<uwb::InputIssue> issues = uwb::checkStreamRates(flight);
-    for (uwb::InputIssue& i : issues) {  // an IMU that the run ignores only warrants a warning
-      const bool imu_field = i.where.field == "t_acc" || i.where.field == "t_gyro";
-      if (imu_field && !use_imu) i.severity = uwb::IssueSeverity::kWarning;
-    }
-    warnings.addIssues(issues);
-  }
+  checkRates(in.flight, in.use_imu, warnings);
+  return in;
+}
 
+/// The run reported (with --fix-survey, that of the corrected survey), its checks and its timing.
+struct LocalizeResult {
+  uwb::LocalizationRun run;
+  std::optional<uwb::RunDiagnostics> diag;
+  std::vector<std::string> notes;  ///< expected behaviour worth stating (warnings are for doubtful input)
+  double cpu_s = 0.0, wall_s = 0.0;
+  double rmse_before_fix = std::numeric_limits<double>::quiet_NaN();  ///< --fix-survey: airborne RMSE before it
+};
+
+LocalizeResult runFilter(const LocalizeArgs& a, const LocalizeInputs& in, uwb::app::Warnings& warnings) {
   uwb::LocalizationOptions opt;
-  opt.params = params;
+  opt.params = in.params;
   opt.output_period_s = a.output_period;
   opt.tdoa_only = a.tdoa_only;
+  LocalizeResult res;
   const auto t0 = std::chrono::steady_clock::now();
   const std::clock_t c0 = std::clock();  // process CPU time: the filter runs on one thread
-  uwb::LocalizationRun run = uwb::localizeFlight(flight, survey, opt, bias);
-  const double cpu_s = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
-  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  requirePositionFound(run, flight, survey, a.flight);  // before the checks below, which need an estimate
-  requireFiniteEstimates(run.trajectory, a.flight);
+  res.run = uwb::localizeFlight(in.flight, in.survey, opt, in.bias);
+  res.cpu_s = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  requirePositionFound(res.run, in.flight, in.survey, a.flight);  // before the checks below, which need an estimate
+  requireFiniteEstimates(res.run.trajectory, a.flight);
   // the "wrong but plausible" checks: survey fit, one anchor mis-surveyed, TDoA/IMU clock offset (re-runs)
-  std::optional<uwb::RunDiagnostics> diag;
   std::optional<uwb::LocalizationRun> fixed_run;
   if (!a.no_diagnostics) {
-    diag = uwb::diagnoseRun(flight, survey, opt, run, bias);
-    for (const std::string& w : diag->warnings()) warnings.add(w);
-    if (a.fix_survey && diag->anchors.named_id >= 0)
-      fixed_run = uwb::localizeFlight(flight, uwb::correctedSurvey(survey, diag->anchors), opt, bias);
+    res.diag = uwb::diagnoseRun(in.flight, in.survey, opt, res.run, in.bias);
+    for (const std::string& w : res.diag->warnings()) warnings.add(w);
+    if (a.fix_survey && res.diag->anchors.named_id >= 0)
+      fixed_run = uwb::localizeFlight(in.flight, uwb::correctedSurvey(in.survey, res.diag->anchors), opt, in.bias);
   }
-  std::vector<std::string> notes;  // expected behaviour worth stating (warnings are for doubtful input)
-  if (use_imu && !flight.hasImu() && run.summary.process_model != uwb::ProcessModel::kImu) {
-    notes.push_back(std::string("the flight has no IMU: the TDoA-only '") + uwb::toString(run.summary.process_model) +
-                    "' model ran (the default without IMU)");
+  if (in.use_imu && !in.flight.hasImu() && res.run.summary.process_model != uwb::ProcessModel::kImu) {
+    res.notes.push_back(std::string("the flight has no IMU: the TDoA-only '") +
+                        uwb::toString(res.run.summary.process_model) + "' model ran (the default without IMU)");
   }
-
-  double rmse_before_fix = std::numeric_limits<double>::quiet_NaN();
   if (fixed_run) {
-    if (run.metrics && run.metrics->airborne.n) rmse_before_fix = run.metrics->airborne.rmse_m;
-    run = std::move(*fixed_run);
+    if (res.run.metrics && res.run.metrics->airborne.n) res.rmse_before_fix = res.run.metrics->airborne.rmse_m;
+    res.run = std::move(*fixed_run);
   }
-  requireFiniteEstimates(run.trajectory, a.flight);  // also the re-run of --fix-survey
-  const uwb::LocalizerSummary& s = run.summary;
-  const double nan = std::numeric_limits<double>::quiet_NaN();
+  requireFiniteEstimates(res.run.trajectory, a.flight);  // also the re-run of --fix-survey
+  if (res.diag && a.fix_survey && res.diag->anchors.named_id >= 0) {
+    res.notes.push_back("--fix-survey: anchor " + std::to_string(res.diag->anchors.named_id) +
+                        " moved by its fitted offset; the results are those of the corrected survey");
+  }
+  return res;
+}
+
+/// Warnings from the run's summary: position lost and found again, sensor-time jumps, values out of range.
+void addSummaryWarnings(const uwb::LocalizerSummary& s, uwb::app::Warnings& warnings) {
   // the estimate lost the TDoA or diverged and was found again (docs/math/filter.md F16): the positions around
   // these times are not to be trusted
   for (std::size_t k = 0; k < s.reacquisition_t_s.size(); ++k) {
@@ -198,29 +232,33 @@ void runLocalize(const LocalizeArgs& a) {
     warnings.add(std::to_string(s.n_time_jumps) + " sensor-time gap(s) or backward jump(s): the IMU was not integrated "
                  "across them");
   for (const std::string& w : uwb::sensorRangeWarnings(s.sensor_range)) warnings.add(w);  // (F31)
-  json j = uwb::localizerSummaryJson(s, params);  // eval/LocalizationJson.h, shared with Python
+}
+
+json localizeJson(const LocalizeArgs& a, const LocalizeInputs& in, const LocalizeResult& res,
+                  const uwb::app::Warnings& warnings) {
+  const uwb::LocalizationRun& run = res.run;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  json j = uwb::localizerSummaryJson(run.summary, in.params);  // eval/LocalizationJson.h, shared with Python
   j["flight"] = a.flight;
   j["window_s"] = a.window.empty() ? json(nullptr) : json(a.window);
   j["duration_s"] = run.duration_s;
   j["bias_model"] = a.filter.bias_model.empty() ? json(nullptr) : json(a.filter.bias_model);
-  j["diagnostics"] = diag ? uwb::runDiagnosticsJson(*diag) : json(nullptr);
-  if (diag && a.fix_survey && diag->anchors.named_id >= 0) {
+  j["diagnostics"] = res.diag ? uwb::runDiagnosticsJson(*res.diag) : json(nullptr);
+  if (res.diag && a.fix_survey && res.diag->anchors.named_id >= 0) {
     // the estimate with the named anchor moved by its fitted offset: the trajectory written and the RMSE below
-    const uwb::Vec3& offset = diag->anchors.named_offset_m;
-    j["fixed_survey"] = {{"anchor", diag->anchors.named_id},
+    const uwb::Vec3& offset = res.diag->anchors.named_offset_m;
+    j["fixed_survey"] = {{"anchor", res.diag->anchors.named_id},
                          {"offset_m", {offset.x(), offset.y(), offset.z()}},
                          {"rmse_airborne_before_m",
-                          std::isfinite(rmse_before_fix) ? json(rmse_before_fix) : json(nullptr)}};
-    notes.push_back("--fix-survey: anchor " + std::to_string(diag->anchors.named_id) +
-                    " moved by its fitted offset; the results are those of the corrected survey");
+                          std::isfinite(res.rmse_before_fix) ? json(res.rmse_before_fix) : json(nullptr)}};
   }
-  j["read_notes"] = read_report.notes;
+  j["read_notes"] = in.read_report.notes;
   j["warnings"] = warnings.list();
-  j["notes"] = notes;
-  j["wall_time_s"] = wall_s;
-  j["real_time_factor"] = wall_s > 0 ? run.duration_s / wall_s : nan;  // wall clock: slower on a loaded machine
-  j["cpu_time_s"] = cpu_s;
-  j["real_time_factor_cpu"] = cpu_s > 0 ? run.duration_s / cpu_s : nan;
+  j["notes"] = res.notes;
+  j["wall_time_s"] = res.wall_s;
+  j["real_time_factor"] = res.wall_s > 0 ? run.duration_s / res.wall_s : nan;  // wall clock: slower on a loaded machine
+  j["cpu_time_s"] = res.cpu_s;
+  j["real_time_factor_cpu"] = res.cpu_s > 0 ? run.duration_s / res.cpu_s : nan;
   if (run.metrics) {
     const uwb::TrajectoryMetrics& m = *run.metrics;
     j["rmse_m"] = m.whole.n ? json(m.whole.rmse_m) : json(nullptr);
@@ -232,42 +270,47 @@ void runLocalize(const LocalizeArgs& a) {
     j["rmse_m"] = nullptr;
     j["rmse_airborne_m"] = nullptr;
   }
-  // The JSON text is made before the trajectory file appears, so a failure here leaves no output behind.
-  const std::string json_text = uwb::app::dumpJson(j);
-  if (!a.out.empty()) {
-    if (a.format == "tum")
-      uwb::writeTrajectoryTum(run.trajectory, a.out);
-    else
-      uwb::writeTrajectoryCsv(run.trajectory, a.out);
-  }
-  if (!a.plot.empty()) {
-    // x, y, z against time with the ±2σ band and the ground truth (docs/math/filter.md F23); drawn to a temporary
-    // name beside the target and renamed, so the PNG appears complete or not at all. The temporary names follow
-    // writeFileAtomically's pattern: removed on SIGINT/SIGTERM, swept by a later run after a SIGKILL.
-    const std::filesystem::path png(a.plot);
-    const std::filesystem::path tmp_traj = uwb::temporaryPathBeside(a.plot, ".trajectory.csv");
-    const std::filesystem::path tmp_png = uwb::temporaryPathBeside(a.plot, ".png");
-    const uwb::TemporaryFileGuard traj_guard(tmp_traj.string()), png_guard(tmp_png.string());
-    const auto cleanup = [&] {
-      std::error_code ec;
-      std::filesystem::remove(tmp_traj, ec);
-      std::filesystem::remove(tmp_png, ec);
-    };
-    try {
-      uwb::writeTrajectoryCsv(run.trajectory, tmp_traj.string());
-      uwb::app::runPlots({"position", tmp_traj.string(), a.flight, tmp_png.string()});
-      uwb::checkOutputFile(a.plot, "plot file");  // still a regular file (or absent) and no input
-      std::filesystem::rename(tmp_png, png);
-    } catch (...) {
-      cleanup();
-      throw;
-    }
+  return j;
+}
+
+/// x, y, z against time with the ±2σ band and the ground truth (docs/math/filter.md F23); drawn to a temporary name
+/// beside the target and renamed, so the PNG appears complete or not at all. The temporary names follow
+/// writeFileAtomically's pattern: removed on SIGINT/SIGTERM, swept by a later run after a SIGKILL.
+void drawPlot(const LocalizeArgs& a, const uwb::Trajectory& trajectory) {
+  const std::filesystem::path png(a.plot);
+  const std::filesystem::path tmp_traj = uwb::temporaryPathBeside(a.plot, ".trajectory.csv");
+  const std::filesystem::path tmp_png = uwb::temporaryPathBeside(a.plot, ".png");
+  const uwb::TemporaryFileGuard traj_guard(tmp_traj.string()), png_guard(tmp_png.string());
+  const auto cleanup = [&] {
+    std::error_code ec;
+    std::filesystem::remove(tmp_traj, ec);
+    std::filesystem::remove(tmp_png, ec);
+  };
+  try {
+    uwb::writeTrajectoryCsv(trajectory, tmp_traj.string());
+    uwb::app::runPlots({"position", tmp_traj.string(), a.flight, tmp_png.string()});
+    uwb::checkOutputFile(a.plot, "plot file");  // still a regular file (or absent) and no input
+    std::filesystem::rename(tmp_png, png);
+  } catch (...) {
     cleanup();
+    throw;
   }
-  if (a.json_out) {
-    std::cout << json_text << '\n';
+  cleanup();
+}
+
+void printErrorStats(const char* name, const uwb::PositionErrorStats& st) {
+  if (st.n == 0) {  // never an RMSE over zero samples
+    std::printf("%-9s n=%6zu  no estimate to compare%s\n", name, st.n,
+                std::string(name) == "airborne" ? " (the ground truth never leaves the floor)" : "");
     return;
   }
+  std::printf("%-9s n=%6zu  RMSE 3D %.3f m  (x %.3f, y %.3f, z %.3f)  p50 %.3f  p90 %.3f  p99 %.3f m\n", name, st.n,
+              st.rmse_m, st.rmse_axis_m.x(), st.rmse_axis_m.y(), st.rmse_axis_m.z(), st.p50_m, st.p90_m, st.p99_m);
+}
+
+void printLocalizeText(const LocalizeArgs& a, const uwb::EkfParams& params, const LocalizeResult& res) {
+  const uwb::LocalizationRun& run = res.run;
+  const uwb::LocalizerSummary& s = run.summary;
   std::cout << "flight " << a.flight << ": " << run.duration_s << " s, model " << uwb::toString(s.process_model)
             << ", TDoA used " << s.n_tdoa_used << " (at rest " << s.n_tdoa_used_at_rest << ") / rejected "
             << s.n_tdoa_rejected << " / start-up " << s.n_tdoa_start << " of " << s.n_tdoa_total << "\n";
@@ -287,24 +330,36 @@ void runLocalize(const LocalizeArgs& a) {
                 s.bias_level_m, params.output_bias_level_m, widen);
   }
   for (const std::string& n : s.merge.notes()) std::cout << "note: " << n << "\n";
-  for (const std::string& n : notes) std::cout << "note: " << n << "\n";
+  for (const std::string& n : res.notes) std::cout << "note: " << n << "\n";
   if (run.metrics) {
-    const auto print = [](const char* name, const uwb::PositionErrorStats& st) {
-      if (st.n == 0) {  // never an RMSE over zero samples
-        std::printf("%-9s n=%6zu  no estimate to compare%s\n", name, st.n,
-                    std::string(name) == "airborne" ? " (the ground truth never leaves the floor)" : "");
-        return;
-      }
-      std::printf("%-9s n=%6zu  RMSE 3D %.3f m  (x %.3f, y %.3f, z %.3f)  p50 %.3f  p90 %.3f  p99 %.3f m\n", name,
-                  st.n, st.rmse_m, st.rmse_axis_m.x(), st.rmse_axis_m.y(), st.rmse_axis_m.z(), st.p50_m, st.p90_m,
-                  st.p99_m);
-    };
-    print("whole", run.metrics->whole);
-    print("airborne", run.metrics->airborne);
+    printErrorStats("whole", run.metrics->whole);
+    printErrorStats("airborne", run.metrics->airborne);
   } else {
     std::cout << "no ground truth in the flight: no RMSE\n";
   }
   if (!a.out.empty()) std::cout << "trajectory written to " << a.out << "\n";
+}
+
+void runLocalize(const LocalizeArgs& a) {
+  uwb::app::Warnings warnings;
+  checkOutputs(a);
+  const LocalizeInputs in = loadInputs(a, warnings);
+  const LocalizeResult res = runFilter(a, in, warnings);
+  addSummaryWarnings(res.run.summary, warnings);
+  // The JSON text is made before the trajectory file appears, so a failure here leaves no output behind.
+  const std::string json_text = uwb::app::dumpJson(localizeJson(a, in, res, warnings));
+  if (!a.out.empty()) {
+    if (a.format == "tum")
+      uwb::writeTrajectoryTum(res.run.trajectory, a.out);
+    else
+      uwb::writeTrajectoryCsv(res.run.trajectory, a.out);
+  }
+  if (!a.plot.empty()) drawPlot(a, res.run.trajectory);
+  if (a.json_out) {
+    std::cout << json_text << '\n';
+    return;
+  }
+  printLocalizeText(a, in.params, res);
 }
 
 const bool kRegistered = uwb::app::registerCommand(

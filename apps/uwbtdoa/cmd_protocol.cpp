@@ -44,6 +44,9 @@ struct ProtocolArgs {
   std::string write_cuts;  ///< folder for the real flights' mid-air cuts as flight CSV, with their survey
 };
 
+/// --data, else $UWBTDOA_DATA or the build-time default.
+std::string dataDir(const ProtocolArgs& a) { return a.data_dir.empty() ? uwb::app::defaultDataDir() : a.data_dir; }
+
 struct RealFlight {
   std::string name, session, path, survey;
 };
@@ -147,30 +150,22 @@ Row evaluateRun(const uwb::LocalizationRun& run, const std::string& name, const 
   return r;
 }
 
-std::string fmt3(double v) {
+/// A table cell: scale · v with `decimals` digits after the point, or "–" when v is not finite.
+std::string cell(double v, int decimals, double scale = 1.0) {
   if (!std::isfinite(v)) return "–";
   char b[32];
-  std::snprintf(b, sizeof b, "%.3f", v);
+  std::snprintf(b, sizeof b, "%.*f", decimals, scale * v);
   return b;
 }
+std::string fmt3(double v) { return cell(v, 3); }
+std::string fmt2(double v) { return cell(v, 2); }
+std::string pct(double v) { return cell(v, 0, 100.0); }
+
 /// A cut's start time as written in labels and file names: 10 → "10", 7.5 → "7.5".
 std::string cutTime(double t0) {
   std::ostringstream os;
   os << t0;
   return os.str();
-}
-
-std::string fmt2(double v) {
-  if (!std::isfinite(v)) return "–";
-  char b[32];
-  std::snprintf(b, sizeof b, "%.2f", v);
-  return b;
-}
-std::string pct(double v) {
-  if (!std::isfinite(v)) return "–";
-  char b[32];
-  std::snprintf(b, sizeof b, "%.0f", 100.0 * v);
-  return b;
 }
 
 json rowJson(const Row& r) {
@@ -326,7 +321,7 @@ void recovery(const uwb::TrajectoryMetrics& m, double t1, double* err_after, dou
 
 /// The fault-injection suite on real dev flights (issue "Nothing a flight or a file can do makes it lie").
 void runFaults(const ProtocolArgs& a, const uwb::LocalizationOptions& opt) {
-  const std::string data = a.data_dir.empty() ? uwb::app::defaultDataDir() : a.data_dir;
+  const std::string data = dataDir(a);
   const std::vector<std::string> names = {"0425-traj2", "0425-traj6", "0426-traj1", "0426-traj11"};
   json rows = json::array();
   if (!a.json_out)
@@ -398,7 +393,7 @@ void runFaults(const ProtocolArgs& a, const uwb::LocalizationOptions& opt) {
 
 /// The sensor-signature matrix (eval/SignatureMatrix.h): every cell against the same flight with its own IMU.
 void runSignatures(const ProtocolArgs& a, const uwb::LocalizationOptions& opt) {
-  const std::string data = a.data_dir.empty() ? uwb::app::defaultDataDir() : a.data_dir;
+  const std::string data = dataDir(a);
   json rows = json::array();
   if (!a.json_out)
     std::cout << "## Sensor-signature matrix\n\n| flight | signature | RMSE air plain [m] | RMSE air [m] | ratio | "
@@ -439,7 +434,7 @@ void runSignatures(const ProtocolArgs& a, const uwb::LocalizationOptions& opt) {
 /// The statistics of the checks after a run (eval/RunDiagnostics.h) on every real flight, clean and with the
 /// faults they are meant to find: how the thresholds were chosen (docs/robustness.md, "Wrong but plausible").
 void runChecks(const ProtocolArgs& a, const uwb::LocalizationOptions& opt) {
-  const std::string data = a.data_dir.empty() ? uwb::app::defaultDataDir() : a.data_dir;
+  const std::string data = dataDir(a);
   json rows = json::array();
   if (!a.json_out)
     std::cout << "## Checks after the run: statistic clean / faulted\n\n| flight | survey rms clean | other arena | "
@@ -501,6 +496,202 @@ void runChecks(const ProtocolArgs& a, const uwb::LocalizationOptions& opt) {
   if (a.json_out) std::cout << json{{"checks", rows}}.dump() << '\n';
 }
 
+/// The runs of the protocol, by table, and what the checks after the run said on the landed cuts.
+struct ProtocolRows {
+  std::vector<Row> full, cuts, sim, sim_cuts;
+  // the same cuts logged on to the end, landing included (a log started mid-flight): only the checks after the run
+  // are read from them (the survey fit must stay silent: the floor after the landing is not the survey's misfit)
+  std::vector<std::string> landed_cut_warnings;
+  std::size_t n_landed_cuts = 0;
+};
+
+/// The estimate checks' floor (the filter's ground height) and ceiling (the highest anchor).
+uwb::EstimateCheckParams estimateCheckParams(const uwb::EkfParams& params, const uwb::AnchorSurvey& survey) {
+  uwb::EstimateCheckParams cp;
+  cp.floor_z_m = params.ground_z_m;
+  cp.ceiling_z_m = -1e300;
+  for (const uwb::Anchor& an : survey.anchors) cp.ceiling_z_m = std::max(cp.ceiling_z_m, an.w_p.z());
+  return cp;
+}
+
+/// A real flight's logs started in the air: cut at each of --cuts, ending 1 s before the last airborne instant of the
+/// truth (mid-air); each also logged on to the end, for the checks after the run.
+void runCuts(const ProtocolArgs& a, const RealFlight& f, const uwb::Flight& flight, const uwb::AnchorSurvey& survey,
+             const uwb::LocalizationRun& full, const uwb::EstimateCheckParams& cp,
+             const uwb::LocalizationOptions& opt, ProtocolRows& rows) {
+  double t_air_end = -1.0;
+  for (const uwb::PositionErrorSample& s : full.metrics->samples)
+    if (s.airborne) t_air_end = s.t_s;
+  bool survey_written = false;
+  for (double t0 : a.cuts) {
+    const double t1 = t_air_end - 1.0;
+    if (!(t1 > t0 + 5.0)) continue;
+    const uwb::Flight cut = uwb::sliceFlight(flight, t0, t1);
+    const uwb::LocalizationRun run = uwb::localizeFlight(cut, survey, opt);
+    if (!a.write_cuts.empty()) {
+      // the cut as the filter sees it, to re-run with `localize`, and once per flight its survey (both atomically)
+      uwb::writeFlightCsv(cut, (fs::path(a.write_cuts) / (f.name + "-cut" + cutTime(t0) + ".csv")).string());
+      if (!survey_written) {
+        uwb::writeAnchorSurvey(survey, (fs::path(a.write_cuts) / (f.name + "-survey.txt")).string());
+        survey_written = true;
+      }
+    }
+    Row r = evaluateRun(run, f.name, f.session, "cut at " + cutTime(t0) + " s", cp, cut, survey, opt);
+    r.t0 = t0;
+    r.t1 = t1;
+    if (run.metrics) r.rmse_air = uwb::airborneRmseInWindow(*run.metrics, t0, t1);
+    r.rmse_ref = uwb::airborneRmseInWindow(*full.metrics, t0, t1);
+    if (!cut.tdoa.empty()) {
+      const double ts = cut.tdoa.front().t_s;
+      r.early_ref = uwb::airborneRmseInWindow(*full.metrics, ts + 3.0, ts + 5.0);
+    }
+    rows.cuts.push_back(r);
+    const uwb::Flight to_end = uwb::sliceFlight(flight, t0, flight.timeSpan().second);
+    ++rows.n_landed_cuts;
+    if (evaluateRun(uwb::localizeFlight(to_end, survey, opt), f.name, f.session, "", cp, to_end, survey, opt)
+            .survey_warning)
+      rows.landed_cut_warnings.push_back(f.name + " (from " + fmt2(t0) + " s to the end)");
+  }
+}
+
+/// Every real flight whole, and (with IMU and ground truth) its mid-air cuts.
+void runRealFlights(const ProtocolArgs& a, const uwb::EkfParams& params, const uwb::LocalizationOptions& opt,
+                    ProtocolRows& rows) {
+  const std::string data = dataDir(a);
+  if (!fs::is_directory(data + "/real"))
+    throw uwb::FileError("protocol: no real data under '" + data + "/real' (set --data or $UWBTDOA_DATA)");
+  if (!a.write_cuts.empty()) fs::create_directories(a.write_cuts);
+  for (const RealFlight& f : realFlights(data)) {
+    if (!a.only.empty() && f.name.find(a.only) == std::string::npos) continue;
+    if (!fs::is_regular_file(f.path)) {
+      std::cerr << "protocol: missing " << f.path << ", skipped\n";
+      continue;
+    }
+    const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(f.survey);
+    uwb::FlightReadOptions ro;
+    ro.required = {uwb::Stream::kTdoa};
+    ro.survey = &survey;
+    const uwb::Flight flight = uwb::readFlightCsv(f.path, ro);
+    const uwb::EstimateCheckParams cp = estimateCheckParams(params, survey);
+    const uwb::LocalizationRun full = uwb::localizeFlight(flight, survey, opt);
+    rows.full.push_back(evaluateRun(full, f.name, f.session, flight.hasImu() ? "full" : "full (TDoA only)", cp, flight,
+                                    survey, opt));
+    std::cerr << "protocol: " << f.name << " full " << fmt3(rows.full.back().rmse_air) << " m\n";
+    if (a.no_cuts || !full.metrics || !flight.hasImu()) continue;
+    runCuts(a, f, flight, survey, full, cp, opt, rows);
+  }
+}
+
+/// The simulated scenarios; a run that starts in the air is compared with the same flight logged from the ground.
+void runSimulations(const ProtocolArgs& a, const uwb::EkfParams& params, const uwb::LocalizationOptions& opt,
+                    ProtocolRows& rows) {
+  if (!a.write_sims.empty()) fs::create_directories(a.write_sims);
+  for (const uwb::SimScenarioRun& s : uwb::protocolSimulations(dataDir(a), {11, 12, 13}, a.only)) {
+    if (!a.write_sims.empty()) {
+      // the run as the filter sees it, to re-run with `localize` (both files written atomically)
+      uwb::writeFlightCsv(s.flight, (fs::path(a.write_sims) / (s.name + ".csv")).string());
+      uwb::writeAnchorSurvey(s.survey, (fs::path(a.write_sims) / (s.name + "-survey.txt")).string());
+      if (s.cut) uwb::writeFlightCsv(s.whole, (fs::path(a.write_sims) / (s.name + "-whole.csv")).string());
+    }
+    const uwb::EstimateCheckParams cp = estimateCheckParams(params, s.survey);
+    const uwb::LocalizationRun run = uwb::localizeFlight(s.flight, s.survey, opt);
+    Row r = evaluateRun(run, s.name, s.group, s.kind, cp, s.flight, s.survey, opt);
+    std::cerr << "protocol: " << s.name << " " << fmt3(r.rmse_air) << " m\n";
+    if (!s.cut) {
+      rows.sim.push_back(r);
+      continue;
+    }
+    r.t0 = s.flight.timeSpan().first;
+    r.t1 = s.flight.timeSpan().second;
+    // the same flight logged from the ground: its error on the same window is what the bias field gives
+    // without the start in the air
+    const uwb::LocalizationRun whole = uwb::localizeFlight(s.whole, s.survey, opt);
+    if (whole.metrics) {
+      r.rmse_ref = uwb::airborneRmseInWindow(*whole.metrics, r.t0, r.t1);
+      if (!s.flight.tdoa.empty()) {
+        const double ts = s.flight.tdoa.front().t_s;
+        r.early_ref = uwb::airborneRmseInWindow(*whole.metrics, ts + 3.0, ts + 5.0);
+      }
+    }
+    rows.sim_cuts.push_back(r);
+  }
+}
+
+/// The summaries of the cut tables: per cut time (the development flights, TDoA2, apart from the TDoA3 flight, whose
+/// session has a mode of its own) and per simulated group.
+void printCutSummaries(const ProtocolArgs& a, const ProtocolRows& rows) {
+  for (const bool tdoa2 : {true, false})
+    for (double t0 : a.cuts) {
+      std::vector<Row> sel;
+      for (const Row& r : rows.cuts)
+        if (r.t0 == t0 && isDevSession(r.session) == tdoa2) sel.push_back(r);
+      if (sel.empty()) continue;
+      std::cout << "\n" << (tdoa2 ? "" : "TDoA3, ") << "cut at " << t0 << " s: ";
+      printCutSummary(sel);
+    }
+}
+
+void printSimCutSummaries(const ProtocolRows& rows) {
+  std::map<std::string, std::vector<Row>> by_group;
+  for (const Row& r : rows.sim_cuts) by_group[r.session].push_back(r);
+  for (const auto& [group, sel] : by_group) {
+    std::cout << "\n" << group << ": ";
+    printCutSummary(sel);
+  }
+}
+
+/// Every flight here is clean (its own survey, no fault): a warning of the check after the run is a false alarm.
+void printFalseAlarms(const ProtocolRows& rows) {
+  std::vector<std::string> warned = rows.landed_cut_warnings;
+  std::size_t n_runs = rows.n_landed_cuts;
+  for (const auto* set : {&rows.full, &rows.cuts, &rows.sim, &rows.sim_cuts})
+    for (const Row& r : *set) {
+      ++n_runs;
+      if (r.survey_warning) warned.push_back(r.name + " (" + r.kind + ")");
+    }
+  std::cout << "\nSurvey-fit check after the run (eval/RunDiagnostics.h) on these clean runs and on the real cuts logged on to the end, landing included: " << warned.size()
+            << " false alarm(s) in " << n_runs << " runs";
+  for (std::size_t k = 0; k < warned.size(); ++k) std::cout << (k ? ", " : ": ") << warned[k];
+  std::cout << "\n";
+}
+
+void printProtocol(const ProtocolArgs& a, const ProtocolRows& rows) {
+  std::cout << "## Generalization protocol\n\nFilter parameters: defaults";
+  for (const std::string& kv : a.sets) std::cout << ", " << kv;
+  std::cout << ". Airborne: ground-truth z > 0.3 m. Coverage: fraction of airborne samples whose per-axis error "
+               "is within the reported 1σ / 2σ.\n";
+  if (!rows.full.empty()) {
+    printTable("Real flights, whole", rows.full, false);
+    summarize(rows.full, "Whole real flights", true);
+  }
+  if (!rows.cuts.empty()) {
+    printTable("Real flights cut to start in the air and end before landing", rows.cuts, true);
+    printCutSummaries(a, rows);
+  }
+  if (!rows.sim.empty()) {
+    printTable("Simulated flights, whole", rows.sim, false);
+    summarize(rows.sim, "Simulated flights", true);
+  }
+  if (!rows.sim_cuts.empty()) {
+    printTable("Simulated flights that start in the air", rows.sim_cuts, true);
+    printSimCutSummaries(rows);
+  }
+  printFalseAlarms(rows);
+}
+
+json protocolJson(const ProtocolArgs& a, const ProtocolRows& rows) {
+  json j;
+  json all = json::array();
+  for (const auto* set : {&rows.full, &rows.cuts, &rows.sim, &rows.sim_cuts})
+    for (const Row& r : *set) all.push_back(rowJson(r));
+  j["rows"] = all;
+  j["landed_cuts"] = {{"n", rows.n_landed_cuts}, {"survey_fit_warnings", rows.landed_cut_warnings}};
+  j["real_whole_summary"] = summarize(rows.full, "", false);
+  j["sim_whole_summary"] = summarize(rows.sim, "", false);
+  j["parameters_set"] = a.sets;
+  return j;
+}
+
 void runProtocol(const ProtocolArgs& a) {
   uwb::EkfParams params;
   for (const std::string& kv : a.sets) applySet(kv, params);
@@ -519,168 +710,11 @@ void runProtocol(const ProtocolArgs& a) {
     runSignatures(a, opt);
     return;
   }
-  json j;
-  std::vector<Row> full_rows, cut_rows, sim_rows, sim_cut_rows;
-  // the same cuts logged on to the end, landing included (a log started mid-flight): only the checks after the run
-  // are read from them (the survey fit must stay silent: the floor after the landing is not the survey's misfit)
-  std::vector<std::string> landed_cut_warnings;
-  std::size_t n_landed_cuts = 0;
-
-  if (!a.no_real) {
-    const std::string data = a.data_dir.empty() ? uwb::app::defaultDataDir() : a.data_dir;
-    if (!fs::is_directory(data + "/real"))
-      throw uwb::FileError("protocol: no real data under '" + data + "/real' (set --data or $UWBTDOA_DATA)");
-    if (!a.write_cuts.empty()) fs::create_directories(a.write_cuts);
-    for (const RealFlight& f : realFlights(data)) {
-      if (!a.only.empty() && f.name.find(a.only) == std::string::npos) continue;
-      if (!fs::is_regular_file(f.path)) {
-        std::cerr << "protocol: missing " << f.path << ", skipped\n";
-        continue;
-      }
-      const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(f.survey);
-      uwb::FlightReadOptions ro;
-      ro.required = {uwb::Stream::kTdoa};
-      ro.survey = &survey;
-      const uwb::Flight flight = uwb::readFlightCsv(f.path, ro);
-      uwb::EstimateCheckParams cp;
-      cp.floor_z_m = params.ground_z_m;
-      cp.ceiling_z_m = -1e300;
-      for (const uwb::Anchor& an : survey.anchors) cp.ceiling_z_m = std::max(cp.ceiling_z_m, an.w_p.z());
-      const uwb::LocalizationRun full = uwb::localizeFlight(flight, survey, opt);
-      full_rows.push_back(evaluateRun(full, f.name, f.session, flight.hasImu() ? "full" : "full (TDoA only)", cp, flight, survey, opt));
-      std::cerr << "protocol: " << f.name << " full " << fmt3(full_rows.back().rmse_air) << " m\n";
-      if (a.no_cuts || !full.metrics || !flight.hasImu()) continue;
-      // the airborne span of the truth; cut logs end 1 s before the last airborne instant (mid-air)
-      double t_air_end = -1.0;
-      for (const uwb::PositionErrorSample& s : full.metrics->samples)
-        if (s.airborne) t_air_end = s.t_s;
-      bool survey_written = false;
-      for (double t0 : a.cuts) {
-        const double t1 = t_air_end - 1.0;
-        if (!(t1 > t0 + 5.0)) continue;
-        const uwb::Flight cut = uwb::sliceFlight(flight, t0, t1);
-        const uwb::LocalizationRun run = uwb::localizeFlight(cut, survey, opt);
-        if (!a.write_cuts.empty()) {
-          // the cut as the filter sees it, to re-run with `localize`, and once per flight its survey (both atomically)
-          uwb::writeFlightCsv(cut, (fs::path(a.write_cuts) / (f.name + "-cut" + cutTime(t0) + ".csv")).string());
-          if (!survey_written) {
-            uwb::writeAnchorSurvey(survey, (fs::path(a.write_cuts) / (f.name + "-survey.txt")).string());
-            survey_written = true;
-          }
-        }
-        Row r = evaluateRun(run, f.name, f.session, "cut at " + cutTime(t0) + " s", cp, cut, survey, opt);
-        r.t0 = t0;
-        r.t1 = t1;
-        if (run.metrics) r.rmse_air = uwb::airborneRmseInWindow(*run.metrics, t0, t1);
-        r.rmse_ref = uwb::airborneRmseInWindow(*full.metrics, t0, t1);
-        if (!cut.tdoa.empty()) {
-          const double ts = cut.tdoa.front().t_s;
-          r.early_ref = uwb::airborneRmseInWindow(*full.metrics, ts + 3.0, ts + 5.0);
-        }
-        cut_rows.push_back(r);
-        const uwb::Flight to_end = uwb::sliceFlight(flight, t0, flight.timeSpan().second);
-        ++n_landed_cuts;
-        if (evaluateRun(uwb::localizeFlight(to_end, survey, opt), f.name, f.session, "", cp, to_end, survey, opt)
-                .survey_warning)
-          landed_cut_warnings.push_back(f.name + " (from " + fmt2(t0) + " s to the end)");
-      }
-    }
-  }
-  if (!a.no_sim) {
-    const std::string data = a.data_dir.empty() ? uwb::app::defaultDataDir() : a.data_dir;
-    if (!a.write_sims.empty()) fs::create_directories(a.write_sims);
-    for (const uwb::SimScenarioRun& s : uwb::protocolSimulations(data, {11, 12, 13}, a.only)) {
-      if (!a.write_sims.empty()) {
-        // the run as the filter sees it, to re-run with `localize` (both files written atomically)
-        uwb::writeFlightCsv(s.flight, (fs::path(a.write_sims) / (s.name + ".csv")).string());
-        uwb::writeAnchorSurvey(s.survey, (fs::path(a.write_sims) / (s.name + "-survey.txt")).string());
-        if (s.cut) uwb::writeFlightCsv(s.whole, (fs::path(a.write_sims) / (s.name + "-whole.csv")).string());
-      }
-      uwb::EstimateCheckParams cp;
-      cp.floor_z_m = params.ground_z_m;
-      cp.ceiling_z_m = -1e300;
-      for (const uwb::Anchor& an : s.survey.anchors) cp.ceiling_z_m = std::max(cp.ceiling_z_m, an.w_p.z());
-      const uwb::LocalizationRun run = uwb::localizeFlight(s.flight, s.survey, opt);
-      Row r = evaluateRun(run, s.name, s.group, s.kind, cp, s.flight, s.survey, opt);
-      std::cerr << "protocol: " << s.name << " " << fmt3(r.rmse_air) << " m\n";
-      if (s.cut) {
-        r.t0 = s.flight.timeSpan().first;
-        r.t1 = s.flight.timeSpan().second;
-        // the same flight logged from the ground: its error on the same window is what the bias field gives
-        // without the start in the air
-        const uwb::LocalizationRun whole = uwb::localizeFlight(s.whole, s.survey, opt);
-        if (whole.metrics) {
-          r.rmse_ref = uwb::airborneRmseInWindow(*whole.metrics, r.t0, r.t1);
-          if (!s.flight.tdoa.empty()) {
-            const double ts = s.flight.tdoa.front().t_s;
-            r.early_ref = uwb::airborneRmseInWindow(*whole.metrics, ts + 3.0, ts + 5.0);
-          }
-        }
-        sim_cut_rows.push_back(r);
-      } else {
-        sim_rows.push_back(r);
-      }
-    }
-  }
-
-  if (!a.json_out) {
-    std::cout << "## Generalization protocol\n\nFilter parameters: defaults";
-    for (const std::string& kv : a.sets) std::cout << ", " << kv;
-    std::cout << ". Airborne: ground-truth z > 0.3 m. Coverage: fraction of airborne samples whose per-axis error "
-                 "is within the reported 1σ / 2σ.\n";
-    if (!full_rows.empty()) {
-      printTable("Real flights, whole", full_rows, false);
-      summarize(full_rows, "Whole real flights", true);
-    }
-    if (!cut_rows.empty()) {
-      printTable("Real flights cut to start in the air and end before landing", cut_rows, true);
-      // the development flights (TDoA2) apart from the TDoA3 flight, whose session has a mode of its own
-      for (const bool tdoa2 : {true, false})
-        for (double t0 : a.cuts) {
-          std::vector<Row> sel;
-          for (const Row& r : cut_rows)
-            if (r.t0 == t0 && isDevSession(r.session) == tdoa2) sel.push_back(r);
-          if (sel.empty()) continue;
-          std::cout << "\n" << (tdoa2 ? "" : "TDoA3, ") << "cut at " << t0 << " s: ";
-          printCutSummary(sel);
-        }
-    }
-    if (!sim_rows.empty()) {
-      printTable("Simulated flights, whole", sim_rows, false);
-      summarize(sim_rows, "Simulated flights", true);
-    }
-    if (!sim_cut_rows.empty()) {
-      printTable("Simulated flights that start in the air", sim_cut_rows, true);
-      std::map<std::string, std::vector<Row>> by_group;
-      for (const Row& r : sim_cut_rows) by_group[r.session].push_back(r);
-      for (const auto& [group, sel] : by_group) {
-        std::cout << "\n" << group << ": ";
-        printCutSummary(sel);
-      }
-    }
-    // every flight here is clean (its own survey, no fault): a warning of the check after the run is a false alarm
-    std::vector<std::string> warned = landed_cut_warnings;
-    std::size_t n_runs = n_landed_cuts;
-    for (const auto* set : {&full_rows, &cut_rows, &sim_rows, &sim_cut_rows})
-      for (const Row& r : *set) {
-        ++n_runs;
-        if (r.survey_warning) warned.push_back(r.name + " (" + r.kind + ")");
-      }
-    std::cout << "\nSurvey-fit check after the run (eval/RunDiagnostics.h) on these clean runs and on the real cuts logged on to the end, landing included: " << warned.size()
-              << " false alarm(s) in " << n_runs << " runs";
-    for (std::size_t k = 0; k < warned.size(); ++k) std::cout << (k ? ", " : ": ") << warned[k];
-    std::cout << "\n";
-    return;
-  }
-  json rows = json::array();
-  for (const auto* set : {&full_rows, &cut_rows, &sim_rows, &sim_cut_rows})
-    for (const Row& r : *set) rows.push_back(rowJson(r));
-  j["rows"] = rows;
-  j["landed_cuts"] = {{"n", n_landed_cuts}, {"survey_fit_warnings", landed_cut_warnings}};
-  j["real_whole_summary"] = summarize(full_rows, "", false);
-  j["sim_whole_summary"] = summarize(sim_rows, "", false);
-  j["parameters_set"] = a.sets;
-  std::cout << j.dump() << '\n';
+  ProtocolRows rows;
+  if (!a.no_real) runRealFlights(a, params, opt, rows);
+  if (!a.no_sim) runSimulations(a, params, opt, rows);
+  if (a.json_out) std::cout << protocolJson(a, rows).dump() << '\n';
+  else printProtocol(a, rows);
 }
 
 const bool kRegistered = uwb::app::registerCommand(

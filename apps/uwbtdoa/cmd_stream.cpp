@@ -71,13 +71,160 @@ class LineSink {
   bool ok_ = true;
 };
 
-void runStream(const StreamArgs& a) {
+uwb::EstimateFormat estimateFormat(const StreamArgs& a) {
   if (a.output_period != 0.0) uwb::app::checkPeriod(a.output_period, "--output-period", kMaxOutputPeriod_s);
   if (a.format != "json" && a.format != "csv" && a.format != "tum")
     throw uwb::InputError("--format: expected json, csv or tum, got '" + a.format + "'");
-  const uwb::EstimateFormat format = a.format == "csv"   ? uwb::EstimateFormat::kCsv
-                                     : a.format == "tum" ? uwb::EstimateFormat::kTum
-                                                         : uwb::EstimateFormat::kJson;
+  return a.format == "csv"   ? uwb::EstimateFormat::kCsv
+         : a.format == "tum" ? uwb::EstimateFormat::kTum
+                             : uwb::EstimateFormat::kJson;
+}
+
+/// One live run: events in (stdin or a ZeroMQ SUB), the estimator, estimates out (stdout or a ZeroMQ PUB), and what
+/// it counts and reports on the way.
+class StreamRun {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  StreamRun(const StreamArgs& a, uwb::EstimateFormat format, const uwb::AnchorTable& anchors,
+            uwb::EstimateStream& stream, uwb::app::Warnings& warnings)
+      : a_(a), format_(format), anchors_(anchors), stream_(stream), warnings_(warnings) {
+    if (!a.in.empty()) {
+      sub_ = std::make_unique<uwb::ZmqLineSubscriber>(ctx_, a.in, uwb::kEventTopic);
+      sub_->setIdleTimeout(a.idle_timeout);
+    }
+    if (!a.out.empty()) pub_ = std::make_unique<uwb::ZmqLinePublisher>(ctx_, a.out, uwb::kEstimateTopic, false);
+    if (format != uwb::EstimateFormat::kJson) emit(uwb::estimateHeader(format));
+  }
+
+  /// Every event until the end of the input, a stop signal or the idle timeout; then the last estimate.
+  void run() {
+    for (std::string line; next(line);) handle(line);
+    if (stream_.finish()) {
+      emit(uwb::formatEstimate(stream_.last(), format_));
+      ++n_out_;
+    }
+  }
+
+  /// The warnings of the end, the end marker, the flush; then the totals (and with --stats the latency) on stderr.
+  void finish() {
+    for (const std::string& w : uwb::sensorRangeWarnings(stream_.sensorRange())) warnings_.add(w);  // (F31)
+    if (sub_ && sub_->timedOut())
+      warnings_.add(fmt::format("no message for {} (--idle-timeout): the producer is gone? ending the stream",
+                                seconds(a_.idle_timeout)));
+    if (pub_) pub_->send(uwb::kEndOfEvents);  // tells the consumer the stream ended (may be dropped like any estimate)
+    sink_.flush();
+    if (!reader_.error().empty()) throw uwb::FileError("stream: reading stdin: " + reader_.error());
+    printTotals();
+    if (a_.stats) printStats();
+  }
+
+ private:
+  void emit(const std::string& line) {
+    if (pub_) pub_->send(line);  // never blocks: a slow consumer loses estimates (counted), never sensor events
+    else sink_.write(line);
+  }
+
+  bool next(std::string& line) {
+    if (sub_) return sub_->next(line, uwb::app::stopFlag());
+    return sink_.ok() && reader_.next(line);
+  }
+
+  std::size_t lineNumber() const { return sub_ ? sub_->messageNumber() : reader_.lineNumber(); }
+  const char* unit() const { return sub_ ? "message" : "line"; }
+
+  void handle(const std::string& line) {
+    const Clock::time_point t_arrival = a_.stats ? Clock::now() : Clock::time_point{};
+    const std::size_t line_no = lineNumber();
+    const std::string source = sub_ ? "<zmq>" : "<stdin>";
+    uwb::StreamEvent ev;
+    try {
+      ev = uwb::parseEventLine(line, line_no, source);
+      uwb::checkEventAnchors(ev, anchors_, line_no, source);
+    } catch (const uwb::InputError& e) {
+      if (a_.strict) throw;
+      // a live tool keeps going: the line is skipped, counted and (the first few) reported
+      if (++n_bad_ <= kMaxReported)
+        warnings_.add(std::string(e.what()) + "; line skipped" +
+                      (n_bad_ == kMaxReported ? " (further bad lines are only counted)" : ""));
+      return;
+    }
+    const bool out = stream_.add(ev);
+    reportClockTrouble(line_no);
+    if (out) {
+      emit(uwb::formatEstimate(stream_.last(), format_));
+      ++n_out_;
+    }
+    if (a_.stats) {
+      const Clock::time_point t_done = Clock::now();
+      const double dt_s = std::chrono::duration<double>(t_done - t_arrival).count();
+      latency_all_.add(dt_s);
+      if (out) latency_out_.add(dt_s);
+      busy_s_ += dt_s;
+      if (t_first_ == Clock::time_point{}) t_first_ = t_arrival;
+      t_last_ = t_done;
+    }
+  }
+
+  /// A new clock jump, and new events skipped off the sensor clock (the first kMaxReported), as warnings.
+  void reportClockTrouble(std::size_t line_no) {
+    if (stream_.clockJumps().size() > n_jumps_reported_) {
+      const uwb::StreamClockJump& j = stream_.clockJumps()[n_jumps_reported_++];
+      warnings_.add(fmt::format("THE SENSOR CLOCK JUMPED from {} to {} (near {} {}; a reboot or a stepped clock): the "
+                                "estimator starts again from scratch on the new clock",
+                                seconds(j.t_from_s), seconds(j.t_to_s), unit(), line_no));
+    }
+    if (stream_.stampOutliers() > n_outliers_reported_) {
+      if (n_outliers_reported_ < kMaxReported)
+        warnings_.add(fmt::format("{} event(s) before {} {} skipped: stamp {} is off the sensor clock (latest {})",
+                                  stream_.stampOutliers() - n_outliers_reported_, unit(), line_no,
+                                  seconds(stream_.lastOutlierStamp()), seconds(stream_.lastOutlierClock())));
+      n_outliers_reported_ = stream_.stampOutliers();
+    }
+  }
+
+  void printTotals() const {
+    std::cerr << "stream: " << stream_.eventsIn() << " events, " << n_out_ << " estimates";
+    if (n_bad_ > 0) std::cerr << ", " << n_bad_ << " bad lines skipped";
+    if (stream_.stampOutliers() > 0) std::cerr << ", " << stream_.stampOutliers() << " events off the clock skipped";
+    if (const std::size_t n_range = stream_.sensorRange().total(); n_range > 0)
+      std::cerr << ", " << n_range << " sensor values out of range skipped";
+    if (!stream_.clockJumps().empty()) std::cerr << ", " << stream_.clockJumps().size() << " clock jumps (restarts)";
+    if (sub_ && sub_->timedOut()) std::cerr << " (idle timeout)";
+    if (pub_) std::cerr << ", " << pub_->sent() << " sent, " << pub_->dropped() << " dropped (slow consumer)";
+    std::cerr << (*uwb::app::stopFlag() ? " (stopped by signal)" : "") << (sink_.ok() ? "" : " (stdout closed)")
+              << "\n";
+  }
+
+  /// --stats: latency per event (arrival to handled / to the estimate sent) and throughput.
+  void printStats() const {
+    const double wall_s = std::chrono::duration<double>(t_last_ - t_first_).count();
+    std::cerr << "stream: latency per event, arrival to handled: " << latency_all_.summary() << "\n"
+              << "stream: latency per event with an estimate, arrival to sent: " << latency_out_.summary() << "\n"
+              << "stream: throughput " << (busy_s_ > 0 ? static_cast<double>(latency_all_.size()) / busy_s_ : 0.0)
+              << " events/s of handling time; "
+              << (wall_s > 0 ? static_cast<double>(latency_all_.size()) / wall_s : 0.0) << " events/s received over "
+              << wall_s << " s\n";
+  }
+
+  const StreamArgs& a_;
+  const uwb::EstimateFormat format_;
+  const uwb::AnchorTable& anchors_;
+  uwb::EstimateStream& stream_;
+  uwb::app::Warnings& warnings_;
+  zmq::context_t ctx_;
+  std::unique_ptr<uwb::ZmqLineSubscriber> sub_;
+  std::unique_ptr<uwb::ZmqLinePublisher> pub_;
+  LineSink sink_;
+  uwb::FdLineReader reader_{STDIN_FILENO, uwb::app::stopFlag(), [this] { sink_.flush(); }};
+  std::size_t n_out_ = 0, n_bad_ = 0, n_outliers_reported_ = 0, n_jumps_reported_ = 0;
+  uwb::LatencyStats latency_all_, latency_out_;
+  Clock::time_point t_first_{}, t_last_{};
+  double busy_s_ = 0.0;
+};
+
+void runStream(const StreamArgs& a) {
+  const uwb::EstimateFormat format = estimateFormat(a);
   uwb::app::FilterSetup setup = uwb::app::buildFilterParams(a.filter);
   const uwb::BiasPredictor bias = uwb::app::loadBiasPredictor(a.filter, &setup.params);
   const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(a.anchors);
@@ -89,106 +236,9 @@ void runStream(const StreamArgs& a) {
   uwb::EstimateStream stream(setup.params, anchors, a.output_period, bias);
 
   uwb::app::installStopHandlers();
-  zmq::context_t ctx;
-  std::unique_ptr<uwb::ZmqLineSubscriber> sub;
-  std::unique_ptr<uwb::ZmqLinePublisher> pub;
-  if (!a.in.empty()) {
-    sub = std::make_unique<uwb::ZmqLineSubscriber>(ctx, a.in, uwb::kEventTopic);
-    sub->setIdleTimeout(a.idle_timeout);
-  }
-  if (!a.out.empty()) pub = std::make_unique<uwb::ZmqLinePublisher>(ctx, a.out, uwb::kEstimateTopic, false);
-  LineSink sink;
-  const auto emit = [&](const std::string& line) {
-    if (pub) pub->send(line);  // never blocks: a slow consumer loses estimates (counted), never sensor events
-    else sink.write(line);
-  };
-  if (format != uwb::EstimateFormat::kJson) emit(uwb::estimateHeader(format));
-  uwb::FdLineReader reader(STDIN_FILENO, uwb::app::stopFlag(), [&sink] { sink.flush(); });
-  const auto next = [&](std::string& line) {
-    if (sub) {
-      if (!sub->next(line, uwb::app::stopFlag())) return false;
-      return true;
-    }
-    return sink.ok() && reader.next(line);
-  };
-  const std::string source = sub ? "<zmq>" : "<stdin>";
-  std::size_t n_out = 0;
-  uwb::LatencyStats latency_all, latency_out;  // --stats: arrival → handled (all events) / → estimate sent
-  using Clock = std::chrono::steady_clock;
-  Clock::time_point t_first{}, t_last{};
-  double busy_s = 0.0;
-  std::size_t n_bad = 0, n_outliers_reported = 0, n_jumps_reported = 0;
-  for (std::string line; next(line);) {
-    const Clock::time_point t_arrival = a.stats ? Clock::now() : Clock::time_point{};
-    const std::size_t line_no = sub ? sub->messageNumber() : reader.lineNumber();
-    uwb::StreamEvent ev;
-    try {
-      ev = uwb::parseEventLine(line, line_no, source);
-      uwb::checkEventAnchors(ev, anchors, line_no, source);
-    } catch (const uwb::InputError& e) {
-      if (a.strict) throw;
-      // a live tool keeps going: the line is skipped, counted and (the first few) reported
-      if (++n_bad <= kMaxReported)
-        warnings.add(std::string(e.what()) + "; line skipped" +
-                     (n_bad == kMaxReported ? " (further bad lines are only counted)" : ""));
-      continue;
-    }
-    const bool out = stream.add(ev);
-    if (stream.clockJumps().size() > n_jumps_reported) {
-      const uwb::StreamClockJump& j = stream.clockJumps()[n_jumps_reported++];
-      warnings.add(fmt::format("THE SENSOR CLOCK JUMPED from {} to {} (near {} {}; a reboot or a stepped clock): the "
-                               "estimator starts again from scratch on the new clock",
-                               seconds(j.t_from_s), seconds(j.t_to_s), sub ? "message" : "line", line_no));
-    }
-    if (stream.stampOutliers() > n_outliers_reported) {
-      if (n_outliers_reported < kMaxReported)
-        warnings.add(fmt::format("{} event(s) before {} {} skipped: stamp {} is off the sensor clock (latest {})",
-                                 stream.stampOutliers() - n_outliers_reported, sub ? "message" : "line", line_no,
-                                 seconds(stream.lastOutlierStamp()), seconds(stream.lastOutlierClock())));
-      n_outliers_reported = stream.stampOutliers();
-    }
-    if (out) {
-      emit(uwb::formatEstimate(stream.last(), format));
-      ++n_out;
-    }
-    if (a.stats) {
-      const Clock::time_point t_done = Clock::now();
-      const double dt_s = std::chrono::duration<double>(t_done - t_arrival).count();
-      latency_all.add(dt_s);
-      if (out) latency_out.add(dt_s);
-      busy_s += dt_s;
-      if (t_first == Clock::time_point{}) t_first = t_arrival;
-      t_last = t_done;
-    }
-  }
-  if (stream.finish()) {
-    emit(uwb::formatEstimate(stream.last(), format));
-    ++n_out;
-  }
-  for (const std::string& w : uwb::sensorRangeWarnings(stream.sensorRange())) warnings.add(w);  // (F31)
-  if (sub && sub->timedOut())
-    warnings.add(fmt::format("no message for {} (--idle-timeout): the producer is gone? ending the stream",
-                             seconds(a.idle_timeout)));
-  if (pub) pub->send(uwb::kEndOfEvents);  // tells the consumer the stream ended (may be dropped like any estimate)
-  sink.flush();
-  if (!reader.error().empty()) throw uwb::FileError("stream: reading stdin: " + reader.error());
-  std::cerr << "stream: " << stream.eventsIn() << " events, " << n_out << " estimates";
-  if (n_bad > 0) std::cerr << ", " << n_bad << " bad lines skipped";
-  if (stream.stampOutliers() > 0) std::cerr << ", " << stream.stampOutliers() << " events off the clock skipped";
-  if (const std::size_t n_range = stream.sensorRange().total(); n_range > 0)
-    std::cerr << ", " << n_range << " sensor values out of range skipped";
-  if (!stream.clockJumps().empty()) std::cerr << ", " << stream.clockJumps().size() << " clock jumps (restarts)";
-  if (sub && sub->timedOut()) std::cerr << " (idle timeout)";
-  if (pub) std::cerr << ", " << pub->sent() << " sent, " << pub->dropped() << " dropped (slow consumer)";
-  std::cerr << (*uwb::app::stopFlag() ? " (stopped by signal)" : "") << (sink.ok() ? "" : " (stdout closed)") << "\n";
-  if (a.stats) {
-    const double wall_s = std::chrono::duration<double>(t_last - t_first).count();
-    std::cerr << "stream: latency per event, arrival to handled: " << latency_all.summary() << "\n"
-              << "stream: latency per event with an estimate, arrival to sent: " << latency_out.summary() << "\n"
-              << "stream: throughput " << (busy_s > 0 ? static_cast<double>(latency_all.size()) / busy_s : 0.0)
-              << " events/s of handling time; " << (wall_s > 0 ? static_cast<double>(latency_all.size()) / wall_s : 0.0)
-              << " events/s received over " << wall_s << " s\n";
-  }
+  StreamRun live(a, format, anchors, stream, warnings);
+  live.run();
+  live.finish();
 }
 
 const bool kRegistered = uwb::app::registerCommand(

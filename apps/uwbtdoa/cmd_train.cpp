@@ -78,30 +78,16 @@ void dumpArrays(const std::string& path, const uwb::BiasDataset& data, const uwb
   uwb::writeFileAtomically(path, out.str(), "training arrays");
 }
 
-void run(const TrainOptions& o) {
-  {  // before minutes of training; the model must not replace one of the inputs
-    std::vector<std::string> inputs = o.flights;
-    inputs.push_back(o.anchors);
-    uwb::checkOutputFile(o.out, "bias model", inputs);
-  }
-  if (o.passes > 1 && o.inputs != "estimate") throw std::invalid_argument("--passes > 1 needs --inputs estimate");
-  const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(o.anchors);
-  uwb::app::Warnings().addIssues(uwb::checkSurveyGeometry(survey));  // errors stop, warnings go to stderr
-  std::vector<uwb::Flight> flights;
-  uwb::FlightReadOptions ro;
-  ro.required = {uwb::Stream::kTdoa};
-  for (const auto& f : o.flights) flights.push_back(uwb::readFlightCsv(f, ro));
-
+uwb::BiasDatasetParams datasetParams(const TrainOptions& o) {
   uwb::BiasDatasetParams dp;
   dp.min_z_m = o.min_z;
   dp.max_abs_error_m = o.max_abs_error;
   dp.neighbour_pairs_only = o.neighbour_only;
   dp.inputs = uwb::biasInputSourceFromString(o.inputs);
-  uwb::BiasDataset data = uwb::buildBiasDataset(flights, survey, dp);
-  if (!o.quiet) std::cerr << data.reportText();
-  for (const uwb::BiasFlightReport& f : data.flights)  // (F31) the estimated inputs' filter skipped sensor values
-    for (const std::string& w : uwb::sensorRangeWarnings(f.sensor_range)) uwb::app::Warnings().add(f.source + ": " + w);
+  return dp;
+}
 
+uwb::BiasTrainParams trainParams(const TrainOptions& o) {
   uwb::BiasTrainParams tp;
   tp.preset = o.kernel;
   tp.num_inducing = o.inducing;
@@ -117,20 +103,43 @@ void run(const TrainOptions& o) {
   tp.mean_scale = o.mean_scale;
   tp.predictive_shape = o.predictive_shape;
   tp.full_variance = o.full_variance;
-  if (!o.dump_arrays.empty()) dumpArrays(o.dump_arrays, data, tp);
+  return tp;
+}
+
+/// The trained model, the training data of its last pass and that pass's report.
+struct Trained {
+  uwb::BiasModel model;
+  uwb::BiasDataset data;
   uwb::BiasTrainReport rep;
-  uwb::BiasModel model = uwb::trainBiasModel(data, tp, &rep, o.quiet ? uwb::BiasTrainProgress{} : uwb::BiasTrainProgress{progressBar});
-  // docs/math/gp.md (P30): further passes take the GP inputs from the filter corrected by the previous pass's model
+};
+
+/// Builds the training set and trains; docs/math/gp.md (P30): further passes take the GP inputs from the filter
+/// corrected by the previous pass's model.
+Trained trainPasses(const TrainOptions& o, const std::vector<uwb::Flight>& flights, const uwb::AnchorSurvey& survey) {
+  uwb::BiasDatasetParams dp = datasetParams(o);
+  Trained t;
+  t.data = uwb::buildBiasDataset(flights, survey, dp);
+  if (!o.quiet) std::cerr << t.data.reportText();
+  for (const uwb::BiasFlightReport& f : t.data.flights)  // (F31) the estimated inputs' filter skipped sensor values
+    for (const std::string& w : uwb::sensorRangeWarnings(f.sensor_range)) uwb::app::Warnings().add(f.source + ": " + w);
+  const uwb::BiasTrainParams tp = trainParams(o);
+  if (!o.dump_arrays.empty()) dumpArrays(o.dump_arrays, t.data, tp);
+  const uwb::BiasTrainProgress progress = o.quiet ? uwb::BiasTrainProgress{} : uwb::BiasTrainProgress{progressBar};
+  t.model = uwb::trainBiasModel(t.data, tp, &t.rep, progress);
   for (int pass = 2; pass <= o.passes; ++pass) {
     if (dp.inputs != uwb::BiasInputSource::kFilterEstimate)
       throw std::invalid_argument("--passes > 1 needs --inputs estimate");
-    dp.estimate_bias = model.predictor();
-    data = uwb::buildBiasDataset(flights, survey, dp);
+    dp.estimate_bias = t.model.predictor();
+    t.data = uwb::buildBiasDataset(flights, survey, dp);
     if (!o.quiet) std::cerr << "pass " << pass << ": GP inputs from the filter corrected by pass " << pass - 1 << '\n';
-    model = uwb::trainBiasModel(data, tp, &rep, o.quiet ? uwb::BiasTrainProgress{} : uwb::BiasTrainProgress{progressBar});
+    t.model = uwb::trainBiasModel(t.data, tp, &t.rep, progress);
   }
-  if (!o.dump_arrays.empty() && o.passes > 1) dumpArrays(o.dump_arrays, data, tp);  // the last pass's arrays
+  if (!o.dump_arrays.empty() && o.passes > 1) dumpArrays(o.dump_arrays, t.data, tp);  // the last pass's arrays
+  return t;
+}
 
+/// The learned hyperparameters of each GP of the model: {"global" or "pair_A_B": {name: value, num_inducing}}.
+json hyperparametersJson(const uwb::BiasModel& model) {
   json hyper = json::object();
   for (const auto& e : model.entries()) {
     json h;
@@ -138,6 +147,12 @@ void run(const TrainOptions& o) {
     h["num_inducing"] = e.gp.numInducing();
     hyper[e.id_a < 0 ? std::string("global") : fmt::format("pair_{}_{}", e.id_a, e.id_b)] = h;
   }
+  return hyper;
+}
+
+/// The summary printed with --json and stored in the model file (metadata_json).
+json trainSummaryJson(const TrainOptions& o, const Trained& t) {
+  const uwb::BiasTrainReport& rep = t.rep;
   json summary{{"kernel", o.kernel},
                {"inducing", o.inducing},
                {"epochs", o.epochs},
@@ -147,8 +162,8 @@ void run(const TrainOptions& o) {
                {"inputs", o.inputs},
                {"extra_sigma_m", o.extra_sigma},
                {"mean_scale", o.mean_scale},
-               {"training_bias_level_m", model.trainingBiasLevel()},
-               {"training_mean_level_m", model.trainingMeanLevel()},
+               {"training_bias_level_m", t.model.trainingBiasLevel()},
+               {"training_mean_level_m", t.model.trainingMeanLevel()},
                {"predictive_dof", o.predictive_shape.dof},
                {"predictive_scale", o.predictive_shape.scale},
                {"full_variance", o.full_variance},
@@ -166,22 +181,20 @@ void run(const TrainOptions& o) {
                {"final_elbo", rep.final_elbo},
                {"threads", o.threads},
                {"num_models", rep.num_models},
-               {"hyperparameters", hyper},
+               {"hyperparameters", hyperparametersJson(t.model)},
                {"model", o.out}};
   json excl = json::array();
-  for (const auto& f : data.flights)
+  for (const auto& f : t.data.flights)
     excl.push_back({{"flight", f.source}, {"measurements", f.n_measurements}, {"unknown_anchor", f.n_unknown_anchor},
                     {"no_ground_truth", f.n_no_ground_truth}, {"pose_glitch", f.n_pose_glitch}, {"on_ground", f.n_on_ground},
                     {"non_neighbour", f.n_non_neighbour}, {"outlier", f.n_outlier}, {"used", f.n_used},
                     {"bias_level_m", std::isnan(f.bias_level_m) ? json(nullptr) : json(f.bias_level_m)}});
   summary["exclusions"] = excl;
-  model.metadata_json = uwb::app::dumpJson(summary);
-  model.save(o.out);
+  return summary;
+}
 
-  if (o.json_out) {
-    std::cout << uwb::app::dumpJson(summary) << '\n';
-    return;
-  }
+void printTrainText(const TrainOptions& o, const Trained& t, const json& hyper) {
+  const uwb::BiasTrainReport& rep = t.rep;
   std::cout << fmt::format("trained {} ({} GP{}, M = {}) on {} samples in {:.1f} s; held out {} samples; full-data "
                            "ELBO per datum {:.4f}\n",
                            o.kernel, rep.num_models, rep.num_models == 1 ? "" : "s", o.inducing, rep.n_train,
@@ -196,14 +209,14 @@ void run(const TrainOptions& o) {
                            "`uwbtdoa predict-bias`)\n",
                            rep.mean_predictive_std_m, 100.0 * rep.holdout_coverage_1sigma,
                            100.0 * rep.holdout_coverage_2sigma, rep.holdout_nlpd);
-  if (model.trainingBiasLevel() > 0.0)
+  if (t.model.trainingBiasLevel() > 0.0)
     std::cout << fmt::format("TDoA bias level of the training flights (filter.md F23c) {:.3f} m: the filter scales the "
                              "mean down on a flight of a lower level (F24b)\n",
-                             model.trainingBiasLevel());
-  if (model.trainingMeanLevel() > 0.0)
+                             t.model.trainingBiasLevel());
+  if (t.model.trainingMeanLevel() > 0.0)
     std::cout << fmt::format("level of the model's own mean on them {:.3f} m: the filter compares it with the mean's "
                              "level on the flight at hand (F24c)\n",
-                             model.trainingMeanLevel());
+                             t.model.trainingMeanLevel());
   std::cout << "learned hyperparameters:\n";
   for (const auto& [model_name, h] : hyper.items()) {
     std::cout << "  " << model_name << ":";
@@ -211,6 +224,31 @@ void run(const TrainOptions& o) {
     std::cout << '\n';
   }
   std::cout << "model written to " << o.out << '\n';
+}
+
+void run(const TrainOptions& o) {
+  {  // before minutes of training; the model must not replace one of the inputs
+    std::vector<std::string> inputs = o.flights;
+    inputs.push_back(o.anchors);
+    uwb::checkOutputFile(o.out, "bias model", inputs);
+  }
+  if (o.passes > 1 && o.inputs != "estimate") throw std::invalid_argument("--passes > 1 needs --inputs estimate");
+  const uwb::AnchorSurvey survey = uwb::readAnchorSurvey(o.anchors);
+  uwb::app::Warnings().addIssues(uwb::checkSurveyGeometry(survey));  // errors stop, warnings go to stderr
+  std::vector<uwb::Flight> flights;
+  uwb::FlightReadOptions ro;
+  ro.required = {uwb::Stream::kTdoa};
+  for (const auto& f : o.flights) flights.push_back(uwb::readFlightCsv(f, ro));
+
+  Trained t = trainPasses(o, flights, survey);
+  const json summary = trainSummaryJson(o, t);
+  t.model.metadata_json = uwb::app::dumpJson(summary);
+  t.model.save(o.out);
+  if (o.json_out) {
+    std::cout << uwb::app::dumpJson(summary) << '\n';
+    return;
+  }
+  printTrainText(o, t, summary.at("hyperparameters"));
 }
 
 void setup(CLI::App& sub) {
