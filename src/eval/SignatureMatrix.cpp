@@ -35,6 +35,16 @@ SignatureCell cell(std::string name, double gyro_dps, double acc_g, bool replace
   return c;
 }
 
+/// A floor that shakes (idling: gyro and 0.05 g of accelerometer) or is held in a hand (S24b), gyro RMS in °/s.
+SignatureCell floorCell(sim::FloorImu floor, double gyro_dps) {
+  SignatureCell c;
+  c.name = "floor " + sim::toString(floor) + " " + std::to_string(static_cast<int>(gyro_dps)) + "°/s";
+  c.signature.floor = floor;
+  c.signature.floor_gyro_vib_rms_radps = gyro_dps * kDeg;
+  if (floor == sim::FloorImu::kIdle) c.signature.floor_acc_vib_rms_mps2 = 0.05 * kG;
+  return c;
+}
+
 /// Airborne TDoA by the truth (above the flight's floor level + kAirborneMinZ_m).
 std::size_t airborneTdoa(const Flight& f) {
   const double floor_z = sim::truthFloorLevel(f.pose);
@@ -70,21 +80,8 @@ std::vector<SignatureCell> signatureCells(bool transplant) {
   off.name = "floor motors off";
   off.signature.floor = sim::FloorImu::kMotorsOff;
   cells.push_back(off);
-  for (double idle : {10.0, 40.0}) {
-    SignatureCell c;
-    c.name = "floor idle " + std::to_string(static_cast<int>(idle)) + "°/s";
-    c.signature.floor = sim::FloorImu::kIdle;
-    c.signature.floor_gyro_vib_rms_radps = idle * kDeg;
-    c.signature.floor_acc_vib_rms_mps2 = 0.05 * kG;
-    cells.push_back(c);
-  }
-  for (double hand : {10.0, 30.0}) {
-    SignatureCell c;
-    c.name = "floor hand-held " + std::to_string(static_cast<int>(hand)) + "°/s";
-    c.signature.floor = sim::FloorImu::kHandHeld;
-    c.signature.floor_gyro_vib_rms_radps = hand * kDeg;
-    cells.push_back(c);
-  }
+  for (double idle : {10.0, 40.0}) cells.push_back(floorCell(sim::FloorImu::kIdle, idle));
+  for (double hand : {10.0, 30.0}) cells.push_back(floorCell(sim::FloorImu::kHandHeld, hand));
   for (double hz : {100.0, 500.0, 1000.0}) {
     SignatureCell c;
     c.name = "IMU " + std::to_string(static_cast<int>(hz)) + " Hz";
