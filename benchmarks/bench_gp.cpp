@@ -3,7 +3,8 @@
  *         unless its name says otherwise (the predict rows' second argument is the thread count).
  *         BM_SvgpEpoch*: one epoch = the 49 minibatch steps and nothing else (the trainer's final full-data passes
  *         are switched off); BM_SvgpFinalPasses: those passes (optimal q(v) on the full data, P41, and the
- *         full-data ELBO, P15), which the trainer runs once after its last epoch.
+ *         full-data ELBO, P15), which the trainer runs once after its last epoch; BM_SvgpTrainOneEpochDefaults:
+ *         a one-epoch training with the trainer's defaults (all cores, both parts).
  *         Targets: 10,000 predictions at M = 170 in < 10 ms.
  *         GPyTorch 1.10 cannot be re-run from this repository: its figures in docs/results.md are a measurement
  *         reported elsewhere, quoted with its source and conditions, not a measurement of this benchmark.
@@ -113,6 +114,23 @@ void BM_SvgpFinalPasses(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_SvgpFinalPasses)->Arg(30)->Arg(170)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// One call of `trainSvgp` with epochs = 1 and every other setting at the trainer's default: all cores
+/// (num_threads = 0), natural gradients on q(v), and the two final full-data passes. What `uwbtdoa train` spends on
+/// one epoch of a one-epoch run; the rows above split it into its parts on one thread.
+void BM_SvgpTrainOneEpochDefaults(benchmark::State& state) {
+  const int M = static_cast<int>(state.range(0));
+  Svgp gp = makeModel(M);
+  SvgpTrainParams params;
+  params.epochs = 1;
+  params.batch_size = 1024;
+  for (auto _ : state) {
+    trainSvgp(gp, problem().X, problem().y, params);
+    benchmark::ClobberMemory();
+  }
+  state.SetLabel("all cores, final passes");
+}
+BENCHMARK(BM_SvgpTrainOneEpochDefaults)->Arg(30)->Arg(170)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 /// Batch prediction of 10,000 points (mean, var_f, var_y) with a precomputed predictor; args: M, threads.
 /// With threads > 1 the CPU column counts only the calling thread: read the wall-clock (Time) column.

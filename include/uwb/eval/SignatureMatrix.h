@@ -46,6 +46,8 @@ struct SignatureRow {
   Vec3 coverage_2sigma = Vec3::Zero();
   std::size_t mode_overrules = 0;      ///< mode changes the TDoA forced against the IMU (filter.md F29)
   bool pass = false;                   ///< ratio ≤ 1.2, in-flight ≥ 95 %, stuck ≤ 1 s
+  int n_draws = 1;                     ///< vibration draws behind the row (evaluateSignatureDraws)
+  int n_draws_pass = 0;                ///< … of which passed
 };
 
 /// The cells of the matrix; transplant cells replace the flight's own in-flight vibration.
@@ -55,9 +57,20 @@ std::vector<SignatureCell> signatureCells(bool transplant);
 /// 0425-traj2, 0426-traj1 and 0426-traj11 when data_dir holds them. `only` keeps names containing it.
 std::vector<SignatureFlight> signatureFlights(const std::string& data_dir, const std::string& only = "");
 
-/// Localizes the flight with the cell's signature (seed fixed per cell) and compares it with `plain`, the run on the
-/// flight as it is.
+/// Seed of one vibration draw of a cell: a function of the flight's and the cell's names and the draw's index alone
+/// (FNV-1a), so a cell draws the same whether the whole matrix runs or `--only` picks it.
+std::uint64_t signatureSeed(const std::string& flight, const std::string& cell, int draw);
+
+/// Localizes the flight with the cell's signature (the vibration drawn from `seed`) and compares it with `plain`,
+/// the run on the flight as it is.
 SignatureRow evaluateSignature(const SignatureFlight& flight, const SignatureCell& cell, const LocalizationRun& plain,
                                const LocalizationOptions& options, std::uint64_t seed);
+
+/// The cell over `draws` vibration draws (signatureSeed(flight, cell, 0 … draws − 1)), reported by its worst draw in
+/// each figure (largest ratio, time on the floor and TDoA overrules; smallest in-flight fraction and 2σ coverage per
+/// axis); it passes when every draw passes. One draw is a sample of a random vibration: a cell that passes one
+/// draw and fails the next sits at a cliff edge.
+SignatureRow evaluateSignatureDraws(const SignatureFlight& flight, const SignatureCell& cell,
+                                    const LocalizationRun& plain, const LocalizationOptions& options, int draws);
 
 }  // namespace uwb
