@@ -352,7 +352,9 @@ void Estimator::enterGround(double t_s) {
   descent_.clear();
   climb_.clear();
   n_low_z_ = 0;
-  v_climb_ = 0.0;
+  // (F15) the take-off detector starts from the descent the floor is about to stop: the touchdown's deceleration
+  // brings it to zero, not to a climb
+  v_climb_ = std::min(ekf_.state().w_v_b.z(), 0.0);
   ++summary_.n_rest_periods;
   if (summary_.ground_entered_t_s.size() < kMaxListedEvents) summary_.ground_entered_t_s.push_back(t_s);
   if (moved_) summary_.landing_t_s = t_s;
@@ -558,7 +560,8 @@ bool Estimator::updateTakeoffDetector(const ImuReading& imu, double dt_imu, bool
   v_climb_ = expNegative(dt_imu / params_.takeoff_leak_s) * v_climb_ + dt_imu * (a_up - g_ref_);
   if (rest_.stillNow() || v_climb_ < 0.05) g_ref_ += (dt_imu / 2.0) * (a_up - g_ref_);
   // a body that shakes is still touching the floor (touchdown bounces, spin-up): no take-off
-  return v_climb_ > params_.takeoff_climb_mps && !rest_.stillNow() && !shaking;
+  (void)shaking;
+  return v_climb_ > params_.takeoff_climb_mps && !rest_.stillNow();
 }
 
 double Estimator::lowestRecentZ(std::size_t n) const {

@@ -47,6 +47,26 @@ TEST(OtherDrone, SimulatedFlightWhoseGyroShakesInFlight) {
   }
 }
 
+TEST(OtherDrone, AFloorThatShakesAsHardAsTheFlightDoesNotHoldTheTakeOff) {
+  // GIVEN a simulated circle whose floor idles at 40°/s and whose flight shakes at 20°/s: the gyro cannot tell the
+  // take-off from the floor (with the climb vetoed by the shaking: 1.27 s on the floor in flight, 1.6×)
+  const sim::Scenario sc = sim::makeScenario(sim::paperAnchors(), sim::TrajectoryShape::kCircle, 40.0);
+  SignatureFlight f{"sim-circle", sim::simulateFlight(sc, sim::SimParams{}, 11).flight, sc.survey, false};
+  const LocalizationRun plain = localizeFlight(f.flight, f.survey);
+  ASSERT_TRUE(plain.metrics);
+  SignatureCell c = otherDrone(20.0);
+  c.name = "idling floor";
+  c.signature.floor = sim::FloorImu::kIdle;
+  c.signature.floor_gyro_vib_rms_radps = 40.0 * kDeg;
+  c.signature.floor_acc_vib_rms_mps2 = 0.05 * 9.80665;
+  // WHEN localized with the defaults, over three vibration draws
+  const SignatureRow r = evaluateSignatureDraws(f, c, plain, LocalizationOptions{}, 3);
+  // THEN the accelerometer's climb lifts it as from a quiet floor (filter.md F15): every draw passes
+  EXPECT_EQ(r.n_draws_pass, 3);
+  EXPECT_LE(r.longest_floor_stuck_s, 1.0);
+  EXPECT_LE(r.ratio, 1.2) << r.rmse_cell_m << " vs " << r.rmse_plain_m;
+}
+
 TEST(OtherDrone, RealDevFlightTransplanted) {
   // GIVEN a real dev flight with its floor made quiet and 20°/s of rotor vibration in flight, its accelerometer quiet
   const auto path = test::pilotFlight("0425-traj2");
