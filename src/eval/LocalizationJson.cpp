@@ -38,6 +38,8 @@ json localizerSummaryJson(const LocalizerSummary& s, const EkfParams& params) {
   j["n_tdoa_before_imu"] = s.n_tdoa_before_imu;
   j["n_tdoa_out_of_order"] = s.n_tdoa_out_of_order;
   j["n_zero_velocity_updates"] = s.n_zero_velocity_updates;
+  j["n_rest_gyro_updates"] = s.n_rest_gyro_updates;
+  j["n_rest_gyro_widenings"] = s.n_rest_gyro_widenings;
   j["n_floor_updates"] = s.n_floor_updates;
   j["n_descent_bound_updates"] = s.n_descent_bound_updates;
   j["n_rest_periods"] = s.n_rest_periods;

@@ -149,9 +149,10 @@ ErrMat initialCovariance(const EkfParams& p) {
   P.block<3, 3>(kAtt, kAtt).diagonal() << p.init_att_sigma_rad * p.init_att_sigma_rad,
       p.init_att_sigma_rad * p.init_att_sigma_rad, p.init_yaw_sigma_rad * p.init_yaw_sigma_rad;
   P.block<3, 3>(kAccBias, kAccBias).diagonal().setConstant(p.init_acc_bias_sigma_mps2 * p.init_acc_bias_sigma_mps2);
-  P.block<3, 3>(kGyroBias, kGyroBias)
-      .diagonal()
-      .setConstant(p.init_gyro_bias_sigma_radps * p.init_gyro_bias_sigma_radps);
+  // (F1) roll/pitch components of the gyro bias are seen through gravity and thrust, the yaw component hardly
+  P.block<3, 3>(kGyroBias, kGyroBias).diagonal() << p.init_gyro_bias_sigma_xy_radps * p.init_gyro_bias_sigma_xy_radps,
+      p.init_gyro_bias_sigma_xy_radps * p.init_gyro_bias_sigma_xy_radps,
+      p.init_gyro_bias_sigma_z_radps * p.init_gyro_bias_sigma_z_radps;
   return P;
 }
 
@@ -433,6 +434,26 @@ void Ekf::zeroVelocityUpdate(double sigma_mps) {
     const ErrVec u = P_.col(kVel + i);
     if (detail::applyRankOneGain<kDim>(dx, P_, m, u, 0.0, u(kVel + i))) inject(dx);  // (F8)
   }
+}
+
+int Ekf::zeroAngularRateUpdate(const Vec3& mean_gyro_radps, const Vec3& var_radps2, double gate_sigma) {
+  // (F18z) ω̄ = b_g + noise per body axis: the row is the unit vector of the bias component, the innovation ω̄ − b̂_g
+  int widened = 0;
+  for (int i = 0; i < 3; ++i) {
+    const int k = kGyroBias + i;
+    ScalarLinearMessage<kDim> m;
+    m.a.setZero();
+    m.a(k) = 1.0;
+    m.y = mean_gyro_radps(i) - x_.b_gyro_bias(i);
+    m.var = var_radps2(i);
+    // never confidently wrong: a reading of the bias beyond chance widens its variance before it is fused
+    if (m.y * m.y > gate_sigma * gate_sigma * (P_(k, k) + m.var)) {
+      P_(k, k) += m.y * m.y;
+      ++widened;
+    }
+    correct(m);
+  }
+  return widened;
 }
 
 void Ekf::positionUpdate(int axis, double value_m, double sigma_m) {

@@ -61,6 +61,7 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
       heading_align_(params.heading_alignment_window_s, InMotionAlignment::kDefaultSamplePeriod_s,
                      InMotionAlignment::kDefaultCorrelation_s, params.rotor_drag_per_s) {
   params_.validate();
+  rest_gyro_ = RestGyroWindow(params_.rest_gyro_window_s, 5);
   if (anchors_.size() < 4) throw std::invalid_argument("Estimator: at least 4 anchors are needed");
   floor_anchors_ = FloorLevelAnchors(anchors_, params_.ground_z_m, params_.floor_anchor_height_m);
   if (floor_anchors_.any()) start_.setFloorLevelAnchors(floor_anchors_.mask());
@@ -539,6 +540,7 @@ void Estimator::superviseGround(double t_s, const ImuReading& imu, double dt_imu
   }
   const bool contact = floorContact(t_s);
   const bool rest = restNearFloor(t_s);
+  restGyroUpdate(t_s, imu, rest);
   // (F29) the IMU's evidence, weighed with the TDoA's by the flight-mode supervisor
   const NavState& x = ekf_.state();
   const bool settled_in_air = !on_ground_ && ready_ && phase_ == FlightPhase::kTracking &&
@@ -552,6 +554,24 @@ void Estimator::superviseGround(double t_s, const ImuReading& imu, double dt_imu
   summary_.n_mode_overrules = static_cast<std::size_t>(mode_.tdoaOverrules());
   summary_.air_shake_rms_radps = std::sqrt(mode_.airShakeLevel());
   followFlightMode(t_s, climbing, contact, shake_ms);
+}
+
+void Estimator::restGyroUpdate(double t_s, const ImuReading& imu, bool rest) {
+  // (F18z) a body at rest on the floor does not turn: each window of its gyro readings reads the gyro bias, as the
+  // Crazyflie calibrates its gyro before take-off; the window's own spread says how well (learned, not assumed)
+  if (!(params_.rest_gyro_updates && imu_mode_ && on_ground_ && ready_ && rest && mode_.mode() == FlightMode::kRest)) {
+    rest_gyro_.clear();
+    return;
+  }
+  const std::optional<GyroWindowStats> w = rest_gyro_.add(t_s, imu.b_gyro_radps);
+  if (!w) return;
+  predictTo(t_s);
+  propagate(true);
+  const double floor_var = params_.rest_gyro_sigma_floor_radps * params_.rest_gyro_sigma_floor_radps;
+  const Vec3 var = w->mean_var_radps2.array() + floor_var;
+  summary_.n_rest_gyro_widenings +=
+      static_cast<std::size_t>(ekf_.zeroAngularRateUpdate(w->mean_radps, var, params_.rest_gyro_gate_sigma));
+  ++summary_.n_rest_gyro_updates;
 }
 
 bool Estimator::updateTakeoffDetector(const ImuReading& imu, double dt_imu, bool shaking) {

@@ -107,6 +107,11 @@ class Ekf {
 
   /// Zero-velocity update v = 0 with std sigma_mps per axis (F14), three scalar corrections.
   void zeroVelocityUpdate(double sigma_mps);
+  /// Zero-angular-rate update at rest (F18z): a body that does not turn reads its gyro bias, b_g = ω̄ with variance
+  /// var per body axis, three scalar corrections. An axis whose innovation lies beyond gate_sigma standard deviations
+  /// of its predicted spread first has its bias variance raised by the innovation's square: the bias std the filter
+  /// started with was too confident for this gyro. Returns the number of axes so widened.
+  int zeroAngularRateUpdate(const Vec3& mean_gyro_radps, const Vec3& var_radps2, double gate_sigma);
   /// Scalar pseudo-measurement of the position along world axis `axis` (0..2): p_axis = value ± sigma.
   void positionUpdate(int axis, double value_m, double sigma_m);
   /// The one-sided constraint p_axis ≥ lower_m (message-passing.md G23): the position's belief along that axis is

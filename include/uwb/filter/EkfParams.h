@@ -62,7 +62,8 @@ struct EkfParams {
   double init_att_sigma_rad = 0.05;
   double init_yaw_sigma_rad = 0.02;           ///< yaw std at the start: TDoA barely observe yaw (F15)
   double init_acc_bias_sigma_mps2 = 0.05;     ///< accelerometer-bias std at the start (F16b′)
-  double init_gyro_bias_sigma_radps = 0.001;  ///< gyro-bias std at the start: calibrated on the ground (F15)
+  double init_gyro_bias_sigma_xy_radps = 0.01;  ///< roll/pitch-axis gyro-bias std at the start [rad/s] (F1)
+  double init_gyro_bias_sigma_z_radps = 0.001;  ///< yaw-axis gyro-bias std at the start: calibrated on the ground (F1)
 
   // --- TDoA measurement ---
   Vec3 b_t_tag = kUtilTagOffset_b;       ///< tag (antenna) position in the body frame [m]
@@ -121,6 +122,10 @@ struct EkfParams {
   double leave_rest_pos_sigma_m = 0.2;   ///< horizontal position std added when the body leaves rest [m] (F20)
   double zupt_period_s = 0.01;           ///< period of the zero-velocity updates and of the checks in flight [s] (F14)
   double zupt_sigma_mps = 0.02;          ///< std of a zero-velocity update [m/s] (F14)
+  bool rest_gyro_updates = true;         ///< zero-angular-rate updates of the gyro bias at rest (F18z)
+  double rest_gyro_window_s = 0.1;       ///< window of one zero-angular-rate update [s] (F18z)
+  double rest_gyro_sigma_floor_radps = 3e-4;  ///< std added to a window mean's own [rad/s] (F18z)
+  double rest_gyro_gate_sigma = 4.0;     ///< a bias reading beyond this many σ widens the bias variance (F18z)
   double level_window_s = 0.1;           ///< levelling window before the first prediction [s] (F15)
   int level_max_samples = 100;           ///< … or this many IMU samples, whichever comes first (F15)
   double level_rest_acc_std_mps2 = 0.15; ///< |f| std below this over the levelling window: at rest [m/s²] (F15)

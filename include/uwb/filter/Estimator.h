@@ -37,6 +37,7 @@
 #include "uwb/filter/EkfParams.h"
 #include "uwb/filter/InMotionAlignment.h"
 #include "uwb/filter/RestDetector.h"
+#include "uwb/filter/RestGyroWindow.h"
 #include "uwb/filter/SensorRange.h"
 #include "uwb/filter/SensorEvents.h"
 #include "uwb/filter/StartReplay.h"
@@ -98,6 +99,8 @@ struct LocalizerSummary {
   std::size_t n_predictions = 0;
   std::size_t n_covariance_propagations = 0;
   std::size_t n_zero_velocity_updates = 0;
+  std::size_t n_rest_gyro_updates = 0;     ///< zero-angular-rate updates of the gyro bias at rest (F18z)
+  std::size_t n_rest_gyro_widenings = 0;   ///< … whose bias reading widened the bias variance (F18z)
   std::size_t n_floor_updates = 0;     ///< floor constraint applied (F22)
   std::size_t n_descent_bound_updates = 0;  ///< height held down to the dead-reckoned descent while landing (F26)
   std::size_t n_rest_periods = 0;      ///< times the body came to rest
@@ -219,6 +222,8 @@ class Estimator {
   bool floorContact(double t_s) const;
   /// (F18) Rest that may enter the ground: near the floor, not climbing, or within a landing's window.
   bool restNearFloor(double t_s);
+  /// (F18z) The gyro readings of a body at rest on the floor, window by window, as readings of the gyro bias.
+  void restGyroUpdate(double t_s, const ImuReading& imu, bool rest);
   /// (F29, F29e) Floor checks, and entering or leaving the ground as the flight mode decided.
   void followFlightMode(double t_s, bool climbing, bool contact, double shake_ms);
   /// (F14, F16, F22, F26) The zero-velocity update on the ground; in flight the floor, descent and divergence checks.
@@ -282,6 +287,7 @@ class Estimator {
   DescentBound descent_;  ///< dead-reckoned descent while landing (F26)
   Ekf ekf_;
   RestDetector rest_;
+  RestGyroWindow rest_gyro_{0.1, 5};  ///< (F18z) window from the params; 5 readings at least
   FlightModeSupervisor mode_;  ///< ground or air from all the evidence (F29)
   TdoaModelParams tdoa_model_;  ///< the tag lever arm for the supervisor's TDoA heights (F29c)
   // (F30) the innovation consistency check: forgotten sums of the clipped NIS and of the count
