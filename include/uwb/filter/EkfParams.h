@@ -133,6 +133,8 @@ struct EkfParams {
   double start_max_rms_residual_m = 1.0; ///< a re-acquisition fix with a larger robust RMS residual fails [m] (F16)
   double floor_refute_height_m = 1.2;    ///< a moving solve this high above the floor refutes a floor start [m] (F16j)
   double floor_refute_residual_ratio = 1.5;  ///< … with an RMS residual ≤ this many times the floor solve's (F16j)
+  double start_max_speed_mps = 5.0;      ///< a moving solve faster than this is a failed solve [m/s] (F16b)
+  double start_floor_height_sigma_m = 0.1;  ///< height std of a fix on the floor [m] (F16c)
   double moving_start_vel_sigma_mps = 1.0;  ///< velocity std when the IMU starts while moving (in the air) [m/s]
   bool start_replay = true;              ///< a first start in motion reruns the filter over its window (F16g)
   double moving_start_att_sigma_rad = 0.1;  ///< roll/pitch std when the IMU starts while moving [rad]
