@@ -8,6 +8,7 @@
 #include <string>
 
 #include "uwb/core/Types.h"
+#include "uwb/filter/FlightMode.h"
 
 namespace uwb {
 
@@ -157,6 +158,7 @@ struct EkfParams {
   double air_shake_settle_s = 2.0;       ///< airborne shaking learned from this long after leaving ground [s] (F29b)
   double air_shake_min_height_m = 0.5;   ///< … and this high above the floor [m] (F29b)
   double floor_check_period_s = 3.0;     ///< a floor check in contact runs at most this often [s] (F29e)
+  FlightModeParams flight_mode;          ///< the flight-mode supervisor's tunables, registered as mode_… (F29)
 
   // --- re-acquisition and divergence (F16, F16d) ---
   int lost_min_rejections = 20;          ///< lost also needs at least this many rejections in a row (F16)
