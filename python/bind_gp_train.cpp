@@ -16,6 +16,13 @@ MatX matX(const py::handle& obj, const char* name) {
   return Eigen::Map<const RowMat>(a.data(), a.shape(0), a.shape(1));
 }
 VecX vecX(const py::handle& obj, const char* name) { return toMatrix(obj, 0, name).col(0); }
+/// The targets y of the rows of X, one per row.
+VecX targets(const py::handle& y, const MatX& X, const char* y_name, const char* x_name) {
+  VecX v = vecX(y, y_name);
+  if (v.size() != X.rows())
+    throw std::invalid_argument(std::string(y_name) + ": length differs from the rows of " + x_name);
+  return v;
+}
 
 SvgpTrainParams trainParams(const py::kwargs& kw) {
   SvgpTrainParams p;
@@ -50,6 +57,52 @@ SvgpTrainParams trainParams(const py::kwargs& kw) {
   return p;
 }
 
+/// on_epoch(dict) after every epoch, holding the GIL; empty when on_epoch is None.
+std::function<void(const gp::EpochReport&)> epochCallback(const py::object& on_epoch) {
+  if (on_epoch.is_none()) return {};
+  return [&on_epoch](const gp::EpochReport& r) {
+    py::gil_scoped_acquire acquire;
+    py::dict d;
+    d["epoch"] = r.epoch, d["epochs"] = r.epochs, d["elbo"] = r.elbo, d["val_rmse"] = r.val_rmse;
+    d["elapsed_s"] = r.elapsed_s;
+    on_epoch(d);
+  };
+}
+
+/// The training summary as train_svgp returns it: the per-epoch history as arrays, and the totals.
+py::dict trainSummaryDict(const gp::SvgpTrainSummary& s) {
+  const auto n = static_cast<Eigen::Index>(s.history.size());
+  RowMat h(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) h.row(i) << s.history[i].elbo, s.history[i].val_rmse, s.history[i].elapsed_s;
+  py::dict d;
+  d["elbo"] = toNumpy(h.col(0), true), d["val_rmse"] = toNumpy(h.col(1), true);
+  d["elapsed_s"] = toNumpy(h.col(2), true), d["seconds"] = s.seconds, d["steps"] = s.steps;
+  d["batches_per_epoch"] = s.batches_per_epoch, d["final_elbo"] = s.final_elbo;
+  return d;
+}
+
+/// train_svgp: trains gp in place on (X, y), validated on (X_val, y_val) when given, without the GIL.
+py::dict trainSvgpOnArrays(Svgp& gp, const py::handle& X, const py::handle& y, const py::object& X_val,
+                           const py::object& y_val, const py::object& on_epoch, const py::kwargs& kw) {
+  const SvgpTrainParams params = trainParams(kw);
+  const MatX Xm = matX(X, "X");
+  const VecX yv = targets(y, Xm, "y", "X");
+  MatX Xv;
+  VecX yvv;
+  const bool has_val = !X_val.is_none();
+  if (has_val) {
+    Xv = matX(X_val, "X_val");
+    yvv = targets(y_val, Xv, "y_val", "X_val");
+  }
+  const std::function<void(const gp::EpochReport&)> callback = epochCallback(on_epoch);
+  gp::SvgpTrainSummary s;
+  {
+    py::gil_scoped_release release;
+    s = gp::trainSvgp(gp, Xm, yv, params, has_val ? &Xv : nullptr, has_val ? &yvv : nullptr, callback);
+  }
+  return trainSummaryDict(s);
+}
+
 }  // namespace
 
 void bindGpTrain(py::module_& m) {
@@ -65,8 +118,7 @@ void bindGpTrain(py::module_& m) {
       [](const gp::Kernel& kernel, const py::handle& X, const py::handle& y, int num_inducing, std::uint64_t seed,
          bool standardize) {
         const MatX Xm = matX(X, "X");
-        const VecX yv = vecX(y, "y");
-        if (yv.size() != Xm.rows()) throw std::invalid_argument("y: length differs from the rows of X");
+        const VecX yv = targets(y, Xm, "y", "X");
         return gp::initSvgp(kernel, Xm, yv, num_inducing, seed,
                             standardize ? gp::InputNormalization::kStandardize : gp::InputNormalization::kNone);
       },
@@ -74,47 +126,8 @@ void bindGpTrain(py::module_& m) {
       py::arg("standardize") = false,
       "A fresh SVGP for (X, y): inducing points by k-means++, mean = mean(y), scales from var(y).");
   m.def(
-      "train_svgp",
-      [](Svgp& gp, const py::handle& X, const py::handle& y, const py::object& X_val, const py::object& y_val,
-         const py::object& on_epoch, const py::kwargs& kw) {
-        const SvgpTrainParams params = trainParams(kw);
-        const MatX Xm = matX(X, "X");
-        const VecX yv = vecX(y, "y");
-        if (yv.size() != Xm.rows()) throw std::invalid_argument("y: length differs from the rows of X");
-        MatX Xv;
-        VecX yvv;
-        const bool has_val = !X_val.is_none();
-        if (has_val) {
-          Xv = matX(X_val, "X_val");
-          yvv = vecX(y_val, "y_val");
-          if (yvv.size() != Xv.rows()) throw std::invalid_argument("y_val: length differs from the rows of X_val");
-        }
-        std::function<void(const gp::EpochReport&)> callback;
-        if (!on_epoch.is_none()) {
-          callback = [&on_epoch](const gp::EpochReport& r) {
-            py::gil_scoped_acquire acquire;
-            py::dict d;
-            d["epoch"] = r.epoch, d["epochs"] = r.epochs, d["elbo"] = r.elbo, d["val_rmse"] = r.val_rmse;
-            d["elapsed_s"] = r.elapsed_s;
-            on_epoch(d);
-          };
-        }
-        gp::SvgpTrainSummary s;
-        {
-          py::gil_scoped_release release;
-          s = gp::trainSvgp(gp, Xm, yv, params, has_val ? &Xv : nullptr, has_val ? &yvv : nullptr, callback);
-        }
-        const auto n = static_cast<Eigen::Index>(s.history.size());
-        RowMat h(n, 3);
-        for (Eigen::Index i = 0; i < n; ++i) h.row(i) << s.history[i].elbo, s.history[i].val_rmse, s.history[i].elapsed_s;
-        py::dict d;
-        d["elbo"] = toNumpy(h.col(0), true), d["val_rmse"] = toNumpy(h.col(1), true);
-        d["elapsed_s"] = toNumpy(h.col(2), true), d["seconds"] = s.seconds, d["steps"] = s.steps;
-        d["batches_per_epoch"] = s.batches_per_epoch, d["final_elbo"] = s.final_elbo;
-        return d;
-      },
-      py::arg("gp"), py::arg("X"), py::arg("y"), py::arg("X_val") = py::none(), py::arg("y_val") = py::none(),
-      py::arg("on_epoch") = py::none(),
+      "train_svgp", &trainSvgpOnArrays, py::arg("gp"), py::arg("X"), py::arg("y"), py::arg("X_val") = py::none(),
+      py::arg("y_val") = py::none(), py::arg("on_epoch") = py::none(),
       "Optimizes gp in place on (X, y) (Adam + natural gradients). Keyword arguments override SvgpTrainParams\n"
       "(epochs, batch_size, seed, lr, lr_inducing, natgrad_step, train_inducing, ...). on_epoch(dict) is called\n"
       "after every epoch. Returns {elbo, val_rmse, elapsed_s (per epoch), seconds, steps, batches_per_epoch,\n"
@@ -124,8 +137,7 @@ void bindGpTrain(py::module_& m) {
       "full_data_elbo",
       [](const Svgp& gp, const py::handle& X, const py::handle& y, int num_threads) {
         const MatX Xm = matX(X, "X");
-        const VecX yv = vecX(y, "y");
-        if (yv.size() != Xm.rows()) throw std::invalid_argument("y: length differs from the rows of X");
+        const VecX yv = targets(y, Xm, "y", "X");
         py::gil_scoped_release release;
         return gp::fullDataElbo(gp, Xm, yv, num_threads).elbo;
       },

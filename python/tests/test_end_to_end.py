@@ -148,6 +148,12 @@ def test_eval_errors_are_value_and_os_errors(flights, trained, tmp_path):
         u.localize_flight(test["flight"], test["survey"], params={"tdoa_sigma": 0.3})
     with pytest.raises(ValueError, match="unknown filter preset"):
         u.localize_flight(test["flight"], test["survey"], preset="fast")
+    # the flight-mode supervisor's parameters (mode_…, filter.md F29) are checked like the others, orderings included
+    assert {"mode_tdoa_window_s", "start_max_speed_mps", "start_floor_height_sigma_m"} <= set(u.filter_param_names())
+    with pytest.raises(ValueError, match="params: mode_tdoa_window_s must be > 0"):
+        u.localize_flight(test["flight"], test["survey"], params={"mode_tdoa_window_s": 0.0})
+    with pytest.raises(ValueError, match="air_max_height_m > air_min_height_m"):
+        u.localize_flight(test["flight"], test["survey"], params={"mode_air_max_height_m": 0.2})
     with pytest.raises(ValueError):
         u.train_bias_model(data, "no-such-kernel", 10)
     with pytest.raises(OSError):

@@ -37,10 +37,11 @@ SignatureCell cell(std::string name, double gyro_dps, double acc_g, bool replace
   return c;
 }
 
-/// A floor that shakes (idling: gyro and 0.05 g of accelerometer) or is held in a hand (S24b), gyro RMS in °/s.
-SignatureCell floorCell(sim::FloorImu floor, double gyro_dps) {
-  SignatureCell c;
-  c.name = "floor " + sim::toString(floor) + " " + std::to_string(static_cast<int>(gyro_dps)) + "°/s";
+/// A floor that shakes (idling: gyro and 0.05 g of accelerometer) or is held in a hand (S24b), gyro RMS in °/s: a cell
+/// of its own, named after its floor, or the floor of the combined cell `c` (which keeps its name).
+SignatureCell floorCell(sim::FloorImu floor, double gyro_dps, SignatureCell c = {}) {
+  if (c.name.empty())
+    c.name = "floor " + sim::toString(floor) + " " + std::to_string(static_cast<int>(gyro_dps)) + "°/s";
   c.signature.floor = floor;
   c.signature.floor_gyro_vib_rms_radps = gyro_dps * kDeg;
   if (floor == sim::FloorImu::kIdle) c.signature.floor_acc_vib_rms_mps2 = 0.05 * kG;
@@ -120,15 +121,12 @@ std::vector<SignatureCell> signatureCells(bool transplant) {
   slow.signature.lag_s = 0.03;
   cells.push_back(slow);
   SignatureCell idle = cell("combined: floor idle 40°/s, gyro 20°/s, 1000 Hz, lag 10 ms", 20.0, acc, transplant);
-  idle.signature.floor = sim::FloorImu::kIdle;
-  idle.signature.floor_gyro_vib_rms_radps = 40.0 * kDeg;
-  idle.signature.floor_acc_vib_rms_mps2 = 0.05 * kG;
+  idle = floorCell(sim::FloorImu::kIdle, 40.0, idle);
   idle.signature.rate_hz = 1000.0;
   idle.signature.lag_s = 0.01;
   cells.push_back(idle);
   SignatureCell held = cell("combined: hand-held 30°/s, gyro 20°/s, gyro bias 3°/s", 20.0, acc, transplant);
-  held.signature.floor = sim::FloorImu::kHandHeld;
-  held.signature.floor_gyro_vib_rms_radps = 30.0 * kDeg;
+  held = floorCell(sim::FloorImu::kHandHeld, 30.0, held);
   held.signature.gyro_bias_radps = gb.signature.gyro_bias_radps;
   cells.push_back(held);
   return cells;

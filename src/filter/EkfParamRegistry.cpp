@@ -20,16 +20,35 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 const EkfParamRange kPositive{0.0, kInf, true, true};
 const EkfParamRange kNonNegative{0.0, kInf, false, true};
 const EkfParamRange kFinite{-kInf, kInf, true, true};
+EkfParamRange atLeast(double lo) { return {lo, kInf, false, true}; }
 
-EkfParamInfo real(std::string name, double EkfParams::*field, std::string unit, EkfParamRange range, std::string doc,
-                  std::string alias = "") {
+/// A real parameter; `field(p)` is its field in p (of EkfParams itself, or of a Params struct nested in it).
+template <class Field>
+EkfParamInfo realAt(std::string name, Field field, std::string unit, EkfParamRange range, std::string doc,
+                    std::string alias) {
   EkfParamInfo i;
   i.name = std::move(name), i.cli_alias = std::move(alias), i.unit = std::move(unit), i.doc = std::move(doc);
   i.kind = EkfParamKind::kReal;
   i.range = range;
-  i.get = [field](const EkfParams& p) { return EkfParamValue(p.*field); };
-  i.set = [field](EkfParams& p, const EkfParamValue& v) { p.*field = std::get<double>(v); };
+  i.get = [field](const EkfParams& p) { return EkfParamValue(field(p)); };
+  i.set = [field](EkfParams& p, const EkfParamValue& v) { field(p) = std::get<double>(v); };
   return i;
+}
+
+EkfParamInfo real(std::string name, double EkfParams::*field, std::string unit, EkfParamRange range, std::string doc,
+                  std::string alias = "") {
+  return realAt(
+      std::move(name), [field](auto& p) -> auto& { return p.*field; }, std::move(unit), range, std::move(doc),
+      std::move(alias));
+}
+
+/// A real field of the Params struct `group` nested in EkfParams (e.g. flight_mode).
+template <class Group>
+EkfParamInfo real(std::string name, Group EkfParams::*group, double Group::*field, std::string unit,
+                  EkfParamRange range, std::string doc) {
+  return realAt(
+      std::move(name), [group, field](auto& p) -> auto& { return (p.*group).*field; }, std::move(unit), range,
+      std::move(doc), "");
 }
 
 EkfParamInfo integer(std::string name, int EkfParams::*field, EkfParamRange range, std::string doc) {
@@ -79,6 +98,7 @@ EkfParamInfo choice(std::string name, E EkfParams::*field, std::vector<std::stri
 
 std::vector<EkfParamInfo> makeRegistry() {
   using P = EkfParams;
+  using M = FlightModeParams;
   const char* sd = "m/s^2/sqrt(Hz)";
   return {
       // --- process noise (continuous-time spectral densities, docs/math/filter.md F5) ---
@@ -262,6 +282,10 @@ std::vector<EkfParamInfo> makeRegistry() {
            "A first start on floor contact is refuted when the solve in motion stays this high above the floor (F16j)"),
       real("floor_refute_residual_ratio", &P::floor_refute_residual_ratio, "", kPositive,
            "... with an RMS residual at most this many times the floor solve's (F16j)"),
+      real("start_max_speed_mps", &P::start_max_speed_mps, "m/s", kPositive,
+           "A moving start's solve faster than this is a failed solve (F16b)"),
+      real("start_floor_height_sigma_m", &P::start_floor_height_sigma_m, "m", kPositive,
+           "Height std of a start's fix on the floor (F16c)"),
       real("moving_start_vel_sigma_mps", &P::moving_start_vel_sigma_mps, "m/s", kPositive,
            "Velocity std when the IMU starts while moving (F15)"),
       boolean("start_replay", &P::start_replay,
@@ -303,6 +327,40 @@ std::vector<EkfParamInfo> makeRegistry() {
            "... and this high above the floor (F29b)"),
       real("floor_check_period_s", &P::floor_check_period_s, "s", kNonNegative,
            "A floor check in contact runs at most this often (F29e)"),
+      // --- the flight-mode supervisor (F29; FlightModeParams, the fields of flight_mode) ---
+      real("mode_imu_max_log_odds", &P::flight_mode, &M::imu_max_log_odds, "nats", kPositive,
+           "Bound of the IMU's log-odds airborne : floor from shaking and climbs, L_IMU (F29a)"),
+      real("mode_imu_rest_log_odds", &P::flight_mode, &M::imu_rest_log_odds, "nats", kPositive,
+           "Bound of the IMU's log-odds towards the floor while it reads rest, L_rest; at least mode_imu_max_log_odds "
+           "(F29a)"),
+      real("mode_imu_rate_per_s", &P::flight_mode, &M::imu_rate_per_s, "nats/s", kPositive,
+           "Rate at which the IMU's log-odds move (F29a)"),
+      real("mode_tdoa_max_log_odds", &P::flight_mode, &M::tdoa_max_log_odds, "nats", kPositive,
+           "Bound of the TDoA's Bayes factor for the air (F29c)"),
+      real("mode_tdoa_max_floor_log_odds", &P::flight_mode, &M::tdoa_max_floor_log_odds, "nats", kNonNegative,
+           "Bound of the TDoA's Bayes factor for the floor; above it the floor is doubted (F29c, F29d)"),
+      real("mode_tdoa_window_s", &P::flight_mode, &M::tdoa_window_s, "s", kPositive,
+           "Forgetting time of the TDoA height window (F29c)"),
+      real("mode_tdoa_min_effective", &P::flight_mode, &M::tdoa_min_effective, "", atLeast(2.0),
+           "The TDoA window says nothing while it holds fewer (forgotten) TDoA than this (F29c)"),
+      real("mode_tdoa_independent", &P::flight_mode, &M::tdoa_independent, "", atLeast(1.0),
+           "Independent TDoA a window counts as at most: their errors are correlated in time (F29c)"),
+      real("mode_min_vertical_gain", &P::flight_mode, &M::min_vertical_gain, "", kPositive,
+           "A TDoA whose vertical sensitivity dh/dz is below this in magnitude says nothing of the height (F29c)"),
+      real("mode_height_floor_sigma_m", &P::flight_mode, &M::height_floor_sigma_m, "m", kPositive,
+           "Spread added to both hypotheses' mean squares of the TDoA heights (F29c)"),
+      real("mode_air_min_height_m", &P::flight_mode, &M::air_min_height_m, "m", kNonNegative,
+           "Lowest flight height above the floor of the TDoA's air hypothesis (F29c)"),
+      real("mode_air_max_height_m", &P::flight_mode, &M::air_max_height_m, "m", kPositive,
+           "Highest flight height above the floor of the TDoA's air hypothesis; above mode_air_min_height_m (F29c)"),
+      real("mode_hysteresis_log_odds", &P::flight_mode, &M::hysteresis_log_odds, "nats", kNonNegative,
+           "A mode is left when the summed log-odds pass -/+ this (F29)"),
+      real("mode_air_shake_ratio", &P::flight_mode, &M::air_shake_ratio, "", atLeast(1.0),
+           "Floor shaking: a gyro mean square above this times the flight's airborne shaking level (F29b)"),
+      real("mode_air_shake_prior_ms", &P::flight_mode, &M::air_shake_prior_ms, "rad^2/s^2", kPositive,
+           "Airborne shaking level (high-passed gyro mean square) before it is measured (F29b)"),
+      real("mode_air_shake_tau_s", &P::flight_mode, &M::air_shake_tau_s, "s", kPositive,
+           "Time constant of the learned airborne shaking level (F29b)"),
       // --- re-acquisition and divergence (F16, F16d) ---
       integer("lost_min_rejections", &P::lost_min_rejections, EkfParamRange{0, 1e6},
               "Lost (F16) also needs at least this many TDoA rejected in a row"),

@@ -15,6 +15,7 @@ void EkfParams::validate() const {
   // what a range cannot say
   if (antenna_bias_degree == 1)
     throw std::invalid_argument("EkfParams.antenna_bias_degree must be 0 (off) or in [2, 4]");
+  flight_mode.validate();  // (F29) the supervisor's own checks, with the orderings of its bounds and heights
 }
 
 EkfParams EkfParams::crazyflieLike() {

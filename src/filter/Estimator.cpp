@@ -56,6 +56,7 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
       imu_mode_(params.process_model == ProcessModel::kImu),
       descent_(DescentBoundParams{params.descent_margin_m}),
       ekf_(params),
+      mode_(params.flight_mode),
       start_(anchors_, params.b_t_tag, StartUpParams::fromEkfParams(params)),
       replay_(params),
       heading_align_(params.heading_alignment_window_s, InMotionAlignment::kDefaultSamplePeriod_s,

@@ -29,12 +29,14 @@ std::string toString(FlightMode mode) {
 }
 
 void FlightModeParams::validate() const {
-  if (!(imu_max_log_odds > 0.0 && imu_rest_log_odds >= imu_max_log_odds && imu_rate_per_s > 0.0 && tdoa_max_log_odds > 0.0 && tdoa_max_floor_log_odds >= 0.0 && tdoa_window_s > 0.0 &&
+  if (!(imu_max_log_odds > 0.0 && imu_rest_log_odds >= imu_max_log_odds && imu_rate_per_s > 0.0 &&
+        tdoa_max_log_odds > 0.0 && tdoa_max_floor_log_odds >= 0.0 && tdoa_window_s > 0.0 &&
         tdoa_min_effective >= 2.0 && tdoa_independent >= 1.0 && min_vertical_gain > 0.0 &&
         height_floor_sigma_m > 0.0 && air_min_height_m >= 0.0 && air_max_height_m > air_min_height_m &&
         hysteresis_log_odds >= 0.0 && air_shake_ratio >= 1.0 && air_shake_prior_ms > 0.0 && air_shake_tau_s > 0.0))
     throw std::invalid_argument("FlightModeParams: bounds, rates, windows and sigmas must be > 0, "
-                                "air_max_height_m > air_min_height_m, air_shake_ratio >= 1, tdoa_min_effective >= 2");
+                                "imu_rest_log_odds >= imu_max_log_odds, air_max_height_m > air_min_height_m, "
+                                "air_shake_ratio >= 1, tdoa_min_effective >= 2, tdoa_independent >= 1");
 }
 
 FlightModeSupervisor::FlightModeSupervisor(const FlightModeParams& params)

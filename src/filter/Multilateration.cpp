@@ -210,34 +210,48 @@ FloorDelayColumns floorDelayColumns(const std::vector<MultilaterationSample>& sa
   return c;
 }
 
-}  // namespace
+/// (F16f) At most this many delays: a fixed-size system, no heap; unused columns are identity rows with a zero step.
+constexpr int kMaxFloorDelays = 8;
+using MatU = Eigen::Matrix<double, kMaxFloorDelays + 2, kMaxFloorDelays + 2>;
+using VecU = Eigen::Matrix<double, kMaxFloorDelays + 2, 1>;
 
-std::optional<MultilaterationResult> multilaterateOnFloorWithDelays(
-    const std::vector<MultilaterationSample>& samples, const AnchorTable& anchors, const Vec3& b_t_tag,
-    const std::vector<Vec3>& initial_guesses, double floor_z_m, const std::vector<unsigned char>& floor_level,
-    double huber_k_m, int max_iterations) {
-  // (F16f) unknowns u = (x, y, g_1 … g_L): one range delay per floor-level anchor seen in the batch
-  const auto isFloorLevel = [&](int id) { return isFloorLevelAnchor(floor_level, id); };
-  const FloorDelayColumns columns = floorDelayColumns(samples, anchors, floor_level);
+/// (F16f) One start's run as a result: the position on the floor, its covariance, the delays by anchor id; nullopt
+/// when a delay lies outside its range (not a longer first path: a poor geometry fitted the delays to something else).
+std::optional<MultilaterationResult> floorDelayResult(GaussNewtonRun<VecU, MatU>& run, const FloorDelayColumns& columns,
+                                                      double floor_z_m) {
+  const auto implausible = [](double g) { return g < kMinFloorDelay_m || g > kMaxFloorDelay_m; };
+  if (std::any_of(run.x.data() + 2, run.x.data() + columns.n_cols, implausible)) return std::nullopt;
+  MultilaterationResult& res = run.res;
+  res.w_p0 = Vec3(run.x(0), run.x(1), floor_z_m);
+  const MatU Ainv = (run.A + 1e-9 * MatU::Identity()).ldlt().solve(MatU::Identity()) *
+                    (res.rms_residual_m * res.rms_residual_m);
+  res.covariance.setZero();
+  res.covariance.topLeftCorner<2, 2>() = Ainv.topLeftCorner<2, 2>();
+  res.anchor_delay_m.assign(columns.column.size(), std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t id = 0; id < columns.column.size(); ++id)
+    if (columns.column[id] >= 0) res.anchor_delay_m[id] = run.x(columns.column[id]);
+  return res;
+}
+
+/// (F16f) The floor solve over u = (x, y, g_1 … g_L), from each start that differs in x and y; the best plausible run.
+std::optional<MultilaterationResult> solveFloorWithDelays(const std::vector<MultilaterationSample>& samples,
+                                                          const AnchorTable& anchors, const Vec3& b_t_tag,
+                                                          const std::vector<Vec3>& initial_guesses, double floor_z_m,
+                                                          const std::vector<unsigned char>& floor_level,
+                                                          const FloorDelayColumns& columns, double huber_k_m,
+                                                          int max_iterations) {
   const std::vector<int>& column = columns.column;
-  const int n_other = columns.n_other, n_cols = columns.n_cols;
-  // at most kMaxDelays delays (a fixed-size system: no heap; unused columns are identity rows with a zero step);
-  // more floor-level anchors in view than that: the plain solve
-  constexpr int kMaxDelays = 8;
-  if (n_other < 3 || n_cols - 2 > kMaxDelays) return std::nullopt;
-  if (n_cols == 2) return multilaterateOnFloor(samples, anchors, b_t_tag, initial_guesses, floor_z_m, huber_k_m,
-                                               max_iterations);
+  const int n_cols = columns.n_cols;
   const auto delayColumn = [&](int id) {
-    return isFloorLevel(id) && static_cast<std::size_t>(id) < column.size() ? column[static_cast<std::size_t>(id)]
-                                                                             : -1;
+    return isFloorLevelAnchor(floor_level, id) && static_cast<std::size_t>(id) < column.size()
+               ? column[static_cast<std::size_t>(id)]
+               : -1;
   };
   // weak prior g ~ N(0, (5 m)²) in the units of the Huber cost (residual scale k): only an anchor whose delay the
   // batch does not determine (seen in one pair only) is held by it
   constexpr double kDelayPriorSigma_m = 5.0;
   const double lambda = (huber_k_m / kDelayPriorSigma_m) * (huber_k_m / kDelayPriorSigma_m);
   constexpr std::size_t kMinUsed = 4;
-  using MatU = Eigen::Matrix<double, kMaxDelays + 2, kMaxDelays + 2>;
-  using VecU = Eigen::Matrix<double, kMaxDelays + 2, 1>;
   const auto position = [&](const VecU& u, const MultilaterationSample& s) -> Vec3 {
     return Vec3(u(0), u(1), floor_z_m) + s.w_d_b;
   };
@@ -263,7 +277,7 @@ std::optional<MultilaterationResult> multilaterateOnFloorWithDelays(
       g(c) -= lambda * u(c);
       cost += 0.5 * lambda * u(c) * u(c);
     }
-    for (int c = n_cols; c < kMaxDelays + 2; ++c) A(c, c) = 1.0;  // unused columns: a zero step
+    for (int c = n_cols; c < kMaxFloorDelays + 2; ++c) A(c, c) = 1.0;  // unused columns: a zero step
   };
   const auto limit = [](VecU& step) {
     const double sn = step.head<2>().norm();  // as in solve(): at most 2 m of position per step
@@ -279,22 +293,28 @@ std::optional<MultilaterationResult> multilaterateOnFloorWithDelays(
     GaussNewtonRun<VecU, MatU> run = huberGaussNewton<VecU, MatU>(
         u0, samples, anchors, b_t_tag, huber_k_m, max_iterations, kMinUsed, position, row, regularize, limit);
     if (run.res.n_used < kMinUsed || !run.x.allFinite() || !(run.cost < best_cost)) continue;
-    // a delay outside its range is not a longer first path: a poor geometry fitted the delays to something else
-    const auto implausible = [](double g) { return g < kMinFloorDelay_m || g > kMaxFloorDelay_m; };
-    if (std::any_of(run.x.data() + 2, run.x.data() + n_cols, implausible)) continue;
+    std::optional<MultilaterationResult> res = floorDelayResult(run, columns, floor_z_m);
+    if (!res) continue;
     best_cost = run.cost;
-    MultilaterationResult& res = run.res;
-    res.w_p0 = Vec3(run.x(0), run.x(1), floor_z_m);
-    const MatU Ainv = (run.A + 1e-9 * MatU::Identity()).ldlt().solve(MatU::Identity()) *
-                      (res.rms_residual_m * res.rms_residual_m);
-    res.covariance.setZero();
-    res.covariance.topLeftCorner<2, 2>() = Ainv.topLeftCorner<2, 2>();
-    res.anchor_delay_m.assign(column.size(), std::numeric_limits<double>::quiet_NaN());
-    for (std::size_t id = 0; id < column.size(); ++id)
-      if (column[id] >= 0) res.anchor_delay_m[id] = run.x(column[id]);
-    best = res;
+    best = std::move(res);
   }
   return best;
+}
+
+}  // namespace
+
+std::optional<MultilaterationResult> multilaterateOnFloorWithDelays(
+    const std::vector<MultilaterationSample>& samples, const AnchorTable& anchors, const Vec3& b_t_tag,
+    const std::vector<Vec3>& initial_guesses, double floor_z_m, const std::vector<unsigned char>& floor_level,
+    double huber_k_m, int max_iterations) {
+  // (F16f) unknowns u = (x, y, g_1 … g_L): one range delay per floor-level anchor seen in the batch
+  const FloorDelayColumns columns = floorDelayColumns(samples, anchors, floor_level);
+  // more floor-level anchors in view than kMaxFloorDelays: the plain solve
+  if (columns.n_other < 3 || columns.n_cols - 2 > kMaxFloorDelays) return std::nullopt;
+  if (columns.n_cols == 2)
+    return multilaterateOnFloor(samples, anchors, b_t_tag, initial_guesses, floor_z_m, huber_k_m, max_iterations);
+  return solveFloorWithDelays(samples, anchors, b_t_tag, initial_guesses, floor_z_m, floor_level, columns, huber_k_m,
+                              max_iterations);
 }
 
 std::optional<MultilaterationResult> multilaterateMoving(const std::vector<MultilaterationSample>& samples,

@@ -16,7 +16,8 @@ StartUpParams StartUpParams::fromEkfParams(const EkfParams& p) {
           .max_pos_sigma_m = p.init_pos_sigma_m, .min_vel_sigma_mps = p.start_min_vel_sigma_mps,
           .box_margin_m = p.start_box_margin_m, .max_rms_residual_m = p.start_max_rms_residual_m,
           .floor_refute_height_m = p.floor_refute_height_m,
-          .floor_refute_residual_ratio = p.floor_refute_residual_ratio};
+          .floor_refute_residual_ratio = p.floor_refute_residual_ratio, .max_speed_mps = p.start_max_speed_mps,
+          .floor_height_sigma_m = p.start_floor_height_sigma_m};
 }
 
 StartUp::StartUp(const AnchorTable& anchors, const Vec3& b_t_tag, const StartUpParams& params)
@@ -61,7 +62,7 @@ std::optional<StartFix> StartUp::add(const TdoaMeasurement& z, const NavState& x
   const bool inside = r && (!reacquisition_ || r->rms_residual_m <= params_.max_rms_residual_m) &&
                       (r->w_p0.array() >= box_min_.array() - params_.box_margin_m).all() &&
                       (r->w_p0.array() <= box_max_.array() + params_.box_margin_m).all() &&
-                      (!w.moving || r->w_v0.norm() < 5.0);
+                      (!w.moving || r->w_v0.norm() < params_.max_speed_mps);
   if (!inside) {
     retryLater(z.t_s, x_now);
     return std::nullopt;
@@ -151,7 +152,8 @@ StartFix StartUp::fixNow(const WindowSolve& w, double t_now_s, const NavState& x
                            : params_.min_vel_sigma_mps;
   fix.cov.setZero();
   fix.cov.block<3, 3>(0, 0) = sp * sp * Mat3::Identity();
-  if (w.on_floor) fix.cov(2, 2) = 0.1 * 0.1;  // on the floor: the height is known to a few cm (F22)
+  // on the floor: the height is known to a few cm (F16c, F22)
+  if (w.on_floor) fix.cov(2, 2) = params_.floor_height_sigma_m * params_.floor_height_sigma_m;
   fix.cov.block<3, 3>(3, 3) = sv * sv * Mat3::Identity();
   return fix;
 }

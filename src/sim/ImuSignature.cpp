@@ -291,7 +291,8 @@ void applyImuSignature(Flight& flight, const ImuSignature& sig, std::uint64_t se
   applyToStream(flight.gyro, sig, true, flight.pose, floor_z, hand ? &*hand : nullptr, rng);
   applyToStream(flight.acc, sig, false, flight.pose, floor_z, hand ? &*hand : nullptr, rng);
   if (sig.rate_hz > 0.0 && !faster) {
-    const auto factor = static_cast<std::size_t>(std::max(1.0, std::round(1.0 / (sig.rate_hz * meanPeriod(flight.gyro)))));
+    const auto factor =
+        static_cast<std::size_t>(std::max(1.0, std::round(1.0 / (sig.rate_hz * meanPeriod(flight.gyro)))));
     decimate(flight.gyro, factor);
     decimate(flight.acc, factor);
   }

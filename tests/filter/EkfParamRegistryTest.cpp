@@ -17,14 +17,16 @@
 namespace uwb {
 namespace {
 
-/// Field names declared in `struct EkfParams { … }` of the header (lines "type name = default;").
-std::set<std::string> fieldsDeclaredInHeader() {
-  std::ifstream in(std::string(UWB_SOURCE_DIR) + "/include/uwb/filter/EkfParams.h");
-  EXPECT_TRUE(in) << "cannot read EkfParams.h";
+/// Field names declared in `struct <name> { … }` of a header under include/uwb/filter (lines "type name = default;"),
+/// each with `prefix` in front: the registry's names of a nested Params struct carry one.
+std::set<std::string> fieldsDeclaredInHeader(const std::string& header, const std::string& name,
+                                             const std::string& prefix = "") {
+  std::ifstream in(std::string(UWB_SOURCE_DIR) + "/include/uwb/filter/" + header);
+  EXPECT_TRUE(in) << "cannot read " << header;
   std::stringstream ss;
   ss << in.rdbuf();
   const std::string text = ss.str();
-  const std::size_t begin = text.find("struct EkfParams {");
+  const std::size_t begin = text.find("struct " + name + " {");
   const std::size_t end = text.find("void validate() const;", begin);
   EXPECT_NE(begin, std::string::npos);
   const std::string body = text.substr(begin, end - begin);
@@ -34,7 +36,16 @@ std::set<std::string> fieldsDeclaredInHeader() {
   std::string line;
   std::smatch m;
   while (std::getline(lines, line))
-    if (std::regex_match(line, m, field)) names.insert(m[1]);
+    if (std::regex_match(line, m, field)) names.insert(prefix + m[1].str());
+  return names;
+}
+
+/// The EkfParams fields, with those of its nested FlightModeParams flight_mode as mode_<field>.
+std::set<std::string> fieldsDeclaredInHeader() {
+  std::set<std::string> names = fieldsDeclaredInHeader("EkfParams.h", "EkfParams");
+  const std::set<std::string> mode = fieldsDeclaredInHeader("FlightMode.h", "FlightModeParams", "mode_");
+  EXPECT_GT(mode.size(), 10u);
+  names.insert(mode.begin(), mode.end());
   return names;
 }
 
@@ -152,6 +163,20 @@ TEST(EkfParamRegistry, BadValuesNameTheParameterTheSourceAndTheValue) {
     EXPECT_EQ(std::string(e.what()), "gate_sigma must be > 0 (got 0)");
   }
   EXPECT_EQ(p.tdoa_sigma_m, EkfParams{}.tdoa_sigma_m);  // nothing was set by the failed calls
+}
+
+TEST(EkfParamRegistry, FlightModeFieldsAreTheNestedStructs) {
+  // GIVEN a flight-mode parameter set through the registry, as the CLI and Python set it
+  EkfParams p;
+  setEkfParamFromText(p, ekfParamInfo("mode_tdoa_window_s"), "0.8", "--mode-tdoa-window-s");
+  // THEN the field of the nested FlightModeParams holds it
+  EXPECT_EQ(p.flight_mode.tdoa_window_s, 0.8);
+  EXPECT_EQ(ekfParamText(p, ekfParamInfo("mode_tdoa_window_s")), "0.8");
+  // AND an ordering that no range can say (the flight heights) is checked by EkfParams::validate
+  p = EkfParams{};
+  setEkfParam(p, ekfParamInfo("mode_air_max_height_m"), 0.2, "params");  // in its range, below the minimum height
+  EXPECT_NO_THROW(validateEkfParamRanges(p));
+  EXPECT_THROW(p.validate(), std::invalid_argument);
 }
 
 TEST(EkfParamRegistry, HelpAndMarkdownShowUnitDefaultAndRange) {

@@ -270,6 +270,22 @@ TEST(Estimator, AMotorsOffStartIsOnTheGroundBeforeItsFirstFix) {
   EXPECT_LT((r.estimates.back().x.w_p_b - Vec3(0.8, -0.5, 1.05)).norm(), 0.15);
 }
 
+TEST(Estimator, TheFlightModeSupervisorTakesItsParamsFromEkfParams) {
+  // GIVEN a take-off flight, and EkfParams whose prior airborne shaking level (F29b) lies far above any level the
+  // flight shows (the learned level never falls below its prior)
+  filtertest::TakeoffLogSpec spec;
+  spec.duration_s = 6.0;
+  const SensorLog log = filtertest::takeoffLog(spec);
+  EkfParams raised;
+  raised.flight_mode.air_shake_prior_ms = 3.0 * 3.0;
+  // WHEN localizing with them and with the defaults
+  const LocalizerResult with_raised = TdoaLocalizer(raised, arenaAnchors()).run(log);
+  const LocalizerResult with_defaults = TdoaLocalizer(EkfParams{}, arenaAnchors()).run(log);
+  // THEN the estimator's supervisor holds the given prior, and the defaults' level stays below it
+  EXPECT_GE(with_raised.summary.air_shake_rms_radps, 3.0);
+  EXPECT_LT(with_defaults.summary.air_shake_rms_radps, 3.0);
+}
+
 TEST(RestDetector, AStillWindowSeedsRestWithinTheHold) {
   // GIVEN a body still from its first sample, and the moments of its first 0.1 s
   std::mt19937 rng(6);

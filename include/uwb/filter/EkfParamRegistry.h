@@ -5,8 +5,8 @@
  *         the generated table docs/parameters.md (`uwbtdoa params --markdown`).
  *
  *  Adding a field to EkfParams is one line in src/filter/EkfParamRegistry.cpp (a test fails until it is there).
- *  Names are the struct fields; the CLI flag is the name with '-' for '_' (`--tdoa-sigma-m`), plus an optional
- *  short alias (`--tdoa-sigma`).
+ *  Names are the struct fields (those of the nested flight_mode with the prefix mode_); the CLI flag is the name with
+ *  '-' for '_' (`--tdoa-sigma-m`), plus an optional short alias (`--tdoa-sigma`).
  */
 #pragma once
 

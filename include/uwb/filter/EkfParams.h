@@ -8,6 +8,7 @@
 #include <string>
 
 #include "uwb/core/Types.h"
+#include "uwb/filter/FlightMode.h"
 
 namespace uwb {
 
@@ -138,6 +139,8 @@ struct EkfParams {
   double start_max_rms_residual_m = 1.0; ///< a re-acquisition fix with a larger robust RMS residual fails [m] (F16)
   double floor_refute_height_m = 1.2;    ///< a moving solve this high above the floor refutes a floor start [m] (F16j)
   double floor_refute_residual_ratio = 1.5;  ///< … with an RMS residual ≤ this many times the floor solve's (F16j)
+  double start_max_speed_mps = 5.0;      ///< a moving solve faster than this is a failed solve [m/s] (F16b)
+  double start_floor_height_sigma_m = 0.1;  ///< height std of a fix on the floor [m] (F16c)
   double moving_start_vel_sigma_mps = 1.0;  ///< velocity std when the IMU starts while moving (in the air) [m/s]
   bool start_replay = true;              ///< a first start in motion reruns the filter over its window (F16g)
   double moving_start_att_sigma_rad = 0.1;  ///< roll/pitch std when the IMU starts while moving [rad]
@@ -160,6 +163,7 @@ struct EkfParams {
   double air_shake_settle_s = 2.0;       ///< airborne shaking learned from this long after leaving ground [s] (F29b)
   double air_shake_min_height_m = 0.5;   ///< … and this high above the floor [m] (F29b)
   double floor_check_period_s = 3.0;     ///< a floor check in contact runs at most this often [s] (F29e)
+  FlightModeParams flight_mode;          ///< the flight-mode supervisor's tunables, registered as mode_… (F29)
 
   // --- re-acquisition and divergence (F16, F16d) ---
   int lost_min_rejections = 20;          ///< lost also needs at least this many rejections in a row (F16)

@@ -50,26 +50,22 @@ enum FlightModeStatus : std::uint32_t {
 };
 
 struct FlightModeParams {
-  double imu_max_log_odds = 4.0;        ///< bound of the IMU's log-odds from shaking and climbs (F29a) [nats]
-  /// … and towards the floor while the IMU reads rest (motors off: a body that cannot fly; entered from the air only
-  /// near the floor, F18), above the TDoA's bound: rest is not overruled by the TDoA (F29a) [nats]
-  double imu_rest_log_odds = 24.0;
-  double imu_rate_per_s = 100.0;        ///< rate at which the IMU's log-odds move (F29a) [nats/s]
-  double tdoa_max_log_odds = 20.0;      ///< bound of the TDoA's Bayes factor for the air (F29c) [nats]
-  /// … and for the floor: the TDoA near the floor carry the floor-level bias and their window lags a take-off, so
-  /// they can confirm the floor only weakly (F29c) [nats]
-  double tdoa_max_floor_log_odds = 2.0;
-  double tdoa_window_s = 0.5;           ///< forgetting time of the TDoA height window (F29c) [s]
+  double imu_max_log_odds = 4.0;        ///< bound of the IMU's log-odds from shaking and climbs L_IMU [nats] (F29a)
+  double imu_rest_log_odds = 24.0;      ///< bound of the IMU's log-odds towards the floor at rest L_rest [nats] (F29a)
+  double imu_rate_per_s = 100.0;        ///< rate r at which the IMU's log-odds move [nats/s] (F29a)
+  double tdoa_max_log_odds = 20.0;      ///< bound of the TDoA's Bayes factor for the air [nats] (F29c)
+  double tdoa_max_floor_log_odds = 2.0; ///< bound of the TDoA's Bayes factor for the floor [nats] (F29c, F29d)
+  double tdoa_window_s = 0.5;           ///< forgetting time τ of the TDoA height window [s] (F29c)
   double tdoa_min_effective = 30.0;     ///< forgotten TDoA count below which the window says nothing (F29c)
-  double tdoa_independent = 10.0;       ///< independent TDoA per window: their errors are correlated (F29c)
+  double tdoa_independent = 10.0;       ///< independent TDoA per window, their errors being correlated (F29c)
   double min_vertical_gain = 0.2;       ///< |∂h/∂z| below which a TDoA says nothing of the height (F29c)
-  double height_floor_sigma_m = 0.3;    ///< spread added to both hypotheses' mean squares (F29c) [m]
-  double air_min_height_m = 0.3;        ///< flight heights above the floor: uniform over [min, max] (F29c) [m]
-  double air_max_height_m = 3.0;
-  double hysteresis_log_odds = 1.0;     ///< a mode is left when the sum passes ∓ this (F29) [nats]
-  double air_shake_ratio = 4.0;         ///< floor shaking: mean square above this × the airborne level (F29b)
-  double air_shake_prior_ms = 0.075 * 0.075;  ///< airborne shaking before it is measured (F29b) [rad²/s²]
-  double air_shake_tau_s = 3.0;         ///< time constant of the learned airborne level (F29b) [s]
+  double height_floor_sigma_m = 0.3;    ///< spread σ added to both hypotheses' mean squares [m] (F29c)
+  double air_min_height_m = 0.3;        ///< lowest flight height above the floor of the air hypothesis [m] (F29c)
+  double air_max_height_m = 3.0;        ///< highest flight height above the floor of the air hypothesis [m] (F29c)
+  double hysteresis_log_odds = 1.0;     ///< a mode is left when the summed log-odds pass ∓ this h [nats] (F29)
+  double air_shake_ratio = 4.0;         ///< floor shaking: mean square above this κ × the airborne level (F29b)
+  double air_shake_prior_ms = 0.075 * 0.075;  ///< airborne shaking level before it is measured [rad²/s²] (F29b)
+  double air_shake_tau_s = 3.0;         ///< time constant of the learned airborne shaking level [s] (F29b)
   void validate() const;
 };
 

@@ -47,6 +47,8 @@ struct StartUpParams {
   double floor_refute_height_m = 1.2;
   /// … with an RMS residual at most this many times the floor solve's
   double floor_refute_residual_ratio = 1.5;
+  double max_speed_mps = 5.0;         ///< a moving solve faster than this is a failed solve [m/s] (F16b)
+  double floor_height_sigma_m = 0.1;  ///< height std of a fix on the floor [m] (F16c)
 
   /// The estimator's start-up: every field from its EkfParams namesake (start_*, floor_refute_*; the position std at
   /// most init_pos_sigma_m).
