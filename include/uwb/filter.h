@@ -23,6 +23,7 @@
 #include "uwb/filter/OutlierGate.h"
 #include "uwb/filter/QuadImuProcess.h"
 #include "uwb/filter/RestDetector.h"
+#include "uwb/filter/RestGyroWindow.h"
 #include "uwb/filter/SensorEvents.h"
 #include "uwb/filter/SensorRange.h"
 #include "uwb/filter/StartReplay.h"

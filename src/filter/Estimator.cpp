@@ -1134,6 +1134,13 @@ Mat3 Estimator::biasFloor() const {
     C(2, 2) = params_.ground_height_sigma_m * params_.ground_height_sigma_m;  // the body's height on the floor, not the repeated updates'
     return C;
   }
+  // (F23e) in flight with the downward range fused recently, the height is the ToF's: the TDoA bias moves the
+  // horizontal position at the height the ToF holds, and the height's σ is the filter's own
+  if (params_.fuse_tof && t_last_event_ - t_last_tof_accept_ <= params_.recent_pair_window_s) {
+    Mat3 C = Mat3::Zero();
+    C.topLeftCorner<2, 2>() = g.horizontalCovariance(outputBiasSigma());
+    return C;
+  }
   // (F23d) in flight, the vertical part of the bias-induced position error scaled: C ← S C S, S = diag(1, 1, s)
   Mat3 C = g.covariance(outputBiasSigma());
   const double s = params_.output_bias_vertical_scale;

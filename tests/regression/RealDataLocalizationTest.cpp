@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "support/TestSupport.h"
+#include "uwb/eval/EstimateChecks.h"
 #include "uwb/eval/FaultInjection.h"
 #include "uwb/eval/Localization.h"
 #include "uwb/io/UtilCsv.h"
@@ -116,6 +117,23 @@ TEST(RealDataLocalization, ATouchdownIsNotReadAsATakeOff) {
       }
     }
   }
+}
+
+TEST(RealDataLocalization, WithTheDownwardRangeTheHeightBandIsTheFiltersOwn) {
+  // GIVEN a flight whose log carries the Flow deck's range (fused by default, F21): the height error is about 1 cm
+  const std::optional<LocalizationRun> run = replayPilot("0425-traj2");
+  UWB_REQUIRE_REAL_DATA(run);
+  ASSERT_TRUE(run->metrics);
+  ASSERT_GT(run->summary.n_tof_used, 500u);
+  // WHEN the reported σ is compared with the error
+  EstimateCheckParams cp;
+  cp.floor_z_m = EkfParams{}.ground_z_m;
+  const EstimateChecks c = checkEstimate(run->trajectory, *run->metrics, cp);
+  // THEN the height band means what it says (filter.md F23e: the TDoA bias adds nothing to the height the ToF holds;
+  // before, 1σ and 2σ covered 100 % of the z errors, the band ±0.2–0.3 m about a 1 cm error)
+  EXPECT_GT(c.coverage_1sigma.z(), 0.5);
+  EXPECT_LT(c.coverage_1sigma.z(), 0.95);
+  EXPECT_GT(c.coverage_2sigma.z(), 0.85);
 }
 
 TEST(RealDataLocalization, Pilot0426Traj11WithObstaclesUnderBound) {
