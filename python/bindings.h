@@ -17,6 +17,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "uwb/core/Strings.h"
 #include "uwb/core/Types.h"
 #include "uwb/filter/EkfParams.h"
 #include "uwb/filter/Estimator.h"
@@ -64,8 +65,10 @@ inline RowMat toMatrix(const py::handle& obj, py::ssize_t cols, const char* name
   }
   if (a.ndim() == 1 && allow_row && a.shape(0) == cols) return Eigen::Map<const RowMat>(a.data(), 1, cols);
   if (a.ndim() != 2 || a.shape(1) != cols) {
+    std::string dims;
+    for (py::ssize_t d = 0; d < a.ndim(); ++d) uwb::appendToList(&dims, std::to_string(a.shape(d)));
     std::string shape = "(";
-    for (py::ssize_t d = 0; d < a.ndim(); ++d) shape += (d ? ", " : "") + std::to_string(a.shape(d));
+    shape += dims;
     shape += a.ndim() == 1 ? ",)" : ")";
     throw std::invalid_argument(std::string(name) + ": expected shape (N, " + std::to_string(cols) + "), got " +
                                 shape);
@@ -180,7 +183,7 @@ void applyOverrides(T& obj, const Setters<T>& setters, const py::dict& overrides
     const auto it = setters.find(name);
     if (it == setters.end()) {
       std::string known;
-      for (const auto& [n, _] : setters) known += (known.empty() ? "" : ", ") + n;
+      for (const auto& [n, _] : setters) uwb::appendToList(&known, n);
       throw std::invalid_argument("unknown " + what + " parameter '" + name + "' (known: " + known + ")");
     }
     try {

@@ -6,6 +6,7 @@
 #include <variant>
 
 #include "uwb/core/Error.h"
+#include "uwb/core/Strings.h"
 #include "uwb/io/JsonFile.h"
 
 namespace uwb::app {
@@ -26,7 +27,7 @@ void applyObject(const nlohmann::json& j, const std::string& section, const std:
     const auto it = fields.find(key);
     if (it == fields.end()) {
       std::string known;
-      for (const auto& field : fields) known += (known.empty() ? "" : ", ") + field.first;
+      for (const auto& field : fields) uwb::appendToList(&known, field.first);
       throw ConfigKeyError(full, "unknown key '" + full + "' (known: " + known + ")");
     }
     try {

@@ -7,5 +7,6 @@
 #include "uwb/core/Angle.h"
 #include "uwb/core/Error.h"
 #include "uwb/core/Smoothstep.h"
+#include "uwb/core/Strings.h"
 #include "uwb/core/Tdoa.h"
 #include "uwb/core/Types.h"

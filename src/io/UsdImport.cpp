@@ -12,6 +12,7 @@
 
 #include "CsvDetail.h"
 #include "uwb/core/Error.h"
+#include "uwb/core/Strings.h"
 #include "uwb/core/Types.h"
 #include "uwb/io/AnchorSurvey.h"
 #include "uwb/io/UtilCsv.h"
@@ -51,7 +52,7 @@ const std::vector<Recording>& recordings() {
 
 std::string joined(const std::vector<const char*>& fields) {
   std::string out;
-  for (const char* f : fields) out += (out.empty() ? "" : ", ") + std::string(f);
+  for (const char* f : fields) appendToList(&out, f);
   return out;
 }
 

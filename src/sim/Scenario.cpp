@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "uwb/core/Error.h"
+#include "uwb/core/Strings.h"
 #include "uwb/io/UtilCsv.h"
 
 namespace uwb::sim {
@@ -46,7 +47,7 @@ AnchorSurvey anchorPreset(const std::string& name, const std::string& data_dir) 
     path = fs::path(data_dir) / "real" / "util-pilot" / "survey" / ("anchor_" + name.substr(11) + "_survey.txt");
   } else {
     std::string known;
-    for (const std::string& n : anchorPresetNames()) known += (known.empty() ? "" : ", ") + n;
+    for (const std::string& n : anchorPresetNames()) appendToList(&known, n);
     throw std::invalid_argument("unknown anchor preset '" + name + "' (expected one of: " + known + ")");
   }
   if (!fs::exists(path)) {

@@ -9,6 +9,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "uwb/core/Strings.h"
 #include "uwb/model/TdoaModel.h"
 #include "uwb/sim/Kinematics.h"
 
@@ -53,7 +54,7 @@ SwarmScenario makeSwarmScenario(const std::string& name, int n_agents, double du
   const std::vector<std::string> names = swarmScenarioNames();
   if (std::find(names.begin(), names.end(), name) == names.end()) {
     std::string known;
-    for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
+    for (const std::string& n : names) appendToList(&known, n);
     throw std::invalid_argument("unknown swarm scenario '" + name + "' (expected one of: " + known + ")");
   }
   if (n_agents < 1 || n_agents > 200) throw std::invalid_argument("swarm: the number of agents must be in [1, 200]");
