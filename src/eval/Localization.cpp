@@ -72,6 +72,8 @@ LocalizationRun localizeFlight(const Flight& flight, const AnchorSurvey& survey,
   LocalizationRun run;
   run.trajectory = toTrajectory(res.estimates, res.summary.process_model == ProcessModel::kImu);
   run.summary = res.summary;
+  run.n_tdoa_used_at_rest.reserve(res.estimates.size());
+  for (const LocalizerEstimate& e : res.estimates) run.n_tdoa_used_at_rest.push_back(e.n_tdoa_used_at_rest);
   run.duration_s = res.summary.end_t_s - res.summary.start_t_s;
   if (flight.hasGroundTruth()) {
     const PoseTrack track(flight);

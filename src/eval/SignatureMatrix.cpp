@@ -57,6 +57,20 @@ std::size_t airborneTdoa(const Flight& f) {
   return n;
 }
 
+/// TDoA the run took at the floor's σ while the truth flew: the running count of each output interval, counted when
+/// the truth at the interval's end is airborne.
+double tdoaAtRestWhileFlying(const LocalizationRun& run, const Flight& f) {
+  const double floor_z = sim::truthFloorLevel(f.pose);
+  std::size_t n = 0, before = 0;
+  const std::size_t m = std::min(run.trajectory.size(), run.n_tdoa_used_at_rest.size());
+  for (std::size_t k = 0; k < m; ++k) {
+    const std::size_t now = run.n_tdoa_used_at_rest[k];
+    if (isAirborne(sim::truthHeightAt(f.pose, run.trajectory[k].t_s) - floor_z)) n += now - before;
+    before = now;
+  }
+  return static_cast<double>(n);
+}
+
 /// Longest span of the estimate within kStuckEstimate_m of the floor while the truth flies above kStuckTruth_m.
 double longestStuck(const TrajectoryMetrics& m, double floor_z) {
   double longest = 0.0, since = std::nan("");
@@ -173,8 +187,8 @@ SignatureRow evaluateSignature(const SignatureFlight& f, const SignatureCell& c,
   r.rmse_cell_m = run.metrics->airborne.rmse_m;
   r.ratio = r.rmse_cell_m / r.rmse_plain_m;
   const double n_air = static_cast<double>(std::max<std::size_t>(airborneTdoa(f.flight), 1));
-  const double extra_floor = static_cast<double>(run.summary.n_tdoa_used_at_rest) -
-                             static_cast<double>(plain.summary.n_tdoa_used_at_rest);
+  // the airborne TDoA (by the truth) that the cell took at the floor's σ and the plain flight did not
+  const double extra_floor = tdoaAtRestWhileFlying(run, f.flight) - tdoaAtRestWhileFlying(plain, f.flight);
   r.in_flight_fraction = std::clamp(1.0 - std::max(extra_floor, 0.0) / n_air, 0.0, 1.0);
   r.longest_floor_stuck_s = longestStuck(*run.metrics, sim::truthFloorLevel(f.flight.pose));
   EstimateCheckParams cp;

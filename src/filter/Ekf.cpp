@@ -500,6 +500,15 @@ void Ekf::resetPosition(const Vec3& w_p_b, double sigma_m) {
   if (range_bias_) range_bias_->biasRows().middleCols<3>(kPos).setZero();
 }
 
+void Ekf::resetHeight(double z_m, double var_m2) {
+  constexpr int kZ = kPos + 2;
+  x_.w_p_b.z() = z_m;
+  P_.row(kZ).setZero();
+  P_.col(kZ).setZero();
+  P_(kZ, kZ) = var_m2;
+  if (range_bias_) range_bias_->biasRows().col(kZ).setZero();
+}
+
 void Ekf::resetPositionVelocity(const Vec3& w_p_b, const Vec3& w_v_b, const Eigen::Matrix<double, 6, 6>& cov) {
   static_assert(kVel == kPos + 3, "position and velocity are adjacent in the error state");
   x_.w_p_b = w_p_b;

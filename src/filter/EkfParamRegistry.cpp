@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "uwb/core/Strings.h"
 #include "uwb/filter/InMotionAlignment.h"
 
 namespace uwb {
@@ -254,6 +255,8 @@ std::vector<EkfParamInfo> makeRegistry() {
               "Zero-angular-rate updates of the gyro bias while the body rests (F18z)", "no-rest-gyro-updates"),
       real("rest_gyro_window_s", &P::rest_gyro_window_s, "s", kPositive,
            "Window of one zero-angular-rate update at rest (F18z)"),
+      integer("rest_gyro_min_samples", &P::rest_gyro_min_samples, EkfParamRange{2, 1e6},
+              "A window at rest with fewer gyro readings gives no zero-angular-rate update (F18z)"),
       real("rest_gyro_sigma_floor_radps", &P::rest_gyro_sigma_floor_radps, "rad/s", kPositive,
            "Std added to the window mean's own in a zero-angular-rate update (F18z)"),
       real("rest_gyro_gate_sigma", &P::rest_gyro_gate_sigma, "", kPositive,
@@ -361,6 +364,12 @@ std::vector<EkfParamInfo> makeRegistry() {
            "Airborne shaking level (high-passed gyro mean square) before it is measured (F29b)"),
       real("mode_air_shake_tau_s", &P::flight_mode, &M::air_shake_tau_s, "s", kPositive,
            "Time constant of the learned airborne shaking level (F29b)"),
+      real("mode_tof_window_s", &P::flight_mode, &M::tof_window_s, "s", kPositive,
+           "Forgetting time of the downward range's height window (F29f)"),
+      real("mode_tof_min_effective", &P::flight_mode, &M::tof_min_effective, "", atLeast(1.0),
+           "Forgotten downward-range count below which its window says nothing (F29f)"),
+      real("mode_tof_height_sigma_m", &P::flight_mode, &M::tof_height_sigma_m, "m", kPositive,
+           "Spread added to both hypotheses' mean squares of the downward range's heights (F29f)"),
       // --- re-acquisition and divergence (F16, F16d) ---
       integer("lost_min_rejections", &P::lost_min_rejections, EkfParamRange{0, 1e6},
               "Lost (F16) also needs at least this many TDoA rejected in a row"),
@@ -468,8 +477,10 @@ std::string kindName(const EkfParamInfo& info) {
     case EkfParamKind::kBool: return "true or false";
     case EkfParamKind::kVec3: return "three numbers x,y,z";
     case EkfParamKind::kChoice: {
+      std::string choices;
+      for (const std::string& c : info.choices) appendToList(&choices, c);
       std::string s = "one of ";
-      for (std::size_t k = 0; k < info.choices.size(); ++k) s += (k ? ", " : "") + info.choices[k];
+      s += choices;
       return s;
     }
   }
@@ -556,7 +567,7 @@ const EkfParamInfo& ekfParamInfo(const std::string& name) {
   for (const EkfParamInfo& i : ekfParamRegistry())
     if (i.name == name) return i;
   std::string known;
-  for (const EkfParamInfo& i : ekfParamRegistry()) known += (known.empty() ? "" : ", ") + i.name;
+  for (const EkfParamInfo& i : ekfParamRegistry()) appendToList(&known, i.name);
   throw std::invalid_argument("unknown filter parameter '" + name + "' (known: " + known + ")");
 }
 

@@ -56,13 +56,13 @@ Estimator::Estimator(const EkfParams& params, AnchorTable anchors, BiasPredictor
       imu_mode_(params.process_model == ProcessModel::kImu),
       descent_(DescentBoundParams{params.descent_margin_m}),
       ekf_(params),
+      rest_gyro_(params.rest_gyro_window_s, params.rest_gyro_min_samples),
       mode_(params.flight_mode),
       start_(anchors_, params.b_t_tag, StartUpParams::fromEkfParams(params)),
       replay_(params),
       heading_align_(params.heading_alignment_window_s, InMotionAlignment::kDefaultSamplePeriod_s,
                      InMotionAlignment::kDefaultCorrelation_s, params.rotor_drag_per_s) {
   params_.validate();
-  rest_gyro_ = RestGyroWindow(params_.rest_gyro_window_s, 5);
   if (anchors_.size() < 4) throw std::invalid_argument("Estimator: at least 4 anchors are needed");
   floor_anchors_ = FloorLevelAnchors(anchors_, params_.ground_z_m, params_.floor_anchor_height_m);
   if (floor_anchors_.any()) start_.setFloorLevelAnchors(floor_anchors_.mask());
@@ -309,7 +309,7 @@ void Estimator::handleTimeJump(double t_s, double gap_s) {
 void Estimator::leaveGround(double t_s, bool climbing) {
   on_ground_ = false;
   if (mode_.onFloor()) mode_.reset(FlightMode::kAirborne);  // (F29) a start's TDoA refuted the floor (F16j)
-  if (floor_check_) start_.cancel();  // (F29e) the check's window holds the body on the floor
+  if (floor_check_) cancelStartWindow();  // (F29e) the check's window holds the body on the floor
   floor_check_ = false;
   endLandingFix();  // (F16i) the window holds the body at rest on the floor only
   replay_.stop();  // (F16g) the record holds predictions and TDoA only
@@ -386,8 +386,15 @@ void Estimator::finishFloorCheck(double t_s, const StartFix& fix) {
 }
 
 void Estimator::endLandingFix() {
-  if (landing_fix_) start_.cancel();
+  if (landing_fix_) cancelStartWindow();
   landing_fix_ = false;
+}
+
+void Estimator::cancelStartWindow() {
+  start_.cancel();
+  // (F16) the window's TDoA were received and held for its solve, not missing: the time without an accepted TDoA
+  // that declares the position lost in flight counts from here
+  t_last_accept_ = std::max(t_last_accept_, t_last_event_);
 }
 
 void Estimator::finishLandingFix(const StartFix& fix) {
@@ -651,10 +658,37 @@ void Estimator::followFlightMode(double t_s, bool climbing, bool contact, double
       // (F29) the TDoA put the tag in the air against the IMU's floor evidence: the shaking seen now is this
       // flight's airborne shaking (F29b), and the position held on the floor is found again from the TDoA (F16)
       if (contact) mode_.learnAirShake(shake_ms);
-      if (ready_ && !start_.active()) startAcquisition(t_s, true);
+      if (ready_ && !start_.active()) acquireFromHeightWindow(t_s);
       mode_.clearTdoa();
     }
   }
+}
+
+void Estimator::acquireFromHeightWindow(double t_s) {
+  // (F29c) the height from the downward range's window when it has one (F29f), from the TDoA's otherwise; the
+  // horizontal position as held on the floor within the floor's TDoA σ, the velocity unknown; the robust, gate-free
+  // acquisition updates (F16) take it from there
+  const FlightModeParams& mp = params_.flight_mode;
+  const bool tof = std::isfinite(mode_.tofHeight());
+  const double h_m = tof ? mode_.tofHeight() : mode_.tdoaHeight();
+  const double spread_m = tof ? mode_.tofHeightSpread() : mode_.tdoaHeightSpread();
+  const double sigma_m = tof ? mp.tof_height_sigma_m : mp.height_floor_sigma_m;
+  if (!(std::isfinite(h_m) && std::isfinite(spread_m))) {
+    startAcquisition(t_s, true);
+    return;
+  }
+  ekf_.resetHeight(params_.ground_z_m + h_m, spread_m * spread_m + sigma_m * sigma_m);
+  ekf_.inflateHorizontalPosition(params_.rest_tdoa_sigma_m, params_.moving_start_vel_sigma_mps);
+  landing_fix_ = false;
+  floor_check_ = false;
+  descent_.clear();
+  climb_.clear();
+  phase_ = FlightPhase::kAcquisition;
+  t_acq_end_ = t_s + params_.acquisition_s;
+  t_fix_settled_ = t_s + params_.acquisition_s;  // (F25d) as after a fix
+  t_last_accept_ = t_s;
+  n_rejected_streak_ = 0;
+  n_rejected_recent_ = n_gated_recent_ = 0.0;
 }
 
 void Estimator::runPeriodicChecks(double t_s) {
@@ -692,6 +726,11 @@ void Estimator::addTof(const TofObservation& tof) {
   if (!(std::isfinite(tof.range_m) && tof.range_m > 0.0 && tof.range_m <= params_.tof_max_range_m)) {
     ++summary_.n_tof_invalid;
     return;
+  }
+  // (F29f) the height it measures is evidence of the flight mode whatever the position estimate
+  if (initialized_ && imu_mode_ && params_.ground_phase == GroundPhase::kDetectTakeoff) {
+    const std::optional<double> h = tofMeasuredHeight(ekf_.state().w_q_b, tof.range_m, params_.tof_offset_m);
+    if (h) mode_.addTof(t, *h + params_.floor_z_m - params_.ground_z_m);
   }
   if (!initialized_ || !ready_ || start_.active()) {
     ++summary_.n_tof_not_ready;
@@ -1192,6 +1231,7 @@ LocalizerEstimate Estimator::estimate() const {
   e.x = ekf_.state();
   e.phase = phase_;
   e.mode_status = mode_.status() | (inconsistent_ ? kInconsistent : 0u);
+  e.n_tdoa_used_at_rest = summary_.n_tdoa_used_at_rest;
   const ErrMat& P = ekf_.covariance();
   e.cov_pose.block<3, 3>(0, 0) = reportedPositionCovariance();
   e.cov_pose.block<3, 3>(0, 3) = P.block<3, 3>(kPos, kAtt);

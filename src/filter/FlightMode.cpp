@@ -33,14 +33,21 @@ void FlightModeParams::validate() const {
         tdoa_max_log_odds > 0.0 && tdoa_max_floor_log_odds >= 0.0 && tdoa_window_s > 0.0 &&
         tdoa_min_effective >= 2.0 && tdoa_independent >= 1.0 && min_vertical_gain > 0.0 &&
         height_floor_sigma_m > 0.0 && air_min_height_m >= 0.0 && air_max_height_m > air_min_height_m &&
-        hysteresis_log_odds >= 0.0 && air_shake_ratio >= 1.0 && air_shake_prior_ms > 0.0 && air_shake_tau_s > 0.0))
+        hysteresis_log_odds >= 0.0 && air_shake_ratio >= 1.0 && air_shake_prior_ms > 0.0 && air_shake_tau_s > 0.0 &&
+        tof_window_s > 0.0 && tof_min_effective >= 1.0 && tof_height_sigma_m > 0.0))
     throw std::invalid_argument("FlightModeParams: bounds, rates, windows and sigmas must be > 0, "
                                 "imu_rest_log_odds >= imu_max_log_odds, air_max_height_m > air_min_height_m, "
-                                "air_shake_ratio >= 1, tdoa_min_effective >= 2, tdoa_independent >= 1");
+                                "air_shake_ratio >= 1, tdoa_min_effective >= 2, tdoa_independent >= 1, "
+                                "tof_min_effective >= 1");
 }
 
 FlightModeSupervisor::FlightModeSupervisor(const FlightModeParams& params)
-    : params_(params), tdoa_height_m_(kNaN), tdoa_height_spread_m_(kNaN), air_shake_ms_(params.air_shake_prior_ms) {
+    : params_(params),
+      tdoa_height_m_(kNaN),
+      tdoa_height_spread_m_(kNaN),
+      tof_height_m_(kNaN),
+      tof_height_spread_m_(kNaN),
+      air_shake_ms_(params.air_shake_prior_ms) {
   params_.validate();
 }
 
@@ -49,6 +56,10 @@ void FlightModeSupervisor::reset(FlightMode mode) {
   imu_log_odds_ = mode == FlightMode::kAirborne ? params_.imu_max_log_odds : -params_.imu_max_log_odds;
   overruled_ = false;
   clearTdoa();
+  tof_ = HeightWindow{};
+  t_tof_ = -1e300;
+  n_tof_ = tof_log_odds_ = 0.0;
+  tof_height_m_ = tof_height_spread_m_ = kNaN;
 }
 
 void FlightModeSupervisor::clearTdoa() {
@@ -68,6 +79,8 @@ void FlightModeSupervisor::learnAirShake(double shake_ms_radps2) {
   if (!(std::isfinite(shake_ms_radps2) && shake_ms_radps2 > 0.0)) return;
   air_shake_ms_ = std::max(air_shake_ms_, shake_ms_radps2);
   air_shake_learned_ = true;
+  // … and the floor evidence the IMU drew from that shaking is void (rest, motors off, is not shaking)
+  if (!imu_rest_) imu_log_odds_ = std::max(imu_log_odds_, 0.0);
 }
 
 void FlightModeSupervisor::addImu(double t_s, double dt_s, const ImuModeEvidence& e, bool settled_in_air) {
@@ -132,24 +145,59 @@ void FlightModeSupervisor::updateTdoaFactor() {
   // window counts as at most tdoa_independent samples
   const double h_air = air_.mean();
   const double s2_air = air_.spread2();
+  const double h_floor = floor_.mean();
+  const double ms_floor = floor_.spread2() + h_floor * h_floor;
+  tdoa_height_m_ = h_air;
+  tdoa_height_spread_m_ = std::sqrt(s2_air);
+  tdoa_log_odds_ = heightLogOdds(n_, h_air, s2_air, ms_floor, params_.height_floor_sigma_m);
+}
+
+double FlightModeSupervisor::heightLogOdds(double n, double h_air, double s2_air, double ms_floor,
+                                           double sigma_m) const {
   const double d = h_air < params_.air_min_height_m   ? params_.air_min_height_m - h_air
                    : h_air > params_.air_max_height_m ? h_air - params_.air_max_height_m
                                                       : 0.0;
-  const double h_floor = floor_.mean();
   const double ms_air = s2_air + d * d;
-  const double ms_floor = floor_.spread2() + h_floor * h_floor;
-  const double s2 = params_.height_floor_sigma_m * params_.height_floor_sigma_m;
-  const double n_eff = std::min(n_, params_.tdoa_independent);
-  tdoa_height_m_ = h_air;
-  tdoa_height_spread_m_ = std::sqrt(s2_air);
-  tdoa_log_odds_ = std::clamp(0.5 * n_eff * (std::log(ms_floor + s2) - std::log(ms_air + s2)),
-                              -params_.tdoa_max_floor_log_odds, params_.tdoa_max_log_odds);
+  const double s2 = sigma_m * sigma_m;
+  const double n_eff = std::min(n, params_.tdoa_independent);
+  return std::clamp(0.5 * n_eff * (std::log(ms_floor + s2) - std::log(ms_air + s2)), -params_.tdoa_max_floor_log_odds,
+                    params_.tdoa_max_log_odds);
+}
+
+void FlightModeSupervisor::addTof(double t_s, double height_m) {
+  if (!(std::isfinite(t_s) && std::isfinite(height_m))) return;
+  updateTofFactor(t_s);
+  // (F29f) the height the range measures, clipped as the TDoA's
+  tof_.add(1.0, std::clamp(height_m, kMinSampleHeight_m, kMaxSampleHeight_m));
+  n_tof_ += 1.0;
+  updateTofFactor(t_s);
+}
+
+void FlightModeSupervisor::updateTofFactor(double t_s) {
+  if (!(n_tof_ > 0.0)) return;
+  if (t_s > t_tof_) {
+    const double a = t_tof_ > -1e299 ? expNegative((t_s - t_tof_) / params_.tof_window_s) : 1.0;
+    tof_.scale(a);
+    n_tof_ *= a;
+    t_tof_ = t_s;
+  }
+  if (n_tof_ < params_.tof_min_effective) {
+    tof_log_odds_ = 0.0;
+    tof_height_m_ = tof_height_spread_m_ = kNaN;
+    return;
+  }
+  // (F29f) one window for both hypotheses: the air about the flight range, the floor about the floor
+  const double h = tof_.mean(), s2 = tof_.spread2();
+  tof_height_m_ = h;
+  tof_height_spread_m_ = std::sqrt(s2);
+  tof_log_odds_ = heightLogOdds(n_tof_, h, s2, s2 + h * h, params_.tof_height_sigma_m);
 }
 
 bool FlightModeSupervisor::decide(double t_s) {
   const double dt = t_s > t_last_ && t_last_ > -1e299 ? std::min(t_s - t_last_, 0.1) : 0.0;
   t_last_ = std::max(t_last_, t_s);
-  const double sum = imu_log_odds_ + tdoa_log_odds_;
+  updateTofFactor(t_s);  // (F29f) the range's window ages between its readings
+  const double sum = imu_log_odds_ + tdoa_log_odds_ + tof_log_odds_;
   // on the floor: rest or contact as the IMU reads it; without either (the IMU's log-odds on their way up), as before
   const FlightMode floor_mode = imu_rest_                     ? FlightMode::kRest
                                 : imu_contact_                ? FlightMode::kContact
@@ -193,6 +241,7 @@ std::uint32_t FlightModeSupervisor::status() const {
   if (imu_climb_) s |= kImuSaysClimb;
   if (std::isfinite(tdoa_height_m_)) s |= kTdoaHeightValid;
   if (tdoa_log_odds_ > params_.tdoa_max_floor_log_odds) s |= kTdoaSaysAirborne;
+  if (tof_log_odds_ > params_.tdoa_max_floor_log_odds) s |= kTofSaysAirborne;
   if (overruled_) s |= kTdoaOverrulesImu;
   if (air_shake_learned_) s |= kAirShakeLearned;
   return s;

@@ -26,6 +26,12 @@ std::optional<double> tofPredictedRange(const NavState& x, double offset_m, doub
   return height_m / R33 - offset_m;
 }
 
+std::optional<double> tofMeasuredHeight(const Quat& w_q_b, double range_m, double offset_m) {
+  const double R33 = w_q_b.toRotationMatrix()(2, 2);
+  if (!(R33 > kTofMinCosTilt)) return std::nullopt;
+  return (range_m + offset_m) * R33;
+}
+
 TofUpdateResult updateTof(Ekf& ekf, double range_m, const TofUpdateOptions& options) {
   TofUpdateResult res;
   if (!std::isfinite(range_m) || range_m <= 0.0 || range_m > options.max_range_m) return res;  // kSkipped

@@ -288,6 +288,33 @@ TEST(EkfRangeBias, ResetsClearTheCrossCovarianceOfWhatTheyReset) {
   EXPECT_LT((ekf.rangeBias()->joint(ekf.covariance()) - 2.0 * J).norm(), 1e-12);
 }
 
+TEST(EkfRangeBias, AHeightResetClearsTheHeightsCorrelationsAndNothingElse) {
+  // GIVEN a filter whose position is correlated with the range biases and with its other states
+  TdoaUpdateOptions opt;
+  Ekf ekf = correlatedFilter(rangeBiasParams(), 5, {{0.0, 0, 1, 0.3}, {0.0, 1, 2, -0.2}}, &opt);
+  const ErrMat P0 = ekf.covariance();
+  const Vec3 p0 = ekf.state().w_p_b;
+  ASSERT_GT(ekf.rangeBias()->cross().row(kPos + 2).norm(), 0.0);
+  ASSERT_GT(std::abs(P0(kPos, kPos + 2)), 0.0);
+  // WHEN the height is overwritten (F29c: the TDoA's own height after they overrule the floor)
+  ekf.resetHeight(1.3, 0.04);
+  // THEN the height and its variance are the given ones, uncorrelated with anything; x, y and the rest are untouched
+  const ErrMat& P = ekf.covariance();
+  EXPECT_EQ(ekf.state().w_p_b.z(), 1.3);
+  EXPECT_EQ(ekf.state().w_p_b.head<2>(), p0.head<2>());
+  EXPECT_EQ(P(kPos + 2, kPos + 2), 0.04);
+  EXPECT_EQ(P.row(kPos + 2).norm(), 0.04);
+  EXPECT_EQ(P.col(kPos + 2).norm(), 0.04);
+  EXPECT_EQ(ekf.rangeBias()->cross().row(kPos + 2).norm(), 0.0);
+  EXPECT_GT(ekf.rangeBias()->cross().row(kPos).norm(), 0.0);
+  ErrMat rest = P, rest0 = P0;
+  for (ErrMat* m : {&rest, &rest0}) {
+    m->row(kPos + 2).setZero();
+    m->col(kPos + 2).setZero();
+  }
+  EXPECT_EQ((rest - rest0).norm(), 0.0);
+}
+
 TEST(EkfRangeBias, InflationAlongThePositionIsTheDenseFormulaOnTheJointCovariance) {
   // GIVEN a filter whose joint covariance over [δx, δβ] is correlated with the position
   TdoaUpdateOptions opt;

@@ -124,6 +124,58 @@ TEST(FlightMode, DoubtIsCountedWhileTheImuHoldsTheFloorAgainstTheTdoa) {
   EXPECT_NEAR(s.doubtedFloorMaxHeight(), 0.35, 0.05);
 }
 
+/// Feeds `duration_s` of IMU evidence (1 kHz) and downward ranges (25 Hz, as the Flow deck's) measuring `height_m`.
+void feedTof(SupervisorRun& run, double duration_s, const ImuModeEvidence& imu, double height_m) {
+  const double t_end = run.t + duration_s;
+  double t_next = run.t;
+  while (run.t < t_end) {
+    run.t += kImuDt_s;
+    run.s.addImu(run.t, kImuDt_s, imu, false);
+    if (std::isfinite(height_m) && run.t >= t_next) {
+      run.s.addTof(run.t, height_m);
+      t_next += 0.04;
+    }
+    run.s.decide(run.t);
+  }
+}
+
+TEST(FlightMode, ADownwardRangeThatReadsAHeightLiftsTheImusFloorContact) {
+  // GIVEN floor contact by the IMU (a drone whose gyro shakes in flight) and a range that reads the floor
+  SupervisorRun run(FlightMode::kContact, 7);
+  FlightModeSupervisor& s = run.s;
+  const ImuModeEvidence contact{false, true, false, 0.3 * 0.3};
+  feedTof(run, 0.5, contact, 0.02);
+  // THEN the floor holds; a range near zero is weak floor evidence (an obstacle under a hovering drone reads so)
+  EXPECT_EQ(s.mode(), FlightMode::kContact);
+  EXPECT_DOUBLE_EQ(s.tofLogOdds(), -FlightModeParams{}.tdoa_max_floor_log_odds);
+  EXPECT_NEAR(s.tofHeight(), 0.02, 1e-9);
+  // WHEN the range reads 0.5 m, the IMU unchanged
+  feedTof(run, 0.5, contact, 0.5);
+  // THEN airborne against the IMU (F29f), the status word says why
+  EXPECT_EQ(s.mode(), FlightMode::kAirborne);
+  EXPECT_GT(s.tofLogOdds(), FlightModeParams{}.imu_max_log_odds + FlightModeParams{}.hysteresis_log_odds);
+  EXPECT_TRUE(s.status() & kTofSaysAirborne);
+  EXPECT_TRUE(s.status() & kTdoaOverrulesImu);
+  EXPECT_DOUBLE_EQ(s.tdoaLogOdds(), 0.0);
+}
+
+TEST(FlightMode, ADownwardRangeDoesNotOverruleRestAndStopsCountingWhenItStops) {
+  // GIVEN a body at rest by the IMU (motors off) whose range reads 1 m (carried over a table, a ledge)
+  SupervisorRun run(FlightMode::kRest, 8);
+  FlightModeSupervisor& s = run.s;
+  const ImuModeEvidence rest{true, false, false, 0.0};
+  feedTof(run, 1.0, rest, 1.0);
+  // THEN rest holds: its bound is above the range's
+  EXPECT_EQ(s.mode(), FlightMode::kRest);
+  EXPECT_GT(s.tofLogOdds(), 10.0);
+  // WHEN the range stops reporting (out of range) for a second
+  feedTof(run, 1.0, rest, kNoTdoa);
+  // THEN its window has aged out: it says nothing
+  EXPECT_DOUBLE_EQ(s.tofLogOdds(), 0.0);
+  EXPECT_TRUE(std::isnan(s.tofHeight()));
+  EXPECT_FALSE(s.status() & kTofSaysAirborne);
+}
+
 TEST(FlightMode, TheAirborneShakingLevelIsLearnedFromTheFlight) {
   // GIVEN the prior level: shaking of 0.3 rad/s rms stands out as floor contact
   SupervisorRun run(FlightMode::kAirborne, 6);

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <optional>
+#include <vector>
 
 #include "uwb/eval/TrajectoryMetrics.h"
 #include "uwb/filter/TdoaLocalizer.h"
@@ -37,6 +38,8 @@ struct LocalizationRun {
   std::optional<TrajectoryMetrics> metrics;  ///< when the flight has ground truth
   double duration_s = 0.0;                   ///< flight duration covered by the sensor data [s]
   std::size_t n_truth_glitches = 0;          ///< ground-truth samples rejected as glitches
+  /// Per trajectory sample: the TDoA taken at the floor's σ so far (LocalizerEstimate::n_tdoa_used_at_rest).
+  std::vector<std::size_t> n_tdoa_used_at_rest;
 };
 
 /// The flight's IMU (paired acc/gyro) and TDoA streams as the filter consumes them; with_tof also copies the

@@ -39,8 +39,8 @@ struct SignatureRow {
   std::string flight, cell;
   double rmse_plain_m = 0.0, rmse_cell_m = 0.0;  ///< airborne RMSE [m]
   double ratio = 0.0;                            ///< rmse_cell / rmse_plain
-  /// Airborne TDoA (by the truth) that were not taken at the floor's σ: 1 − (at-floor TDoA in excess of the plain
-  /// run) / airborne TDoA
+  /// Airborne TDoA (by the truth) that were not taken at the floor's σ: 1 − (at-floor TDoA while the truth flies, in
+  /// excess of the plain run's) / airborne TDoA
   double in_flight_fraction = 0.0;
   double longest_floor_stuck_s = 0.0;  ///< longest span with the estimate within 0.2 m of the floor, truth above 0.5 m
   Vec3 coverage_2sigma = Vec3::Zero();

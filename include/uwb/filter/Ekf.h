@@ -133,6 +133,10 @@ class Ekf {
   /// Overwrites the position; keeps other state; sets the position block of P to sigma² I, clears its correlations.
   void resetPosition(const Vec3& w_p_b, double sigma_m);
 
+  /// Overwrites the height (p_z) with variance var_m2; keeps the other states and clears the height's correlations
+  /// with them (F29c).
+  void resetHeight(double z_m, double var_m2);
+
   /// Overwrites position and velocity with a joint Gaussian (mean w_p_b, w_v_b; covariance Σ over (δp, δv)); keeps the
   /// other states and clears the position/velocity correlations with them (F16b).
   void resetPositionVelocity(const Vec3& w_p_b, const Vec3& w_v_b, const Eigen::Matrix<double, 6, 6>& cov);

@@ -125,6 +125,7 @@ struct EkfParams {
   double zupt_sigma_mps = 0.02;          ///< std of a zero-velocity update [m/s] (F14)
   bool rest_gyro_updates = true;         ///< zero-angular-rate updates of the gyro bias at rest (F18z)
   double rest_gyro_window_s = 0.1;       ///< window of one zero-angular-rate update [s] (F18z)
+  int rest_gyro_min_samples = 5;         ///< a window with fewer gyro readings gives no update (F18z)
   double rest_gyro_sigma_floor_radps = 3e-4;  ///< std added to a window mean's own [rad/s] (F18z)
   double rest_gyro_gate_sigma = 4.0;     ///< a bias reading beyond this many σ widens the bias variance (F18z)
   double level_window_s = 0.1;           ///< levelling window before the first prediction [s] (F15)

@@ -67,6 +67,7 @@ struct LocalizerEstimate {
   Vec3 sigma_v_mps = Vec3::Zero();  ///< 1σ of the velocity per world axis [m/s]
   FlightPhase phase = FlightPhase::kGround;
   std::uint32_t mode_status = 0;  ///< the flight-mode supervisor's status word (FlightModeStatus bits, F29)
+  std::size_t n_tdoa_used_at_rest = 0;  ///< LocalizerSummary::n_tdoa_used_at_rest so far (a running count)
 };
 
 struct LocalizerSummary {
@@ -276,6 +277,10 @@ class Estimator {
   double outputBiasSigma() const;
   /// (F24b) The scale of the bias model's mean from the flight's uncorrected level; after each window of raw_level_.
   void updateModelMeanScale();
+  /// (F29c) The ranging overruled the floor: the height from its window, the acquisition's robust updates (F16).
+  void acquireFromHeightWindow(double t_s);
+  /// Drops a landing's or a floor check's window unsolved (F16i, F29e).
+  void cancelStartWindow();
 
   EkfParams params_;
   AnchorTable anchors_;
@@ -287,7 +292,7 @@ class Estimator {
   DescentBound descent_;  ///< dead-reckoned descent while landing (F26)
   Ekf ekf_;
   RestDetector rest_;
-  RestGyroWindow rest_gyro_{0.1, 5};  ///< (F18z) window from the params; 5 readings at least
+  RestGyroWindow rest_gyro_;  ///< (F18z) windows of rest_gyro_window_s, rest_gyro_min_samples readings at least
   FlightModeSupervisor mode_;  ///< ground or air from all the evidence (F29)
   TdoaModelParams tdoa_model_;  ///< the tag lever arm for the supervisor's TDoA heights (F29c)
   // (F30) the innovation consistency check: forgotten sums of the clipped NIS and of the count

@@ -12,7 +12,9 @@
  *     residual and vertical sensitivity at the estimate, once as TDoA in the air and once corrected as on the floor
  *     (the floor-level anchors' delays, F16f): whichever hypothesis explains its window more tightly (about a height
  *     in the flight range, or about the floor) wins. Its log-likelihood ratio is bounded by tdoa_max_log_odds for
- *     the air and by the smaller tdoa_max_floor_log_odds for the floor.
+ *     the air and by the smaller tdoa_max_floor_log_odds for the floor;
+ *   - the downward range (F29f), when the log has one: the same two hypotheses on a window of the heights it
+ *     measures directly, within the TDoA's bounds.
  *  The mode is airborne while the sum is positive (with a hysteresis), on the floor otherwise; rest and contact are
  *  told apart by the IMU. Nothing is decided for good: the evidence is re-weighed at every step.
  *
@@ -47,6 +49,7 @@ enum FlightModeStatus : std::uint32_t {
   kTdoaOverrulesImu = 1u << 8,     ///< the mode follows the TDoA against the IMU
   kAirShakeLearned = 1u << 9,      ///< the flight's airborne shaking level has been measured
   kInconsistent = 1u << 10,        ///< the innovation consistency check fails (set by the estimator, F30)
+  kTofSaysAirborne = 1u << 11,     ///< the downward range's Bayes factor favours the air (F29f)
 };
 
 struct FlightModeParams {
@@ -66,6 +69,9 @@ struct FlightModeParams {
   double air_shake_ratio = 4.0;         ///< floor shaking: mean square above this κ × the airborne level (F29b)
   double air_shake_prior_ms = 0.075 * 0.075;  ///< airborne shaking level before it is measured [rad²/s²] (F29b)
   double air_shake_tau_s = 3.0;         ///< time constant of the learned airborne shaking level [s] (F29b)
+  double tof_window_s = 0.2;            ///< forgetting time of the downward range's height window [s] (F29f)
+  double tof_min_effective = 3.0;       ///< forgotten range count below which that window says nothing (F29f)
+  double tof_height_sigma_m = 0.05;     ///< spread σ added to both hypotheses' mean squares of its heights [m] (F29f)
   void validate() const;
 };
 
@@ -93,6 +99,8 @@ class FlightModeSupervisor {
   void addTdoa(double t_s, double residual_air_m, double residual_floor_m, double dh_dz, double estimate_height_m);
   /// The TDoA window is cleared (a re-acquisition: the estimate is not a linearization point).
   void clearTdoa();
+  /// One downward range (F29f): the height of the body above the floor that it measures [m].
+  void addTof(double t_s, double height_m);
   /// Re-decides the mode from the summed evidence (F29). Returns true when the mode changed.
   bool decide(double t_s);
   /// The TDoA put the tag in the air against the IMU's floor evidence: the shaking seen now is airborne shaking
@@ -107,6 +115,11 @@ class FlightModeSupervisor {
   /// The TDoA window's mean height above the floor as TDoA in the air, and its spread [m] (NaN while not valid).
   double tdoaHeight() const { return tdoa_height_m_; }
   double tdoaHeightSpread() const { return tdoa_height_spread_m_; }
+  /// The downward range's Bayes factor airborne : floor (0 while its window is not valid), its window's mean height
+  /// above the floor and spread [m] (NaN while not valid) (F29f).
+  double tofLogOdds() const { return tof_log_odds_; }
+  double tofHeight() const { return tof_height_m_; }
+  double tofHeightSpread() const { return tof_height_spread_m_; }
   double airShakeLevel() const { return air_shake_ms_; }
   std::uint32_t status() const;
   /// Time the mode was on the floor while the TDoA window said airborne (log-odds above tdoa_max_floor_log_odds)
@@ -118,6 +131,11 @@ class FlightModeSupervisor {
 
  private:
   void updateTdoaFactor();
+  /// Forgets the downward range's window up to t_s (it ages whether or not readings come) and re-weighs it (F29f).
+  void updateTofFactor(double t_s);
+  /// ½ min(n, tdoa_independent) [log(m_floor + σ²) − log(m_air + σ²)] with m_air = s²_air + d², d the distance of h_air
+  /// from the flight range, clamped to [−tdoa_max_floor_log_odds, tdoa_max_log_odds] (F29c, F29f).
+  double heightLogOdds(double n, double h_air, double s2_air, double ms_floor, double sigma_m) const;
 
   FlightModeParams params_;
   FlightMode mode_ = FlightMode::kAirborne;
@@ -134,6 +152,9 @@ class FlightModeSupervisor {
   double t_tdoa_ = -1e300, n_ = 0.0;
   HeightWindow air_, floor_;
   double tdoa_height_m_, tdoa_height_spread_m_;
+  HeightWindow tof_;  ///< heights measured by the downward range, weight 1 each (F29f)
+  double t_tof_ = -1e300, n_tof_ = 0.0, tof_log_odds_ = 0.0;
+  double tof_height_m_, tof_height_spread_m_;
   double air_shake_ms_;
   bool air_shake_learned_ = false;
   double t_last_ = -1e300;

@@ -28,6 +28,10 @@ constexpr double kTofMinCosTilt = 0.1;
 std::optional<double> tofPredictedRange(const NavState& x, double offset_m, double floor_z_m,
                                         ErrRow* J_h_dx = nullptr);
 
+/// (F21) The body's height above the floor z = floor_z_m that a range measures at attitude w_q_b, the inverse of
+/// tofPredictedRange: p_z − floor_z = (range + offset_m)·R33; nullopt when R33 ≤ kTofMinCosTilt.
+std::optional<double> tofMeasuredHeight(const Quat& w_q_b, double range_m, double offset_m);
+
 struct TofUpdateOptions {
   double sigma_m = 0.03;       ///< range noise std [m]
   double offset_m = 0.037;     ///< sensor below the body origin along body z [m]
