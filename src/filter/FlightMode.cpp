@@ -166,21 +166,26 @@ double FlightModeSupervisor::heightLogOdds(double n, double h_air, double s2_air
 
 void FlightModeSupervisor::addTof(double t_s, double height_m) {
   if (!(std::isfinite(t_s) && std::isfinite(height_m))) return;
-  updateTofFactor(t_s);
-  // (F29f) the height the range measures, clipped as the TDoA's
+  // (F29f) forgetting over tof_window_s; the height the range measures, clipped as the TDoA's
+  const double a = t_s >= t_tof_ ? expNegative((t_s - t_tof_) / params_.tof_window_s) : 1.0;
+  t_tof_ = std::max(t_tof_, t_s);
+  tof_.scale(a);
+  n_tof_ = a * n_tof_ + 1.0;
   tof_.add(1.0, std::clamp(height_m, kMinSampleHeight_m, kMaxSampleHeight_m));
-  n_tof_ += 1.0;
-  updateTofFactor(t_s);
+  updateTofFactor();
 }
 
-void FlightModeSupervisor::updateTofFactor(double t_s) {
-  if (!(n_tof_ > 0.0)) return;
-  if (t_s > t_tof_) {
-    const double a = t_tof_ > -1e299 ? expNegative((t_s - t_tof_) / params_.tof_window_s) : 1.0;
-    tof_.scale(a);
-    n_tof_ *= a;
-    t_tof_ = t_s;
+void FlightModeSupervisor::dropStaleTof(double t_s) {
+  // (F29f) a range that stopped reporting (out of range, the deck's dropout) stops counting: after kTofStaleWindows
+  // forgetting times its readings weigh less than 1 %
+  if (n_tof_ > 0.0 && t_s - t_tof_ > kTofStaleWindows * params_.tof_window_s) {
+    tof_ = HeightWindow{};
+    n_tof_ = 0.0;
+    updateTofFactor();
   }
+}
+
+void FlightModeSupervisor::updateTofFactor() {
   if (n_tof_ < params_.tof_min_effective) {
     tof_log_odds_ = 0.0;
     tof_height_m_ = tof_height_spread_m_ = kNaN;
@@ -196,7 +201,7 @@ void FlightModeSupervisor::updateTofFactor(double t_s) {
 bool FlightModeSupervisor::decide(double t_s) {
   const double dt = t_s > t_last_ && t_last_ > -1e299 ? std::min(t_s - t_last_, 0.1) : 0.0;
   t_last_ = std::max(t_last_, t_s);
-  updateTofFactor(t_s);  // (F29f) the range's window ages between its readings
+  dropStaleTof(t_s);
   const double sum = imu_log_odds_ + tdoa_log_odds_ + tof_log_odds_;
   // on the floor: rest or contact as the IMU reads it; without either (the IMU's log-odds on their way up), as before
   const FlightMode floor_mode = imu_rest_                     ? FlightMode::kRest

@@ -168,8 +168,8 @@ TEST(FlightMode, ADownwardRangeDoesNotOverruleRestAndStopsCountingWhenItStops) {
   // THEN rest holds: its bound is above the range's
   EXPECT_EQ(s.mode(), FlightMode::kRest);
   EXPECT_GT(s.tofLogOdds(), 10.0);
-  // WHEN the range stops reporting (out of range) for a second
-  feedTof(run, 1.0, rest, kNoTdoa);
+  // WHEN the range stops reporting (out of range) for 1.5 s
+  feedTof(run, 1.5, rest, kNoTdoa);
   // THEN its window has aged out: it says nothing
   EXPECT_DOUBLE_EQ(s.tofLogOdds(), 0.0);
   EXPECT_TRUE(std::isnan(s.tofHeight()));

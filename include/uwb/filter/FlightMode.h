@@ -131,8 +131,11 @@ class FlightModeSupervisor {
 
  private:
   void updateTdoaFactor();
-  /// Forgets the downward range's window up to t_s (it ages whether or not readings come) and re-weighs it (F29f).
-  void updateTofFactor(double t_s);
+  /// Re-weighs the downward range's window (F29f).
+  void updateTofFactor();
+  /// Drops the range's window when no reading came for kTofStaleWindows forgetting times (F29f).
+  void dropStaleTof(double t_s);
+  static constexpr double kTofStaleWindows = 5.0;
   /// ½ min(n, tdoa_independent) [log(m_floor + σ²) − log(m_air + σ²)] with m_air = s²_air + d², d the distance of h_air
   /// from the flight range, clamped to [−tdoa_max_floor_log_odds, tdoa_max_log_odds] (F29c, F29f).
   double heightLogOdds(double n, double h_air, double s2_air, double ms_floor, double sigma_m) const;
