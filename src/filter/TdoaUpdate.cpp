@@ -15,11 +15,9 @@ namespace uwb {
 
 void AnchorTable::set(int id, const Vec3& w_p, double sigma_m) {
   if (id < 0 || id > 4095) throw std::invalid_argument("AnchorTable::set: anchor id must be in [0, 4095]");
-  // Grown on the size of known_, the vector that is copied bytewise: a test on the other vector's size leaves GCC 12
-  // unable to bound the copy and, inlined at link time, it reports a -Wstringop-overflow false positive.
-  if (known_.size() <= static_cast<std::size_t>(id)) {
-    known_.resize(id + 1, 0);
+  if (static_cast<int>(anchors_.size()) <= id) {
     anchors_.resize(id + 1);
+    known_.resize(id + 1, 0);
   }
   anchors_[id].m = w_p;
   anchors_[id].V = Mat3::Identity() * (sigma_m * sigma_m);
