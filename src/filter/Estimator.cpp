@@ -229,10 +229,14 @@ void Estimator::finishStart(double t_s, const StartFix& fix) {
     summary_.start_rms_residual_m = fix.rms_residual_m;
   }
   ready_ = true;
+  // (F16g) a replayed start ran the acquisition from the window's start already, over the window's TDoA: it counts,
+  // and what is left of it runs from here
+  beginAcquisitionPhase(t_s, replayed ? fix.t_ref_s : t_s);
+}
+
+void Estimator::beginAcquisitionPhase(double t_s, double t_start_s) {
   phase_ = FlightPhase::kAcquisition;
-  // (F16) the acquisition lasts acquisition_s from the fix; (F16g) a replayed start ran it from the window's start
-  // already, over the window's TDoA: it counts, and what is left of it runs from here
-  t_acq_end_ = (replayed ? fix.t_ref_s : t_s) + params_.acquisition_s;
+  t_acq_end_ = t_start_s + params_.acquisition_s;  // (F16) the acquisition lasts acquisition_s from its start
   t_fix_settled_ = t_s + params_.acquisition_s;  // (F25d) the antenna learner waits this long after any fix
   t_last_accept_ = t_s;
   n_rejected_streak_ = 0;
@@ -673,22 +677,21 @@ void Estimator::acquireFromHeightWindow(double t_s) {
   const double h_m = tof ? mode_.tofHeight() : mode_.tdoaHeight();
   const double spread_m = tof ? mode_.tofHeightSpread() : mode_.tdoaHeightSpread();
   const double sigma_m = tof ? mp.tof_height_sigma_m : mp.height_floor_sigma_m;
-  if (!(std::isfinite(h_m) && std::isfinite(spread_m))) {
+  // the air hypothesis that overruled the floor puts the body at the nearest height of the flight range, d from the
+  // window's mean; a window whose variance exceeds that of the flight range itself (uniform: (h_max − h_min)²/12)
+  // locates the height less well than the hypothesis alone (a floor whose TDoA carry metres of bias, after a rough
+  // landing): the position is found again by multilateration instead
+  const double range_m = mp.air_max_height_m - mp.air_min_height_m;
+  const double h_air = std::clamp(h_m, mp.air_min_height_m, mp.air_max_height_m);
+  const double var_m2 = spread_m * spread_m + (h_m - h_air) * (h_m - h_air) + sigma_m * sigma_m;
+  if (!(std::isfinite(h_m) && std::isfinite(spread_m)) || var_m2 > range_m * range_m / 12.0) {
     startAcquisition(t_s, true);
     return;
   }
-  ekf_.resetHeight(params_.ground_z_m + h_m, spread_m * spread_m + sigma_m * sigma_m);
+  ekf_.resetHeight(params_.ground_z_m + h_air, var_m2);
   ekf_.inflateHorizontalPosition(params_.rest_tdoa_sigma_m, params_.moving_start_vel_sigma_mps);
-  landing_fix_ = false;
-  floor_check_ = false;
-  descent_.clear();
-  climb_.clear();
-  phase_ = FlightPhase::kAcquisition;
-  t_acq_end_ = t_s + params_.acquisition_s;
-  t_fix_settled_ = t_s + params_.acquisition_s;  // (F25d) as after a fix
-  t_last_accept_ = t_s;
-  n_rejected_streak_ = 0;
-  n_rejected_recent_ = n_gated_recent_ = 0.0;
+  climb_.clear();  // the height is the window's, not dead-reckoned from the floor (leaveGround may have started it)
+  beginAcquisitionPhase(t_s, t_s);
 }
 
 void Estimator::runPeriodicChecks(double t_s) {

@@ -13,19 +13,23 @@ namespace {
 
 constexpr double kImuDt_s = 0.001;
 constexpr double kTdoaDt_s = 0.0025;
+constexpr double kTofDt_s = 0.04;  // the Flow deck's 25 Hz
 
 /// A supervisor started in `mode`, its clock from t = 0, and the noise of the TDoA heights seeded by `seed`.
 struct SupervisorRun {
   SupervisorRun(FlightMode mode, unsigned seed) : rng(seed) { s.reset(mode); }
 
   /// Feeds `duration_s` of IMU evidence (1 kHz) and TDoA (400 Hz) whose heights scatter about `tdoa_height_m` with
-  /// `spread_m` (the estimate sits at `estimate_height_m`); the vertical gains cycle through ±0.4…0.8.
+  /// `spread_m` (the estimate sits at `estimate_height_m`); the vertical gains cycle through ±0.4…0.8. A finite
+  /// `tof_height_m` adds a downward range reading it at 25 Hz; NaN heights leave that sensor silent.
   void feed(double duration_s, const ImuModeEvidence& imu, double tdoa_height_m, double spread_m,
-            double estimate_height_m, bool settled_in_air = false) {
+            double estimate_height_m, bool settled_in_air = false,
+            double tof_height_m = std::numeric_limits<double>::quiet_NaN()) {
     std::normal_distribution<double> n(0.0, 1.0);
     const double gains[] = {0.8, -0.5, 0.4, -0.7, 0.6};
     const double t_end = t + duration_s;
     double t_next_tdoa = t;
+    double t_next_tof = t;
     int k = 0;
     while (t < t_end) {
       t += kImuDt_s;
@@ -36,6 +40,10 @@ struct SupervisorRun {
         const double r = (h - estimate_height_m) * g;
         s.addTdoa(t, r, r, g, estimate_height_m);
         t_next_tdoa += kTdoaDt_s;
+      }
+      if (std::isfinite(tof_height_m) && t >= t_next_tof) {
+        s.addTof(t, tof_height_m);
+        t_next_tof += kTofDt_s;
       }
       s.decide(t);
     }
@@ -125,32 +133,19 @@ TEST(FlightMode, DoubtIsCountedWhileTheImuHoldsTheFloorAgainstTheTdoa) {
 }
 
 /// Feeds `duration_s` of IMU evidence (1 kHz) and downward ranges (25 Hz, as the Flow deck's) measuring `height_m`.
-void feedTof(SupervisorRun& run, double duration_s, const ImuModeEvidence& imu, double height_m) {
-  const double t_end = run.t + duration_s;
-  double t_next = run.t;
-  while (run.t < t_end) {
-    run.t += kImuDt_s;
-    run.s.addImu(run.t, kImuDt_s, imu, false);
-    if (std::isfinite(height_m) && run.t >= t_next) {
-      run.s.addTof(run.t, height_m);
-      t_next += 0.04;
-    }
-    run.s.decide(run.t);
-  }
-}
 
 TEST(FlightMode, ADownwardRangeThatReadsAHeightLiftsTheImusFloorContact) {
   // GIVEN floor contact by the IMU (a drone whose gyro shakes in flight) and a range that reads the floor
   SupervisorRun run(FlightMode::kContact, 7);
   FlightModeSupervisor& s = run.s;
   const ImuModeEvidence contact{false, true, false, 0.3 * 0.3};
-  feedTof(run, 0.5, contact, 0.02);
+  run.feed(0.5, contact, kNoTdoa, 0.0, 0.0, false, 0.02);
   // THEN the floor holds; a range near zero is weak floor evidence (an obstacle under a hovering drone reads so)
   EXPECT_EQ(s.mode(), FlightMode::kContact);
   EXPECT_DOUBLE_EQ(s.tofLogOdds(), -FlightModeParams{}.tdoa_max_floor_log_odds);
   EXPECT_NEAR(s.tofHeight(), 0.02, 1e-9);
   // WHEN the range reads 0.5 m, the IMU unchanged
-  feedTof(run, 0.5, contact, 0.5);
+  run.feed(0.5, contact, kNoTdoa, 0.0, 0.0, false, 0.5);
   // THEN airborne against the IMU (F29f), the status word says why
   EXPECT_EQ(s.mode(), FlightMode::kAirborne);
   EXPECT_GT(s.tofLogOdds(), FlightModeParams{}.imu_max_log_odds + FlightModeParams{}.hysteresis_log_odds);
@@ -164,12 +159,12 @@ TEST(FlightMode, ADownwardRangeDoesNotOverruleRestAndStopsCountingWhenItStops) {
   SupervisorRun run(FlightMode::kRest, 8);
   FlightModeSupervisor& s = run.s;
   const ImuModeEvidence rest{true, false, false, 0.0};
-  feedTof(run, 1.0, rest, 1.0);
+  run.feed(1.0, rest, kNoTdoa, 0.0, 0.0, false, 1.0);
   // THEN rest holds: its bound is above the range's
   EXPECT_EQ(s.mode(), FlightMode::kRest);
   EXPECT_GT(s.tofLogOdds(), 10.0);
   // WHEN the range stops reporting (out of range) for 1.5 s
-  feedTof(run, 1.5, rest, kNoTdoa);
+  run.feed(1.5, rest, kNoTdoa, 0.0, 0.0, false, kNoTdoa);
   // THEN its window has aged out: it says nothing
   EXPECT_DOUBLE_EQ(s.tofLogOdds(), 0.0);
   EXPECT_TRUE(std::isnan(s.tofHeight()));

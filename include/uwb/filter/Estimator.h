@@ -279,6 +279,9 @@ class Estimator {
   void updateModelMeanScale();
   /// (F29c) The ranging overruled the floor: the height from its window, the acquisition's robust updates (F16).
   void acquireFromHeightWindow(double t_s);
+  /// (F16) The acquisition phase from a fix or a height reset at t_s: its robust updates until t_start_s +
+  /// acquisition_s, the rejection counters and the time of the last accepted TDoA restarted.
+  void beginAcquisitionPhase(double t_s, double t_start_s);
   /// Drops a landing's or a floor check's window unsolved (F16i, F29e).
   void cancelStartWindow();
 
