@@ -16,19 +16,12 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from script_args import pilot_setup
 
 args = sys.argv[1:]
 extra = args[args.index("--") + 1:] if "--" in args else []
 args = args[: args.index("--")] if "--" in args else args
-build = Path(args[0] if args else "build").resolve()
-sys.path.insert(0, str(build / "python"))
-import uwbtdoa  # noqa: E402
-
-cli = str(build / "uwbtdoa")
-data = Path(subprocess.run([cli, "paths"], capture_output=True, text=True, check=True).stdout.strip())
-pilot = data / "real" / "util-pilot"
-if not (pilot / "survey").is_dir():
-    sys.exit(f"ground_coverage: no util-pilot flights under {pilot}")
+uwbtdoa, cli, pilot = pilot_setup(args[0] if args else "build")
 
 sessions = {"0425": [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12], "0426": [1, 2, 11, 12]}
 print("| session | part | flights | 1σ coverage x/y/z [%] | 2σ coverage x/y/z [%] | RMS error x/y/z [m] | median σ x/y/z [m] |")

@@ -54,6 +54,16 @@ TEST_F(ProtocolCli, JsonRowsCarryTheFiguresAndTheFlightsBiasLevel) {
   }
   EXPECT_EQ(row.at("session").get<std::string>(), "0425");
   EXPECT_FALSE(row.at("survey_fit_warning").get<bool>());  // the check after the run is silent on a clean flight
+  // and the session's summary pools its airborne samples: with one flight, that flight's 2σ coverage; it counts the
+  // flight as outside 85–99 % exactly when one of its axes is
+  const nlohmann::json& session = j.at("real_whole_summary").at("0425");
+  bool outside = false;
+  for (int k = 0; k < 3; ++k) {
+    const double c2 = row.at("coverage_2sigma_xyz").at(k).get<double>();
+    EXPECT_NEAR(session.at("pooled_coverage_2sigma_xyz").at(k).get<double>(), c2, 1e-12);
+    outside = outside || c2 < 0.85 || c2 > 0.99;
+  }
+  EXPECT_EQ(session.at("n_flights_2sigma_outside_85_99").get<int>(), outside ? 1 : 0);
 }
 
 TEST_F(ProtocolCli, TheCutsAreAlsoLoggedToTheLandingAndTheSurveyCheckStaysSilentOnThem) {

@@ -406,13 +406,14 @@ TEST(Generalization, RealFlightWithALargeBiasWidensItsReportedSigma) {
   EXPECT_GT(c.coverage_2sigma.minCoeff(), 0.85);
   EXPECT_LT(c_fixed.coverage_1sigma.z(), 0.45);
   EXPECT_EQ(run.metrics->airborne.rmse_m, run_fixed.metrics->airborne.rmse_m);
-  // and with the defaults' vertical factor 0.8, chosen on the 0425 flights with this one among them (filter.md F23d),
-  // this flight, the most biased one, is the one left over-confident in z at 1σ (47 %), still within 85–99 % at 2σ;
-  // x and y do not change
+  // and with the defaults' vertical factor 0.7, chosen on the 0425 flights without their range with this one among them
+  // (filter.md F23d), this flight, the most biased one, is the one left over-confident in z at 1σ (40 %), still within
+  // 85–99 % at 2σ (92 %); x and y do not change
   const EstimateChecks c_default = checks(run_default, flight, survey);
-  EXPECT_GT(c_default.coverage_1sigma.z(), 0.42);
+  EXPECT_GT(c_default.coverage_1sigma.z(), 0.36);
   EXPECT_LT(c_default.coverage_1sigma.z(), c.coverage_1sigma.z());
-  EXPECT_GT(c_default.coverage_2sigma.z(), 0.9);
+  EXPECT_GT(c_default.coverage_2sigma.z(), 0.88);
+  EXPECT_LT(c_default.coverage_2sigma.z(), 0.99);
   EXPECT_EQ(c_default.coverage_1sigma.head<2>(), c.coverage_1sigma.head<2>());
   EXPECT_EQ(run_default.metrics->airborne.rmse_m, run.metrics->airborne.rmse_m);
   // and the level it measured is above the reference, reported in the summary; none is measured when it is off

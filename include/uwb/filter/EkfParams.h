@@ -200,7 +200,7 @@ struct EkfParams {
   double output_bias_sigma_m = 0.2;      ///< pair TDoA-bias std mapped into the reported covariance [m]; 0 off (F23)
   double output_bias_memory_s = 30.0;    ///< memory of the flight's bias level measured in flight [s]; 0 off (F23c)
   double output_bias_level_m = 0.24;     ///< reference level above which the band widens [m] (F23c)
-  double output_bias_vertical_scale = 0.8;  ///< factor s on the bias term's vertical part, C ← S C S (F23d)
+  double output_bias_vertical_scale = 0.7;  ///< factor s on the bias term's vertical part, C ← S C S (F23d)
   double recent_pair_window_s = 0.5;     ///< pairs seen within this enter the bias term [s] (F23, F16k)
   double bias_floor_period_s = 0.05;     ///< the bias term is recomputed at most this often [s] (F23)
 
