@@ -132,8 +132,6 @@ TEST(FlightMode, DoubtIsCountedWhileTheImuHoldsTheFloorAgainstTheTdoa) {
   EXPECT_NEAR(s.doubtedFloorMaxHeight(), 0.35, 0.05);
 }
 
-/// Feeds `duration_s` of IMU evidence (1 kHz) and downward ranges (25 Hz, as the Flow deck's) measuring `height_m`.
-
 TEST(FlightMode, ADownwardRangeThatReadsAHeightLiftsTheImusFloorContact) {
   // GIVEN floor contact by the IMU (a drone whose gyro shakes in flight) and a range that reads the floor
   SupervisorRun run(FlightMode::kContact, 7);

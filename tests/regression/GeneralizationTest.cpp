@@ -410,9 +410,9 @@ TEST(Generalization, RealFlightWithALargeBiasWidensItsReportedSigma) {
   // (filter.md F23d), this flight, the most biased one, is the one left over-confident in z at 1σ (40 %), still within
   // 85–99 % at 2σ (92 %); x and y do not change
   const EstimateChecks c_default = checks(run_default, flight, survey);
-  EXPECT_GT(c_default.coverage_1sigma.z(), 0.36);
+  EXPECT_GT(c_default.coverage_1sigma.z(), 0.38);
   EXPECT_LT(c_default.coverage_1sigma.z(), c.coverage_1sigma.z());
-  EXPECT_GT(c_default.coverage_2sigma.z(), 0.88);
+  EXPECT_GT(c_default.coverage_2sigma.z(), 0.9);
   EXPECT_LT(c_default.coverage_2sigma.z(), 0.99);
   EXPECT_EQ(c_default.coverage_1sigma.head<2>(), c.coverage_1sigma.head<2>());
   EXPECT_EQ(run_default.metrics->airborne.rmse_m, run.metrics->airborne.rmse_m);
